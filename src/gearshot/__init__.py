@@ -1,0 +1,43 @@
+"""gearshot: one-fault-shot estimation of gear tooth-fault size from vibration.
+
+Implements the method of Matania et al., *Advanced Engineering Informatics* 56 (2023)
+101945: train on a physics simulator, close the sim-to-real gap with one faulty example,
+and remove transfer-path effects.
+
+Subpackages (imported on first use):
+
+``gearshot.signal``
+    Pure DSP functions (angular resampling, synchronous average, orders, spectra, ...).
+``gearshot.features``
+    Condition indicators and their registry.
+``gearshot.transfer``
+    Transfer-function estimation, I/O and propagation.
+``gearshot.sim``
+    The gear-pair dynamic simulator and simulated databases.
+``gearshot.rig``
+    Recordings and the virtual test rig.
+"""
+
+from __future__ import annotations
+
+import importlib
+from importlib.metadata import PackageNotFoundError, version
+
+from ._errors import GearshotError
+from ._paths import data_home
+
+try:
+    __version__ = version("gearshot")
+except PackageNotFoundError:  # running from a source tree
+    __version__ = "0.0.0+unknown"
+
+_SUBMODULES = {"signal", "features", "transfer", "sim", "rig", "estimator", "experiments",
+               "plotting", "cli"}
+
+__all__ = ["GearshotError", "data_home", "__version__", *sorted(_SUBMODULES)]
+
+
+def __getattr__(name: str):
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module 'gearshot' has no attribute {name!r}")

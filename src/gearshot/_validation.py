@@ -1,0 +1,137 @@
+"""Shared input validators. Every message names the parameter and quotes the value."""
+
+from __future__ import annotations
+
+import numbers
+from typing import Any
+
+import numpy as np
+
+from ._errors import GearshotError
+
+__all__ = [
+    "as_signal_array",
+    "check_finite",
+    "check_positive",
+    "check_int",
+    "check_in_range",
+    "describe",
+]
+
+
+def describe(value: Any) -> str:
+    """Short, readable rendering of a (possibly large) value for error messages."""
+    if isinstance(value, np.ndarray):
+        if value.size <= 6:
+            return f"array({np.array2string(value, precision=4, separator=', ')}, shape={value.shape})"
+        return f"array(shape={value.shape}, dtype={value.dtype})"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def check_finite(x: np.ndarray, name: str) -> np.ndarray:
+    """Raise if ``x`` holds NaN or inf."""
+    if not np.all(np.isfinite(x)):
+        bad = np.flatnonzero(~np.isfinite(np.asarray(x).ravel()))
+        first = np.asarray(x).ravel()[bad[0]]
+        raise GearshotError(
+            f"{name} must be finite; it holds {bad.size} non-finite value(s), "
+            f"first {first!r} at flat index {bad[0]}"
+        )
+    return x
+
+
+def as_signal_array(
+    x: Any,
+    name: str,
+    *,
+    min_ndim: int = 1,
+    max_ndim: int | None = None,
+    min_length: int = 1,
+    allow_complex: bool = False,
+) -> np.ndarray:
+    """Convert ``x`` to a finite float (or complex) array with signals along the last axis.
+
+    Parameters
+    ----------
+    x : array_like
+        Input.
+    name : str
+        Parameter name used in error messages.
+    min_ndim, max_ndim : int
+        Accepted number of dimensions.
+    min_length : int
+        Minimum length of the last axis.
+    allow_complex : bool
+        Keep complex input complex; otherwise complex input is an error.
+    """
+    try:
+        arr = np.asarray(x)
+    except Exception as exc:  # ragged lists etc.
+        raise GearshotError(f"{name} must be array-like; got {describe(x)} ({exc})") from None
+    if arr.dtype == object or not (
+        np.issubdtype(arr.dtype, np.number) or np.issubdtype(arr.dtype, np.bool_)
+    ):
+        raise GearshotError(f"{name} must be numeric; got dtype {arr.dtype}")
+    if np.iscomplexobj(arr):
+        if not allow_complex:
+            raise GearshotError(f"{name} must be real; got complex dtype {arr.dtype}")
+        arr = arr.astype(np.complex128, copy=False)
+    else:
+        arr = arr.astype(np.float64, copy=False)
+    if arr.ndim < min_ndim or (max_ndim is not None and arr.ndim > max_ndim):
+        want = f"{min_ndim}" if max_ndim == min_ndim else (
+            f"at least {min_ndim}" if max_ndim is None else f"{min_ndim} to {max_ndim}")
+        raise GearshotError(f"{name} must have {want} dimension(s); got ndim={arr.ndim} "
+                            f"(shape {arr.shape})")
+    if arr.size == 0:
+        raise GearshotError(f"{name} must not be empty; got shape {arr.shape}")
+    if arr.ndim >= 1 and arr.shape[-1] < min_length:
+        raise GearshotError(
+            f"{name} must have at least {min_length} samples along its last axis; "
+            f"got {arr.shape[-1]}")
+    check_finite(arr, name)
+    return arr
+
+
+def check_int(value: Any, name: str, *, minimum: int | None = None,
+              maximum: int | None = None) -> int:
+    """Validate an integer parameter (bools are rejected)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        if isinstance(value, numbers.Real) and float(value).is_integer():
+            value = int(value)
+        else:
+            raise GearshotError(f"{name} must be an integer; got {describe(value)}")
+    value = int(value)
+    if minimum is not None and value < minimum:
+        raise GearshotError(f"{name} must be >= {minimum}; got {value}")
+    if maximum is not None and value > maximum:
+        raise GearshotError(f"{name} must be <= {maximum}; got {value}")
+    return value
+
+
+def check_positive(value: Any, name: str, *, allow_zero: bool = False) -> float:
+    """Validate a finite positive real scalar."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise GearshotError(f"{name} must be a real number; got {describe(value)}")
+    value = float(value)
+    if not np.isfinite(value):
+        raise GearshotError(f"{name} must be finite; got {value}")
+    if value < 0 or (value == 0 and not allow_zero):
+        raise GearshotError(f"{name} must be {'>= 0' if allow_zero else '> 0'}; got {value}")
+    return value
+
+
+def check_in_range(value: Any, name: str, low: float, high: float, *,
+                   low_inclusive: bool = True, high_inclusive: bool = True) -> float:
+    """Validate a finite real scalar inside an interval."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise GearshotError(f"{name} must be a real number; got {describe(value)}")
+    value = float(value)
+    ok_low = value >= low if low_inclusive else value > low
+    ok_high = value <= high if high_inclusive else value < high
+    if not (np.isfinite(value) and ok_low and ok_high):
+        lb = "[" if low_inclusive else "("
+        hb = "]" if high_inclusive else ")"
+        raise GearshotError(f"{name} must lie in {lb}{low}, {high}{hb}; got {value}")
+    return value
