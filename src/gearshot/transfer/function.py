@@ -75,13 +75,13 @@ class TransferFunction:
             raise GearshotError(f"values must have the shape of freqs {freqs.shape}; "
                                 f"got {values.shape}")
         if freqs[0] < 0:
-            raise GearshotError(f"freqs must be >= 0 Hz; got first line {freqs[0]!r}")
+            raise GearshotError(f"freqs must be >= 0 Hz; got first line {float(freqs[0])!r}")
         steps = np.diff(freqs)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
             raise GearshotError(
-                f"freqs must be strictly increasing; freqs[{i}]={freqs[i]!r} is followed by "
-                f"freqs[{i + 1}]={freqs[i + 1]!r}")
+                f"freqs must be strictly increasing; freqs[{i}]={float(freqs[i])!r} is followed by "
+                f"freqs[{i + 1}]={float(freqs[i + 1])!r}")
         for key in ("response_node", "response_direction", "reference_node",
                     "reference_direction"):
             object.__setattr__(self, key, check_int(getattr(self, key), key))
@@ -192,7 +192,7 @@ class TransferFunction:
         slack = self.df * (1 + 1e-9)
         far = (f < lo - slack) | (f > hi + slack)
         if outside == "error" and np.any(far):
-            bad = f[far].ravel()[0]
+            bad = float(f[far].ravel()[0])
             raise GearshotError(
                 f"freqs reach {bad!r} Hz, outside the band of TF {self.name!r} "
                 f"[{lo:g}, {hi:g}] Hz; pass outside='edge' or outside='zero'")

@@ -150,12 +150,12 @@ def _check_58(path: Path, i: int, dset: dict) -> tuple[np.ndarray, np.ndarray]:
     if not np.all(np.isfinite(y)):
         k = int(np.flatnonzero(~np.isfinite(y))[0])
         raise _fail(path, f"{where} has {int(np.sum(~np.isfinite(y)))} non-finite data "
-                          f"value(s) (NaN or inf), first at point {k} (x={x[k]!r})")
+                          f"value(s) (NaN or inf), first at point {k} (x={float(x[k])!r})")
     steps = np.diff(x)
     if np.any(steps <= 0):
         k = int(np.flatnonzero(steps <= 0)[0])
-        raise _fail(path, f"{where}: abscissa is not strictly increasing: x[{k}]={x[k]!r}, "
-                          f"x[{k + 1}]={x[k + 1]!r}")
+        raise _fail(path, f"{where}: abscissa is not strictly increasing: x[{k}]={float(x[k])!r}, "
+                          f"x[{k + 1}]={float(x[k + 1])!r}")
     return x, y
 
 
@@ -164,7 +164,7 @@ def _tf_from_58(path: Path, i: int, dset: dict) -> TransferFunction:
     if x.size < 2:
         raise _fail(path, f"dataset {i} has only {x.size} frequency line(s); need >= 2")
     if x[0] < 0:
-        raise _fail(path, f"dataset {i}: negative frequency {x[0]!r} Hz")
+        raise _fail(path, f"dataset {i}: negative frequency {float(x[0])!r} Hz")
     units = str(dset.get("ordinate_axis_units_lab", "") or "").strip()
     meta = {k: dset[k] for k in _KEEP if k in dset}
     meta["source"] = str(path)
@@ -260,7 +260,7 @@ def _read_csv(path: Path) -> TransferFunction:
     if x.size < 2:
         raise _fail(path, f"only {x.size} frequency line(s); need >= 2")
     if x[0] < 0:
-        raise _fail(path, f"negative frequency {x[0]!r} Hz")
+        raise _fail(path, f"negative frequency {float(x[0])!r} Hz")
 
     def _int(key: str) -> int:
         try:
@@ -357,7 +357,9 @@ def write_frf(path: str | os.PathLike, tf: TransferFunction, *,
 
     def _write(tmp: Path) -> None:
         try:
-            pyuff.UFF(str(tmp)).write_sets(dset, mode="overwrite")
+            # 'add' into the fresh empty temp file: pyuff's 'overwrite' mode truncates the
+            # ASCII header of a binary 58b dataset when it reopens the file for the data.
+            pyuff.UFF(str(tmp)).write_sets(dset, mode="add")
         except Exception as exc:
             raise _fail(p, f"pyuff could not write the dataset ({exc})") from None
 
