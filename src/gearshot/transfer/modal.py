@@ -149,23 +149,37 @@ def attenuation_db(tf: TransferFunction) -> float:
 
 
 def antiresonances(tf: TransferFunction, *, min_depth_db: float = 10.0) -> np.ndarray:
-    """Frequencies (Hz) of antiresonances: local minima of |H| lying at least
-    ``min_depth_db`` below the smaller of the highest maxima on either side up to the
-    neighbouring deeper minima (i.e. a notch between two resonance peaks)."""
+    """Frequencies (Hz) of the antiresonances of an FRF.
+
+    An antiresonance is a notch made by a lightly damped zero pair: a local minimum of |H|
+    that lies at least ``min_depth_db`` below the smaller of the highest levels reached on
+    either side before the curve drops below the notch again, and across which the phase
+    *rises* (by more than π/4 between the lines where |H| is back 3 dB above the minimum).
+    The phase rise tells a zero from a mere trough between two resonances whose residues
+    change sign (there the phase keeps falling).
+    """
     min_depth_db = check_positive(min_depth_db, "min_depth_db", allow_zero=True)
     mag = 20 * np.log10(np.maximum(tf.magnitude, np.finfo(float).tiny))
+    phase = tf.phase
     inner = np.arange(1, mag.size - 1)
     cand = inner[(mag[inner] < mag[inner - 1]) & (mag[inner] <= mag[inner + 1])]
     found = []
     for k in cand:
         left = mag[:k][::-1]
         right = mag[k + 1:]
-        # highest level reached before the curve drops below the notch again
-        lpk = _peak_until_lower(left, mag[k])
-        rpk = _peak_until_lower(right, mag[k])
-        if min(lpk, rpk) - mag[k] >= min_depth_db:
+        if min(_peak_until_lower(left, mag[k]), _peak_until_lower(right, mag[k])) \
+                - mag[k] < min_depth_db:
+            continue
+        lo = k - 1 - _first_at_least(left, mag[k] + 3.0)
+        hi = k + 1 + _first_at_least(right, mag[k] + 3.0)
+        if phase[hi] - phase[lo] > np.pi / 4:
             found.append(tf.freqs[k])
     return np.asarray(found, dtype=float)
+
+
+def _first_at_least(side: np.ndarray, level: float) -> int:
+    above = np.flatnonzero(side >= level)
+    return int(above[0]) if above.size else side.size - 1
 
 
 def _peak_until_lower(side: np.ndarray, level: float) -> float:
