@@ -6,7 +6,7 @@ import numpy as np
 from scipy.signal import oaconvolve
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int, check_positive
+from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .function import TransferFunction
 
 __all__ = ["fir_from_transfer_function", "filter_signal"]
@@ -14,11 +14,12 @@ __all__ = ["fir_from_transfer_function", "filter_signal"]
 
 def fir_from_transfer_function(tf: TransferFunction, fs: float, *, n_taps: int | None = None,
                                outside: str = "error", method: str = "linear") -> np.ndarray:
-    """Causal FIR impulse response of ``tf`` at sampling rate ``fs``.
+    """Periodic impulse response of ``tf`` at sampling rate ``fs`` (one period).
 
     The TF is interpolated (:meth:`TransferFunction.at`) on the ``n_taps``-point DFT grid
-    0, fs/n_taps, …, fs/2 and inverse-transformed; the result is the impulse response over
-    the first ``n_taps / fs`` seconds.
+    0, fs/n_taps, …, fs/2 and inverse-transformed. Sample ``k`` is the response at time
+    ``k / fs`` for ``k < n_taps - n_acausal`` and at ``(k - n_taps) / fs`` (before the input)
+    for the last samples; :func:`filter_signal` places them accordingly.
 
     Parameters
     ----------
@@ -54,13 +55,18 @@ def fir_from_transfer_function(tf: TransferFunction, fs: float, *, n_taps: int |
 
 
 def filter_signal(x, fs: float, tf: TransferFunction, *, n_taps: int | None = None,
-                  outside: str = "error", method: str = "linear") -> np.ndarray:
+                  acausal_fraction: float = 0.125, outside: str = "error",
+                  method: str = "linear") -> np.ndarray:
     """Pass a long recording through ``tf`` (linear convolution, no wrap-around).
 
-    The FIR from :func:`fir_from_transfer_function` is applied by overlap-add
-    (:func:`scipy.signal.oaconvolve`); the output is the first ``n_samples`` samples of the
-    full linear convolution, i.e. the response of an initially-at-rest system (the FIR's
-    start-up transient is at the beginning; nothing from the end of the record leaks back).
+    The periodic impulse response from :func:`fir_from_transfer_function` is unwrapped into
+    a linear FIR covering times ``-n_acausal/fs … (n_taps - n_acausal - 1)/fs`` with
+    ``n_acausal = round(acausal_fraction * n_taps)`` (a measured or band-limited FRF rings a
+    little before t = 0: the Nyquist-line truncation of a non-band-limited response, or an
+    estimation artefact), and applied by overlap-add (:func:`scipy.signal.oaconvolve`).
+    The output is aligned with the input (sample ``t`` of the output is the response at
+    ``t / fs``) and computed by full linear convolution: the system starts at rest and
+    nothing from the end of the record leaks back to its start.
 
     Parameters
     ----------
@@ -69,8 +75,14 @@ def filter_signal(x, fs: float, tf: TransferFunction, *, n_taps: int | None = No
     fs : float
         Sampling rate in Hz.
     tf : TransferFunction
-        Frequency axis in Hz (physical frequencies, unlike :meth:`~TransferFunction.to_signal_grid`).
-    n_taps, outside, method
+        Frequency axis in Hz (physical frequencies, unlike
+        :meth:`~TransferFunction.to_signal_grid`).
+    n_taps : int, optional
+        See :func:`fir_from_transfer_function`.
+    acausal_fraction : float
+        Share of the impulse-response period treated as negative time, in [0, 0.5].
+        0 gives a strictly causal FIR.
+    outside, method
         See :func:`fir_from_transfer_function`.
 
     Returns
@@ -79,8 +91,11 @@ def filter_signal(x, fs: float, tf: TransferFunction, *, n_taps: int | None = No
         The filtered signal(s) in the TF's output units.
     """
     x = as_signal_array(x, "x", min_ndim=1)
+    acausal_fraction = check_in_range(acausal_fraction, "acausal_fraction", 0.0, 0.5)
     h = fir_from_transfer_function(tf, fs, n_taps=n_taps, outside=outside, method=method)
+    n_acausal = int(round(acausal_fraction * h.size))
+    h = np.roll(h, n_acausal)          # now h[j] is the response at (j - n_acausal) / fs
     n = x.shape[-1]
     h = h.reshape((1,) * (x.ndim - 1) + (-1,))
     y = oaconvolve(x, h, mode="full", axes=-1)
-    return np.ascontiguousarray(y[..., :n])
+    return np.ascontiguousarray(y[..., n_acausal:n_acausal + n])
