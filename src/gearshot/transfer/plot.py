@@ -13,8 +13,8 @@ __all__ = ["plot_transfer_function", "plot_transfer_functions"]
 
 
 def plot_transfer_function(tf: TransferFunction, ax: Sequence | None = None, *,
-                           db: bool = True, wrap_phase: bool = True, label: str | None = None,
-                           **line_kw):
+                           db: bool = True, wrap_phase: bool = True, phase_center: float = 0.0,
+                           label: str | None = None, **line_kw):
     """Magnitude and phase of one TF against frequency in Hz.
 
     Parameters
@@ -26,7 +26,11 @@ def plot_transfer_function(tf: TransferFunction, ax: Sequence | None = None, *,
     db : bool
         Magnitude in dB (20·log10|H|) rather than linear.
     wrap_phase : bool
-        Phase in (−180°, 180°] (default) or unwrapped.
+        Phase wrapped into a 360° window (default) or unwrapped.
+    phase_center : float
+        Centre of the wrapping window in degrees: the phase is shown in
+        [phase_center − 180°, phase_center + 180°). Use 90 for nearly real FRFs (phase
+        close to 0° or 180°), which otherwise flicker between ±180°.
     label : str, optional
         Legend label (default: ``tf.name``).
     **line_kw
@@ -50,7 +54,11 @@ def plot_transfer_function(tf: TransferFunction, ax: Sequence | None = None, *,
     mag = tf.magnitude
     if db:
         mag = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))
-    ph = np.degrees(np.angle(tf.values) if wrap_phase else tf.phase)
+    if wrap_phase:
+        ph = np.mod(np.degrees(np.angle(tf.values)) - phase_center + 180.0, 360.0) \
+            - 180.0 + phase_center
+    else:
+        ph = np.degrees(tf.phase)
     label = tf.name if label is None else label
     (l_mag,) = ax_mag.plot(tf.freqs, mag, label=label, **line_kw)
     (l_ph,) = ax_ph.plot(tf.freqs, ph, label=label, **line_kw)
