@@ -53,6 +53,7 @@ def test_equality_ignores_metadata_only():
 def test_at_is_exact_on_lines_and_linear_between():
     tf = _tf()
     assert_allclose(tf.at(tf.freqs), tf.values, rtol=1e-14)
+    assert tf.at(15.0).shape == ()                     # scalar in, scalar out
     mid = tf.at(np.array([15.0]))[0]
     assert_allclose(mid, 0.5 * (tf.values[1] + tf.values[2]), rtol=1e-14)
     # magphase keeps |H| linear between lines

@@ -27,7 +27,8 @@ def _synthetic_impacts(n_impacts=4, noise=0.0, seed=0):
     for i in range(n_impacts):
         start = 40 + 7 * i
         width = 6 + i
-        force[i, start:start + width] = rng.uniform(50, 100) * np.sin(np.pi * np.arange(width) / width)
+        pulse = np.sin(np.pi * np.arange(width) / width)
+        force[i, start:start + width] = rng.uniform(50, 100) * pulse
     resp = lfilter(b, a, force, axis=-1)
     resp_noisy = resp + noise * rng.standard_normal(resp.shape)
     z = np.exp(-2j * np.pi * np.fft.rfftfreq(N, 1 / FS) / FS)
@@ -157,13 +158,16 @@ def test_real_hammer_single_impacts_agree_within_one_line(hammer):
             assert abs(f_single - f0) <= single.df, (i, f0, f_single)
 
 
-def test_real_hammer_h1_h2_agree_where_coherent(hammer):
+def test_real_hammer_h1_repeatable_across_impact_subsets(hammer):
+    """H1 from impacts 1, 3, 5 and from impacts 2, 4 agree at the main resonances."""
     force, resp, fs = hammer
-    h1, coh = frf_from_impacts(force, resp, fs, estimator="H1")
+    odd, _ = frf_from_impacts(force[0::2], resp[0::2], fs)
+    even, _ = frf_from_impacts(force[1::2], resp[1::2], fs)
+    for k in _main_resonances(odd):
+        assert abs(abs(even.values[k]) / abs(odd.values[k]) - 1) < 0.1, odd.freqs[k]
     h2, _ = frf_from_impacts(force, resp, fs, estimator="H2")
-    good = coh > 0.98
-    assert good.sum() > 1000
-    assert_allclose(np.abs(h1.values[good]), np.abs(h2.values[good]), rtol=0.021)
+    h1, coh = frf_from_impacts(force, resp, fs)
+    assert_allclose(np.abs(h1.values) / np.abs(h2.values), coh, rtol=1e-9)
 
 
 def test_impact_arrays_pairing_errors(hammer):

@@ -77,6 +77,21 @@ def test_uff_ascii_and_binary_precision(tmp_path):
     assert read_frf(tmp_path / "x.csv") == tf
 
 
+def test_several_frfs_in_one_file(tmp_path):
+    p = tmp_path / "multi.uff"
+    f = np.arange(6.0)
+    _raw58(p, func_type=1, x=f / 10, data=np.ones(6))               # a time record first
+    _raw58(p, x=f, data=np.ones(6) * (1 + 1j), id1="first")
+    _raw58(p, x=f, data=np.ones(6) * (2 - 1j), id1="second", rsp_node=4)
+    assert read_frf(p).name == "first"
+    second = read_frf(p, index=1)
+    assert second.name == "second" and second.response_node == 4
+    assert_array_equal(second.values, np.full(6, 2 - 1j))
+    with pytest.raises(GearshotError, match=r"multi\.uff.*index=2.*2 FRF"):
+        read_frf(p, index=2)
+    assert len(read_uff_records(p)) == 1
+
+
 def test_write_is_atomic_and_leaves_no_temp_file(tmp_path, monkeypatch):
     tf = _synthetic_tf()
     target = tmp_path / "a.uff"

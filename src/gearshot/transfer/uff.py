@@ -171,8 +171,10 @@ def _tf_from_58(path: Path, i: int, dset: dict) -> TransferFunction:
     return TransferFunction(
         freqs=x, values=np.asarray(y, dtype=np.complex128),
         name=str(dset.get("id1", "") or "").strip() or path.stem,
-        response_node=int(dset.get("rsp_node", 0)), response_direction=int(dset.get("rsp_dir", 0)),
-        reference_node=int(dset.get("ref_node", 0)), reference_direction=int(dset.get("ref_dir", 0)),
+        response_node=int(dset.get("rsp_node", 0)),
+        response_direction=int(dset.get("rsp_dir", 0)),
+        reference_node=int(dset.get("ref_node", 0)),
+        reference_direction=int(dset.get("ref_dir", 0)),
         response_quantity=_SPEC_TYPES.get(int(dset.get("ordinate_spec_data_type", 0)), "unknown"),
         reference_quantity=_SPEC_TYPES.get(int(dset.get("orddenom_spec_data_type", 0)), "unknown"),
         units="" if units.upper() == "NONE" else units, metadata=meta)
@@ -217,7 +219,8 @@ def read_frf(path: str | os.PathLike, *, index: int = 0) -> TransferFunction:
         found = sorted({(s.get("type"), s.get("func_type")) for s in sets}, key=str)
         desc = ", ".join(f"dataset {t}" + (f" function type {ft}" if ft is not None else "")
                          for t, ft in found)
-        raise _fail(p, f"wrong dataset type: no UFF58 FRF (function type 4) found; file holds {desc}")
+        raise _fail(p, "wrong dataset type: no UFF58 FRF (function type 4) found; "
+                       f"file holds {desc}")
     if index >= len(frfs):
         raise _fail(p, f"index={index} but the file holds {len(frfs)} FRF dataset(s)")
     i, dset = frfs[index]
@@ -225,6 +228,14 @@ def read_frf(path: str | os.PathLike, *, index: int = 0) -> TransferFunction:
         raise _fail(p, f"dataset {i} is function type 4 (FRF) but its ordinate is real "
                        f"(ord_data_type {dset.get('ord_data_type')}); expected complex")
     return _tf_from_58(p, i, dset)
+
+
+def _is_number_row(line: str) -> bool:
+    try:
+        [float(v) for v in line.split(",")]
+    except ValueError:
+        return False
+    return True
 
 
 def _read_csv(path: Path) -> TransferFunction:
@@ -245,8 +256,8 @@ def _read_csv(path: Path) -> TransferFunction:
                 meta[key.strip()] = val.strip()
             continue
         body.append(s)
-    if body and any(c.isalpha() and c not in "eE" for c in body[0].replace("nan", "").replace("inf", "")):
-        body = body[1:]  # column header line
+    if body and not _is_number_row(body[0]):
+        body = body[1:]  # column header line, e.g. "freq_hz,re,im"
     if not body:
         raise _fail(path, "no data rows (expected columns freq_hz, re, im)")
     try:
