@@ -247,8 +247,7 @@ def synthetic_bank(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines
     for i in range(n):
         k = int(rng.integers(m_lo, m_hi + 1))
         zeta = rng.uniform(min(z_lo, z_hi), max(z_lo, z_hi), size=k)
-        fr = _spread_modes(rng, k, lo + 0.03 * (hi - lo), lo + 0.97 * (hi - lo),
-                           min_gap=6 * z_hi * hi)
+        fr = _spread_modes(rng, k, lo + 0.03 * (hi - lo), lo + 0.97 * (hi - lo))
         mags = rng.lognormal(0.0, 0.6, size=k)
         flips = rng.random(k - 1) < 0.35
         if k > 1 and flips.all():
@@ -273,10 +272,9 @@ def synthetic_bank(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines
     return TransferFunctionBank(tfs)
 
 
-def _spread_modes(rng: np.random.Generator, k: int, lo: float, hi: float,
-                  min_gap: float) -> np.ndarray:
-    """k sorted frequencies uniform in [lo, hi] with gaps >= min_gap (shrunk if impossible)."""
-    gap = min(min_gap, 0.5 * (hi - lo) / max(k, 1))
-    # uniform spacing draw: place k points in a shortened interval, then add the gaps back
+def _spread_modes(rng: np.random.Generator, k: int, lo: float, hi: float) -> np.ndarray:
+    """k sorted frequencies in [lo, hi], random but at least half the mean spacing apart."""
+    gap = 0.5 * (hi - lo) / k
+    # k uniform points in an interval shortened by the k-1 gaps, then the gaps added back
     base = np.sort(rng.uniform(0.0, (hi - lo) - gap * (k - 1), size=k))
     return lo + base + gap * np.arange(k)

@@ -143,7 +143,8 @@ def _check_58(path: Path, i: int, dset: dict) -> tuple[np.ndarray, np.ndarray]:
     if y.size == 0:
         raise _fail(path, f"{where} holds no data values")
     if y.size != n_expected or x.size != y.size:
-        raise _fail(path, f"{where} is truncated: header announces {n_expected} points, "
+        what = "truncated" if y.size < n_expected else "inconsistent"
+        raise _fail(path, f"{where} is {what}: header announces {n_expected} points, "
                           f"{y.size} values read")
     if not np.all(np.isfinite(x)):
         raise _fail(path, f"{where} has non-finite abscissa values (NaN or inf)")
