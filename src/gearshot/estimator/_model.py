@@ -60,7 +60,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     selection_threshold : float, default 0.10
         Keep features whose invariance error is below this (step 1).
     grades : iterable of int, default range(1, 13)
-        DIN grades tried by simulation tuning (step 2).
+        DIN grades tried by simulation tuning (step 2); those absent from the database
+        are skipped.
     select_features : bool, default True
     tune_simulation : bool, default True
         When False, ``nominal_grade`` is used.
@@ -225,10 +226,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         if healthy_long is not None:
             healthy_long = as_signal_array(healthy_long, "healthy_long", max_ndim=1)
         self.database_ = _database_by_grade(database, n_points)
-        missing = [g for g in grades if g not in self.database_]
-        if missing:
-            raise GearshotError(f"grades {missing} are not in the database (it has "
-                                f"{sorted(self.database_)})")
+        grades = [g for g in grades if g in self.database_]
+        if not grades:
+            raise GearshotError(f"none of grades={list(self.grades)!r} is in the database "
+                                f"(it has {sorted(self.database_)})")
         nominal = self.nominal_grade if self.nominal_grade in self.database_ else grades[0]
         self.n_points_ = n_points
         self.transfer_function_ = self._target_tf(healthy_long, n_points)

@@ -206,11 +206,13 @@ def feature_invariance_errors(a, b):
 
 
 def _long_healthy_signal(healthy_sa, n_cycles, noise_rms, rng):
-    """A long cycle-domain healthy signal: healthy SAs one after another, fresh noise each."""
-    order = rng.integers(0, healthy_sa.shape[0], size=n_cycles)
-    cycles = healthy_sa[order] + noise_rms * rng.standard_normal((n_cycles,
-                                                                  healthy_sa.shape[1]))
-    return cycles
+    """A long cycle-domain healthy signal of one gear: its SA repeated, fresh noise each cycle.
+
+    What a long healthy recording is in the angle domain: the gear's periodic vibration plus
+    non-synchronous vibration, here white noise.
+    """
+    one = healthy_sa[rng.integers(0, healthy_sa.shape[0])]
+    return one + noise_rms * rng.standard_normal((n_cycles, one.size))
 
 
 def select_features(sim_sa, fault_size, selection_tf, *, mesh_order, names,
