@@ -231,7 +231,11 @@ def _check_sizes(fault_sizes):
     return arr
 
 
-def _as_rng(rng):
+def _as_rng(rng, n=None):
+    if isinstance(rng, (list, tuple)):
+        if n is not None and len(rng) != n:
+            raise GearshotError(f"rng must hold one seed per signal ({n}); got {len(rng)}")
+        return [_as_rng(r) for r in rng]
     if isinstance(rng, np.random.Generator):
         return rng
     if rng is None or isinstance(rng, (int, np.integer, np.random.SeedSequence)):
@@ -304,6 +308,12 @@ def _run(pair, integ, mesh_pos, motor_acc, load, faults, gear_errs, pin_errs, re
 
 
 def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
+    if isinstance(rng, list):          # one generator per signal
+        ge = [draw_profile_errors(pair.z_gear, grade, r) for r in rng]
+        pe = [draw_profile_errors(pair.z_pinion, grade, r) for r in rng]
+        if average_pinion:
+            pe = [e.mean_tooth() for e in pe]
+        return ge, pe
     if same_gear:
         ge = [draw_profile_errors(pair.z_gear, grade, rng)] * n
         pe = [draw_profile_errors(pair.z_pinion, grade, rng)] * n
@@ -352,7 +362,9 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     same_gear : bool
         One gear pair (one draw of profile errors) for every signal, whose fault grows;
         otherwise each signal draws its own.
-    rng : numpy.random.Generator or int or None
+    rng : numpy.random.Generator, int, None, or a list of those (one per signal)
+        Source of the profile errors; a list gives each signal its own stream (a signal
+        is then reproducible alone from its seed).
     fault_center, fault_depth : float
         FTFF placement and depth coefficient.
     min_fs : float
@@ -369,7 +381,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     sizes = _check_sizes(fault_sizes)
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = _as_rng(rng)
+    rng = _as_rng(rng, sizes.size)
     faults = _fault_list(pair, sizes, fault_center, fault_depth)
     t_rev = pair.z_gear / (pair.z_pinion * speed)
     n_rev = max(2 * n_points, int(math.ceil(t_rev * min_fs)))
