@@ -273,6 +273,7 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None)
                                 f"grade={man['grades'][k]!r} of {str(store)!r} is not built "
                                 f"yet; run build_database again to finish it")
         parts.append(xr.open_zarr(path, consolidated=False).load())
+    parts = [p.drop_vars(["speed", "load"]) for p in parts]
     ds = parts[0] if len(parts) == 1 else xr.concat(parts, dim="signal", coords="minimal",
                                                     compat="override")
-    return ds
+    return ds.assign_coords(speed=float(man["speeds"][i]), load=float(man["loads"][j]))
