@@ -22,7 +22,7 @@ def test_contract(tmp_path):
     assert ds.sa.shape == (15, 2048)
     assert list(np.unique(ds.grade.values)) == [5, 7, 9]
     assert np.all(ds.fault_size.values[:2] == 0) and ds.seed.dtype.kind == "i"
-    assert float(ds.speed) == 15 and float(ds.load) == 10
+    assert float(ds["speed"]) == 15 and float(ds["load"]) == 10  # ds.load is a method
     one = load_database(tmp_path / "db", speed=20, load=10, grade=7)
     assert one.sa.shape == (5, 2048) and np.all(one.grade.values == 7)
 
