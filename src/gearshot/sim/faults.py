@@ -1,0 +1,284 @@
+"""Tooth faults on the driven gear: an extensible base class and the full tooth face fault.
+
+A fault acts on the gear pair in two ways (DESIGN.md section 2):
+
+* it changes the single-pair stiffness of the pairs its tooth takes part in
+  (:meth:`ToothFault.section_loss` thins the tooth; :meth:`ToothFault.contact_roll`
+  moves the load point), and
+* it adds a displacement excitation along the line of action
+  (:meth:`ToothFault.displacement`).
+
+New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault` and
+override these three hooks; the stiffness and dynamics code only calls the hooks.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._errors import GearshotError
+from .._validation import check_in_range, check_int
+from .geometry import GearPair, involute_half_angle
+
+__all__ = ["ToothFault", "Fault", "FullToothFaceFault"]
+
+
+@dataclass(frozen=True)
+class ToothFault:
+    """Base class of faults on one tooth of the driven gear (healthy by itself).
+
+    Parameters
+    ----------
+    tooth : int
+        Index of the faulty gear tooth; tooth 0 enters contact at pinion angle 0.
+    """
+
+    tooth: int = 0
+
+    def __post_init__(self) -> None:
+        check_int(self.tooth, "tooth", minimum=0)
+
+    @property
+    def is_healthy(self) -> bool:
+        return True
+
+    def section_loss(self, pair: GearPair, x: np.ndarray) -> np.ndarray:
+        """Material removed from the tooth section (m of thickness) at axial positions
+        ``x`` (m from the gear centre along the tooth's centre line)."""
+        return np.zeros_like(np.asarray(x, dtype=float))
+
+    def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
+        """(s_min, breakpoints): the pair stiffness differs from healthy only for gear
+        roll fractions s >= s_min and is smooth between the breakpoints."""
+        return 1.0, np.array([])
+
+    def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """Roll fraction where the load actually acts when the nominal contact is at ``s``
+        (0 = lowest contact point, 1 = tip of the gear tooth)."""
+        return np.asarray(s, dtype=float)
+
+    def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """Displacement excitation along the line of action (m, negative = material
+        missing) when the nominal contact is at gear roll fraction ``s``."""
+        return np.zeros_like(np.asarray(s, dtype=float))
+
+
+@dataclass(frozen=True)
+class FullToothFaceFault(ToothFault):
+    """Full tooth face fault (FTFF): the flank of one gear tooth is cut by a circular arc
+    over the whole face width.
+
+    Parameters
+    ----------
+    size : float
+        y in [0, 1]: removed width along the active profile / active profile width
+        (fractions of the roll length of the active profile).
+    center : float
+        Centre of the cut as a fraction of the active profile (0 = lowest contact point,
+        1 = tip).
+    depth : float
+        Depth coefficient in (0, 1]: the arc's sagitta is ``depth x chord / 2``
+        (1 = semicircle).
+    tooth : int
+        Faulty gear tooth.
+    transmission : float
+        Scale of the displacement excitation (1 = the geometric value of
+        :meth:`deviation_depth`; 0 = stiffness change only). For sensitivity studies.
+    """
+
+    size: float = 0.0
+    center: float = 0.5
+    depth: float = 0.5
+    transmission: float = 1.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_in_range(self.size, "size", 0.0, 1.0)
+        check_in_range(self.center, "center", 0.0, 1.0)
+        check_in_range(self.depth, "depth", 0.0, 1.0, low_inclusive=False)
+        check_in_range(self.transmission, "transmission", 0.0, 10.0)
+        lo, hi = self.window
+        if lo < -1e-12 or hi > 1 + 1e-12:
+            raise GearshotError(
+                f"FTFF of size {self.size!r} centred at {self.center!r} leaves the active "
+                f"profile (spans {lo:.4g} to {hi:.4g}); choose center in "
+                f"[{self.size / 2:.4g}, {1 - self.size / 2:.4g}]")
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.size <= 0.0
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """(start, end) roll fractions of the cut on the gear's active profile."""
+        return self.center - 0.5 * self.size, self.center + 0.5 * self.size
+
+    # -- geometry helpers -------------------------------------------------------------
+    def _edges(self, pair: GearPair):
+        z = pair.z_gear
+        rb = pair.base_radius(z)
+        _, (l_lo, l_hi) = pair.roll_limits
+        s0, s1 = self.window
+        pts = []
+        for s in (s0, s1):
+            r = math.hypot(rb, l_lo + s * (l_hi - l_lo))
+            psi = float(involute_half_angle(z, pair.pressure_angle, np.array(r), rb))
+            pts.append((r * math.cos(psi), r * math.sin(psi)))
+        return np.array(pts)  # [[x_start, h_start], [x_end, h_end]]
+
+    def _arc(self, pair: GearPair):
+        (xa, ha), (xb, hb) = self._edges(pair)
+        chord = math.hypot(xb - xa, hb - ha)
+        radius = chord / 4 * (self.depth + 1 / self.depth)
+        sag = self.depth * chord / 2
+        tx, th = (xb - xa) / chord, (hb - ha) / chord
+        nx, nh = th, -tx          # normal pointing into the tooth (towards h = 0)
+        if nh > 0:
+            nx, nh = -nx, -nh
+        mx, mh = 0.5 * (xa + xb), 0.5 * (ha + hb)
+        cx, ch = mx - nx * (radius - sag), mh - nh * (radius - sag)
+        return (xa, xb), (cx, ch), radius, sag
+
+    def section_loss(self, pair: GearPair, x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if self.is_healthy:
+            return np.zeros_like(x)
+        (xa, xb), (cx, ch), radius, _ = self._arc(pair)
+        z = pair.z_gear
+        rb = pair.base_radius(z)
+        # healthy flank half-thickness at x (invert x(r) on a fine table)
+        r_tab = np.linspace(rb, pair.tip_radius(z), 2001)
+        psi = involute_half_angle(z, pair.pressure_angle, r_tab, rb)
+        x_tab, h_tab = r_tab * np.cos(psi), r_tab * np.sin(psi)
+        inside = (x > xa) & (x < xb)
+        out = np.zeros_like(x)
+        xi = x[inside]
+        h_flank = np.interp(xi, x_tab, h_tab)
+        h_arc = ch - np.sqrt(np.maximum(radius ** 2 - (xi - cx) ** 2, 0.0))
+        out[inside] = np.maximum(h_flank - h_arc, 0.0)
+        return out
+
+    def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
+        s0, s1 = self.window
+        if self.is_healthy:
+            return 1.0, np.array([])
+        return s0, np.array([s0, 0.5 * (s0 + s1), s1])
+
+    def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """While the nominal contact lies in the tip-side half of the cut, the mating flank
+        bridges the hollow and pivots on the cut's tip-side edge, so the load stays there;
+        in the root-side half it follows the cut again (only the thinning acts)."""
+        s = np.asarray(s, dtype=float)
+        if self.is_healthy:
+            return s
+        s0, s1 = self.window
+        mid = 0.5 * (s0 + s1)
+        out = s.copy()
+        out[(s > mid) & (s < s1)] = s1
+        return out
+
+    def _flank_points(self, pair: GearPair, margin: float = 0.25, n: int = 160):
+        """Polar (radius, angle from the tooth centre line) of the cut flank near the cut:
+        the arc, plus the involute up to ``margin`` of the active profile beyond it."""
+        z = pair.z_gear
+        rb = pair.base_radius(z)
+        _, (l_lo, l_hi) = pair.roll_limits
+        s0, s1 = self.window
+        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, n // 2),
+                    np.linspace(s1, min(s1 + margin, 1.0), n // 2)]
+        ls = l_lo + np.concatenate(pieces_s) * (l_hi - l_lo)
+        r = np.hypot(rb, np.maximum(ls, 0.0))
+        psi = involute_half_angle(z, pair.pressure_angle, r, rb)
+        (xa, xb), (cx, ch), radius, _ = self._arc(pair)
+        xx = np.linspace(xa, xb, n)
+        hh = ch - np.sqrt(np.maximum(radius ** 2 - (xx - cx) ** 2, 0.0))
+        return (np.concatenate([r, np.hypot(xx, hh)]),
+                np.concatenate([psi, np.arctan2(hh, xx)]))
+
+    def _retreat(self, pair: GearPair, u: np.ndarray) -> np.ndarray:
+        """Rigid-body retreat (m, >= 0) of the mating pinion flank when the nominal
+        contact is at line-of-action fraction ``u``: the smallest normal gap between the
+        pinion involute (through the nominal contact point) and the remaining gear flank
+        (cut arc and the involute beyond its edges), points within the pinion's flank."""
+        z1, z2 = pair.z_pinion, pair.z_gear
+        a0 = pair.pressure_angle
+        rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
+        ra1 = pair.tip_radius(z1)
+        (p_lo, p_hi), _ = pair.roll_limits
+        inv0 = math.tan(a0) - a0
+
+        def inv_r(r, rb):
+            al = np.arccos(np.clip(rb / r, -1.0, 1.0))
+            return np.tan(al) - al
+
+        d = np.array([math.sin(a0), math.cos(a0)])
+        t1 = rb1 * np.array([math.cos(a0), -math.sin(a0)])
+        o2 = np.array([pair.center_distance, 0.0])
+        lam = p_lo + np.asarray(u, dtype=float) * (p_hi - p_lo)
+        c = t1[None, :] + lam[:, None] * d[None, :]               # contact points
+        phi_p = np.arctan2(c[:, 1], c[:, 0]) + inv_r(np.hypot(c[:, 0], c[:, 1]), rb1)
+        cg = c - o2
+        phi_g = np.arctan2(cg[:, 1], cg[:, 0]) + inv_r(np.hypot(cg[:, 0], cg[:, 1]), rb2)
+        centre = phi_g - math.pi / (2 * z2) - inv0                 # gear tooth centre line
+        r, ang = self._flank_points(pair)
+        px = o2[0] + r[None, :] * np.cos(centre[:, None] + ang[None, :])
+        py = o2[1] + r[None, :] * np.sin(centre[:, None] + ang[None, :])
+        rp = np.hypot(px, py)
+        gap = rb1 * (np.arctan2(py, px) + inv_r(np.maximum(rp, rb1), rb1) - phi_p[:, None])
+        gap = (gap + math.pi * rb1) % (2 * math.pi * rb1) - math.pi * rb1
+        gap = np.where((rp >= rb1) & (rp <= ra1), gap, np.inf)
+        return np.clip(gap.min(axis=1), 0.0, None)
+
+    def deviation_depth(self, pair: GearPair) -> float:
+        """Peak displacement excitation (m) over the cut (see :meth:`displacement`)."""
+        if self.is_healthy:
+            return 0.0
+        s0, s1 = self.window
+        s = np.linspace(s0, s1, 257)
+        return float(-self.displacement(pair, s).min())
+
+    def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """Loss of approach along the line of action while the nominal contact lies in
+        the cut: the mating flank bridges the hollow and bears on the cut's edges (or its
+        floor, for shallow cuts), so the pair's transmission error drops by the rigid
+        gap computed from the exact involute geometry (:meth:`_retreat`)."""
+        s = np.asarray(s, dtype=float)
+        out = np.zeros_like(s)
+        if self.is_healthy:
+            return out
+        s0, s1 = self.window
+        inside = (s > s0) & (s < s1)
+        if inside.any():
+            # the retreat is smooth but for one kink: sample it on 193 points, interpolate
+            knots = np.linspace(s0, s1, 193)
+            ret = self._retreat(pair, 1.0 - knots)
+            out[inside] = -self.transmission * np.interp(s[inside], knots, ret)
+        return out
+
+
+class Fault:
+    """Namespace of fault constructors (``Fault.ftff(0.5)``)."""
+
+    @staticmethod
+    def ftff(size: float, *, center: float = 0.5, depth: float = 0.5,
+             tooth: int = 0) -> FullToothFaceFault:
+        """Full tooth face fault of size ``y`` on gear tooth ``tooth`` (see
+        :class:`FullToothFaceFault`)."""
+        return FullToothFaceFault(tooth=tooth, size=_as_float(size, "size"),
+                                  center=_as_float(center, "center"),
+                                  depth=_as_float(depth, "depth"))
+
+    @staticmethod
+    def healthy() -> ToothFault:
+        """No fault."""
+        return ToothFault()
+
+
+def _as_float(value, name):
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise GearshotError(f"{name} must be a real number; got {value!r}") from None
