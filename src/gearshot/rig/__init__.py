@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 from .angle import check_pulse_train, gear_cycle_times
+from .tacho import tacho_signal
 from .recording import FORMATS, Recording
 
-__all__ = ["Recording", "FORMATS", "gear_cycle_times", "check_pulse_train"]
+__all__ = ["Recording", "FORMATS", "gear_cycle_times", "check_pulse_train", "tacho_signal"]

@@ -58,6 +58,7 @@ class RawFile:
     fs: float | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
     positional_defaults: bool = False          # accel = channel 0, tacho = 1 if unnamed
+    time_channel: str | None = None            # a time column (never a default channel)
 
 
 @contextlib.contextmanager
@@ -174,7 +175,7 @@ def select_channels(raw: RawFile, *, accel: Any, tacho: Any, channels: Any
     0 and 1). ``tacho=False`` means "no tacho". A channel named explicitly but absent raises.
     """
     aliases = _channel_aliases(raw, channels)
-    names = list(raw.channels)
+    names = [n for n in raw.channels if n != raw.time_channel]
     if not names:
         raise GearshotError(f"{str(raw.path)!r} holds no signal channel")
 
@@ -253,4 +254,4 @@ def time_column_fs(path: Path, t: np.ndarray) -> float:
     if not (step > 0 and np.all(np.abs(dt - step) <= 1e-6 * step + 1e-12)):
         raise GearshotError(f"{str(path)!r}: the time column is not uniformly spaced "
                             f"(steps {dt.min()!r} .. {dt.max()!r} s)")
-    return 1.0 / step
+    return float(f"{1.0 / step:.9g}")  # time columns carry rounding noise

@@ -3,7 +3,8 @@
 A gearshot CSV starts with one comment line ``# gearshot.recording {json}`` holding ``fs``,
 ``n_samples`` and the metadata; foreign CSVs need ``fs=`` from the caller, a sidecar
 (``<name>.csv.json``) or a uniformly spaced ``time``/``t`` column (seconds). Other ``#`` lines
-before the header are ignored.
+before the header are ignored. Channel indices count every column, the time column included
+(it is never picked by default).
 """
 
 from __future__ import annotations
@@ -44,23 +45,24 @@ def read_csv(path: Path) -> RawFile:
         raise GearshotError(f"{str(path)!r} is not a readable CSV: {exc}") from None
     chans: dict[str, np.ndarray] = {}
     fs = header.get("fs")
+    time_name = None
     for name in frame.columns:
         col = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=np.float64)
         if np.isnan(col).any():
             bad = int(np.flatnonzero(np.isnan(col))[0])
             raise GearshotError(f"{str(path)!r}: column {name!r} has a missing or non-numeric "
                                 f"value in data row {bad} (truncated or damaged file?)")
-        if str(name).strip().lower() in TIME_NAMES:
+        chans[str(name).strip()] = col
+        if str(name).strip().lower() in TIME_NAMES and time_name is None:
+            time_name = str(name).strip()
             if fs is None:
                 fs = time_column_fs(path, col)
-            continue
-        chans[str(name).strip()] = col
     n_expected = header.get("n_samples")
     if n_expected is not None and int(n_expected) != len(frame):
         raise GearshotError(f"{str(path)!r} holds {len(frame)} rows but its header says "
                             f"{n_expected} (truncated file?)")
     return RawFile(path, chans, fs, dict(header.get("metadata", {})),
-                   positional_defaults=True)
+                   positional_defaults=True, time_channel=time_name)
 
 
 def write_csv(rec: Any, path: Path) -> None:
