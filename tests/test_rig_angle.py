@@ -105,7 +105,7 @@ def test_missing_and_flat_tacho(tmp_path):
     with pytest.raises(GearshotError, match="tacho is flat"):
         flat.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
     one = np.zeros_like(rec.acceleration)
-    one[1000:1100] = 5.0
+    one[1000:30000] = 5.0
     with pytest.raises(GearshotError, match="1 pulse"):
         Recording(rec.acceleration, one, FS).to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
 

@@ -12,8 +12,8 @@ re-sampled directly on the gear angle:
 2. The gear angle is the tacho-shaft angle times ``pinion_teeth / gear_teeth`` (input-shaft
    tacho) or 1 (output-shaft tacho). Gear revolution m therefore starts at tacho-shaft angle
    m * gear_teeth / pinion_teeth revolutions.
-3. The time of that angle is found by cubic-spline interpolation of the pulse times t(angle)
-   -- the same interpolation the angular re-sampler uses for the shaft angle. These
+3. The time of that angle comes from :func:`gearshot.signal.angle_to_time` (cubic spline of
+   the pulse times against angle) -- the same curve the angular re-sampler uses. These
    "virtual gear pulses" (one per gear revolution) go to ``angular_resample`` with
    ``pulses_per_rev=1`` and ``samples_per_rev = samples_per_cycle``.
 4. The angle-domain signal is cut into whole gear cycles; consecutive blocks of
@@ -27,10 +27,9 @@ shifted against each other (by whole teeth and fractions); SAs of one recording 
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline
-
 from .._errors import GearshotError
 from .._validation import check_int
+from ..signal import angle_to_time
 
 __all__ = [
     "check_pulse_train",
@@ -100,7 +99,7 @@ def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
     revs_per_cycle = gear_teeth / pinion_teeth if tacho_shaft == "input" else 1.0
     n_cycles = int(np.floor(shaft_revs[-1] / revs_per_cycle + 1e-9))
     targets = np.arange(n_cycles + 1) * revs_per_cycle
-    return CubicSpline(shaft_revs, pulses)(targets)
+    return angle_to_time(pulses, targets, pulses_per_rev=pulses_per_rev)
 
 
 def uniform_cycle_times(cycle_times: np.ndarray) -> np.ndarray:

@@ -266,7 +266,10 @@ class Recording:
             raise GearshotError(f"{self._label()} has no tacho; SA segments need one")
         if float(np.ptp(self.tacho)) == 0.0:
             raise GearshotError(f"{self._label()}: the tacho is flat (no pulses)")
-        pulses = np.asarray(pulse_times(self.tacho, self.fs, threshold=threshold))
+        try:
+            pulses = np.asarray(pulse_times(self.tacho, self.fs, threshold=threshold))
+        except GearshotError as exc:
+            raise GearshotError(f"{self._label()}: {exc}") from None
         return check_pulse_train(pulses, pulses_per_rev=self.tacho_pulses_per_rev,
                                  label=self._label())
 
