@@ -1,0 +1,279 @@
+"""Simulated SA databases on disk (xarray / Zarr), resumable and Dask-parallel.
+
+Layout of a store (a folder)::
+
+    store/
+      manifest.json                 build parameters (written first, atomically)
+      blocks/s{i}_l{j}_g{k}.zarr    one (speed, load, grade) block, an xarray Dataset
+
+A block is written to a temporary folder beside its final name and renamed when complete,
+so a block is either absent or whole; an interrupted build resumes by skipping the blocks
+present. Each block's random stream derives from ``SeedSequence(seed, spawn_key=(i, j, k))``
+and each signal's from the block's, so contents do not depend on order or interruption.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import uuid
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import GearshotError
+from .._paths import data_home
+from .._validation import check_finite, check_int, describe
+from .dynamics import simulate_sa
+from .geometry import GearPair
+
+__all__ = ["build_database", "load_database", "default_database_path"]
+
+_FORMAT = 1
+_SMALL_BUILD = 16  # blocks; larger builds start a LocalCluster when no client is given
+
+
+def default_database_path(name: str = "sim-db") -> Path:
+    """Default store location: ``gearshot.data_home() / "databases" / name``."""
+    return data_home() / "databases" / name
+
+
+def _check_values(values, name, *, integer=False, lo=None, hi=None):
+    try:
+        arr = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError):
+        raise GearshotError(f"{name} must be numbers; got {describe(values)}") from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise GearshotError(f"{name} must be a non-empty 1-D sequence; got {describe(values)}")
+    check_finite(arr, name)
+    if lo is not None and np.any(arr <= lo):
+        bad = arr[arr <= lo][0]
+        raise GearshotError(f"{name} must be > {lo}; got {bad!r}")
+    if integer:
+        if np.any(arr != np.round(arr)):
+            raise GearshotError(f"{name} must be integers; got {describe(values)}")
+        if hi is not None and np.any((arr < 1) | (arr > hi)):
+            bad = arr[(arr < 1) | (arr > hi)][0]
+            raise GearshotError(f"{name} must lie in 1 ... {hi}; got {int(bad)!r}")
+        return arr.astype(int)
+    if len(np.unique(arr)) != arr.size:
+        raise GearshotError(f"{name} must not repeat values; got {describe(values)}")
+    return arr
+
+
+def _block_name(i, j, k):
+    return f"s{i}_l{j}_g{k}.zarr"
+
+
+def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points):
+    return {"format": _FORMAT, "pair": repr(pair), "speeds": [float(s) for s in speeds],
+            "loads": [float(x) for x in loads], "grades": [int(g) for g in grades],
+            "n_healthy": n_healthy, "n_faulty": n_faulty, "seed": seed, "n_points": n_points}
+
+
+def _write_json_atomic(path: Path, obj) -> None:
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    tmp.write_text(json.dumps(obj, indent=1))
+    os.replace(tmp, path)
+
+
+def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: float,
+                 load: float, grade: int, n_healthy: int, n_faulty: int, seed: int,
+                 n_points: int, single_thread: bool = False) -> str:
+    import xarray as xr
+
+    if single_thread:
+        import numba
+        numba.set_num_threads(1)
+    blocks = Path(store) / "blocks"
+    final = blocks / _block_name(i, j, k)
+    if final.exists():
+        return final.name
+    ss = np.random.SeedSequence(seed, spawn_key=(i, j, k))
+    block_rng = np.random.default_rng(ss)
+    n = n_healthy + n_faulty
+    sizes = np.concatenate([np.zeros(n_healthy), block_rng.uniform(0.0, 1.0, n_faulty)])
+    sig_seeds = block_rng.integers(0, 2 ** 63 - 1, n, dtype=np.int64)
+    sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
+                     n_points=n_points, rng=[int(s) for s in sig_seeds])
+    ds = xr.Dataset(
+        {"sa": (("signal", "angle"), sa.astype(np.float64),
+                {"units": "g", "long_name": "vertical acceleration SA"})},
+        coords={"fault_size": ("signal", sizes), "grade": ("signal", np.full(n, grade)),
+                "seed": ("signal", sig_seeds), "speed": float(speed), "load": float(load),
+                "angle": ("angle", 2 * np.pi * np.arange(n_points) / n_points,
+                          {"units": "rad", "long_name": "driven-gear angle"})},
+        attrs={"speed_units": "rev/s (input shaft)", "load_units": "N m"})
+    tmp = blocks / f".{final.name}.{uuid.uuid4().hex}.tmp"
+    ds.to_zarr(tmp, mode="w", consolidated=False)
+    try:
+        os.rename(tmp, final)
+    except OSError:
+        # another worker finished the same block first
+        shutil.rmtree(tmp, ignore_errors=True)
+        if not final.exists():
+            raise
+    return final.name
+
+
+def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades,
+                   n_healthy: int = 100, n_faulty: int = 700, seed: int = 0,
+                   n_points: int = 2048, client=None, progress: bool = True) -> Path:
+    """Simulate SAs for every (speed, load, grade) and store them as Zarr.
+
+    Parameters
+    ----------
+    store : str or Path
+        Folder of the database (created). A store holding a different build is refused.
+    pair : GearPair, optional
+        Default ``GearPair.paper()``.
+    speeds : sequence of float
+        Input shaft speeds, rev/s.
+    loads : sequence of float
+        Output load torques, N m.
+    grades : sequence of int
+        DIN grades (1 ... 12).
+    n_healthy, n_faulty : int
+        Signals per block: healthy, then faulty with y ~ U(0, 1).
+    seed : int
+        Root seed.
+    n_points : int
+        SA length.
+    client : dask.distributed.Client, False or None
+        Run blocks on this client. ``None``: a LocalCluster for builds of more than 16
+        blocks, in-process otherwise; ``False``: always in-process.
+    progress : bool
+        Show a rich progress bar.
+
+    Returns
+    -------
+    Path
+        The store.
+    """
+    pair = GearPair.paper() if pair is None else pair
+    if not isinstance(pair, GearPair):
+        raise GearshotError(f"pair must be a GearPair; got {describe(pair)}")
+    speeds = _check_values(speeds, "speeds", lo=0)
+    loads = _check_values(loads, "loads", lo=0)
+    grades = _check_values(grades, "grades", integer=True, hi=12)
+    n_healthy = check_int(n_healthy, "n_healthy", minimum=0)
+    n_faulty = check_int(n_faulty, "n_faulty", minimum=0)
+    if n_healthy + n_faulty == 0:
+        raise GearshotError("n_healthy + n_faulty must be > 0; got 0")
+    seed = check_int(seed, "seed", minimum=0)
+    n_points = check_int(n_points, "n_points", minimum=16)
+    store = Path(store).expanduser()
+    manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points)
+    _prepare_store(store, manifest)
+
+    tasks = [(i, j, k, float(s), float(ld), int(g))
+             for i, s in enumerate(speeds) for j, ld in enumerate(loads)
+             for k, g in enumerate(grades)]
+    blocks = store / "blocks"
+    todo = [t for t in tasks if not (blocks / _block_name(*t[:3])).exists()]
+    own_cluster = None
+    if client is None and len(todo) > _SMALL_BUILD:
+        from dask.distributed import Client, LocalCluster
+        own_cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
+                                   processes=True)
+        client = Client(own_cluster)
+    try:
+        _run_tasks(store, pair, todo, len(tasks), n_healthy, n_faulty, seed, n_points,
+                   client if client else None, progress)
+    finally:
+        if own_cluster is not None:
+            client.close()
+            own_cluster.close()
+    return store
+
+
+def _prepare_store(store: Path, manifest: dict) -> None:
+    if store.exists() and not store.is_dir():
+        raise GearshotError(f"store must be a folder; {str(store)!r} is a file")
+    parent = store if store.exists() else store.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise GearshotError(f"store {str(store)!r} is not writable "
+                            f"(no write permission on {str(parent)!r})")
+    mpath = store / "manifest.json"
+    if mpath.exists():
+        old = json.loads(mpath.read_text())
+        if old != manifest:
+            diff = sorted(k for k in manifest if old.get(k) != manifest[k])
+            raise GearshotError(f"store {str(store)!r} holds a different build "
+                                f"(differs in {', '.join(diff)}); use a new store")
+    try:
+        (store / "blocks").mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise GearshotError(f"store {str(store)!r} is not writable ({exc})") from None
+    if not mpath.exists():
+        _write_json_atomic(mpath, manifest)
+    for leftover in (store / "blocks").glob(".*.tmp"):   # from interrupted runs
+        shutil.rmtree(leftover, ignore_errors=True)
+
+
+def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
+               progress):
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    columns = (TextColumn("simulating blocks"), BarColumn(), MofNCompleteColumn(),
+               TimeElapsedColumn(), TimeRemainingColumn())
+    with Progress(*columns, disable=not progress) as bar:
+        task = bar.add_task("blocks", total=n_total, completed=n_total - len(todo))
+        if client is None:
+            for t in todo:
+                _build_block(str(store), pair, *t, n_healthy, n_faulty, seed, n_points)
+                bar.advance(task)
+            return
+        from dask.distributed import as_completed
+        futures = [client.submit(_build_block, str(store), pair, *t, n_healthy, n_faulty,
+                                 seed, n_points, True, pure=False) for t in todo]
+        for fut in as_completed(futures):
+            fut.result()
+            bar.advance(task)
+
+
+def load_database(store, *, speed: float, load: float, grade: int | None = None):
+    """The SAs of one (speed, load) condition, optionally one grade.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``sa`` (signal, angle) float64 in g; coords ``fault_size``, ``grade``, ``seed``
+        along ``signal``; scalar ``speed`` (rev/s) and ``load`` (N m). With ``grade=None``
+        all grades are concatenated along ``signal`` in the build's grade order.
+    """
+    import xarray as xr
+
+    store = Path(store).expanduser()
+    mpath = store / "manifest.json"
+    if not mpath.exists():
+        raise GearshotError(f"store {str(store)!r} holds no gearshot database "
+                            f"(no manifest.json)")
+    man = json.loads(mpath.read_text())
+
+    def index(values, want, name):
+        hits = np.flatnonzero(np.isclose(values, want, rtol=1e-9, atol=1e-12))
+        if hits.size == 0:
+            raise GearshotError(f"{name} {want!r} is not in the database (has {values})")
+        return int(hits[0])
+
+    i = index(man["speeds"], speed, "speed")
+    j = index(man["loads"], load, "load")
+    ks = (range(len(man["grades"])) if grade is None
+          else [index(man["grades"], grade, "grade")])
+    parts = []
+    for k in ks:
+        path = store / "blocks" / _block_name(i, j, k)
+        if not path.exists():
+            raise GearshotError(f"block speed={speed!r}, load={load!r}, "
+                                f"grade={man['grades'][k]!r} of {str(store)!r} is not built "
+                                f"yet; run build_database again to finish it")
+        parts.append(xr.open_zarr(path, consolidated=False).load())
+    parts = [p.drop_vars(["speed", "load"]) for p in parts]
+    ds = parts[0] if len(parts) == 1 else xr.concat(parts, dim="signal", coords="minimal",
+                                                    compat="override")
+    return ds.assign_coords(speed=float(man["speeds"][i]), load=float(man["loads"][j]))

@@ -1,0 +1,526 @@
+"""Batched gear-pair dynamics: Newmark integration of the lumped-parameter model.
+
+Degrees of freedom (``q``, 7 of the 13 of DESIGN.md section 2)::
+
+    [x1, y1, phi1, x2, y2, phi2, phib]
+
+lateral bearing motions of pinion (1) and gear (2), their rotations about the nominal
+rigid motion driven by the motor angle theta_m(t), and the brake rotation. The axial
+and tilt DOFs of the 13-DOF model are left out: for a spur mesh whose load acts at
+mid-face the line-of-action vector has no axial or tilt terms, so those DOFs decouple
+exactly (K, M and C are block-diagonal) and do not reach the vertical acceleration.
+
+Mesh: ``K(t) = K0 + k_m(t) v v^T``; excitation ``v * sum_pairs k_pair e_pair``.
+Newmark beta = 1/4, gamma = 1/2. The effective-stiffness inverse for any k_m follows
+exactly from one precomputed inverse by the Sherman-Morrison formula (rank-one update),
+which replaces the angle-grid table of inverses. Modal damping (``pair.damping_ratio`` on
+every mode of the mean-stiffness system). Output: vertical acceleration ``y1'' + y2''``
+in g.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import numba as nb
+
+from .._errors import GearshotError
+from .._validation import check_finite, check_int, check_positive, describe
+from .faults import FullToothFaceFault, ToothFault
+from .geometry import GearPair
+from .profile_errors import ToothProfileErrors, draw_profile_errors
+from .stiffness import _N_TABLE, _pair_table
+
+__all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
+           "DEFAULT_MIN_FS"]
+
+G0 = 9.80665
+#: internal integration rate floor, Hz (see benchmarks/RESULTS_sim.md: dt convergence)
+DEFAULT_MIN_FS = 100e3
+_BATCH_CHUNK = 64
+
+
+# ----------------------------------------------------------------------------- model
+def system_matrices(pair: GearPair):
+    """Mass, constant stiffness, damping, line-of-action vector of the 7-DOF model.
+
+    Returns
+    -------
+    M, K0, C : ndarray (7, 7)
+    v : ndarray (7,)
+        Mesh deflection = v . q (m).
+    """
+    m1, m2 = pair.masses
+    j1, j2 = pair.inertias
+    kt1, kt2 = pair.shaft_torsional_stiffness
+    kb = pair.bearing_stiffness
+    a = pair.pressure_angle
+    rb1, rb2 = pair.base_radius(pair.z_pinion), pair.base_radius(pair.z_gear)
+    M = np.diag([m1, m1, j1, m2, m2, j2, pair.inertia_brake])
+    K0 = np.zeros((7, 7))
+    for i in (0, 1, 3, 4):
+        K0[i, i] = kb
+    K0[2, 2] = kt1
+    K0[5, 5] += kt2
+    K0[6, 6] += kt2
+    K0[5, 6] = K0[6, 5] = -kt2
+    v = np.array([math.sin(a), math.cos(a), rb1, -math.sin(a), -math.cos(a), -rb2, 0.0])
+    k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
+    K = K0 + k_mean * np.outer(v, v)
+    # modal damping on the mean system
+    L = np.linalg.cholesky(M)
+    Li = np.linalg.inv(L)
+    w2, psi = np.linalg.eigh(Li @ K @ Li.T)
+    phi = Li.T @ psi                          # mass-normalised modes
+    omega = np.sqrt(np.maximum(w2, 0.0))
+    C = M @ phi @ np.diag(2 * pair.damping_ratio * omega) @ phi.T @ M
+    return M, K0, C, v, omega
+
+
+@dataclass(frozen=True)
+class _Integrator:
+    B1: np.ndarray
+    B2: np.ndarray
+    B3: np.ndarray
+    w: np.ndarray
+    s: float
+    v: np.ndarray
+    c_load: np.ndarray
+    c_motor: np.ndarray
+    x_static: np.ndarray
+    coef: np.ndarray      # a0, a2, a3, a6, a7
+    omega_min: float
+
+
+def _integrator(pair: GearPair, dt: float, load0: float) -> _Integrator:
+    M, K0, C, v, omega = system_matrices(pair)
+    beta, gamma = 0.25, 0.5
+    a0 = 1 / (beta * dt ** 2)
+    a1 = gamma / (beta * dt)
+    a2 = 1 / (beta * dt)
+    a3 = 1 / (2 * beta) - 1
+    a4 = gamma / beta - 1
+    a5 = dt / 2 * (gamma / beta - 2)
+    a6 = dt * (1 - gamma)
+    a7 = gamma * dt
+    A = K0 + a0 * M + a1 * C
+    Ai = np.linalg.inv(A)
+    Ai = 0.5 * (Ai + Ai.T)
+    B1 = Ai @ (a0 * M + a1 * C)
+    B2 = Ai @ (a2 * M + a4 * C)
+    B3 = Ai @ (a3 * M + a5 * C)
+    w = Ai @ v
+    f_load = np.zeros(7)
+    f_load[6] = -1.0                      # brake torque opposes rotation (per N m)
+    ratio = pair.z_pinion / pair.z_gear
+    f_motor = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
+    k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
+    x_static = np.linalg.solve(K0 + k_mean * np.outer(v, v), f_load * load0)
+    return _Integrator(B1, B2, B3, w, float(v @ w), v, Ai @ f_load, Ai @ f_motor, x_static,
+                       np.array([a0, a2, a3, a6, a7]), float(omega[omega > 0].min()))
+
+
+@nb.njit(cache=True, fastmath=False)
+def _interp_table(tab, u):
+    n = tab.shape[0] - 1
+    p = u * n
+    i = int(p)
+    if i >= n:
+        return tab[n]
+    f = p - i
+    return tab[i] * (1.0 - f) + tab[i + 1] * f
+
+
+@nb.njit(cache=True)
+def _tooth_error(slope, wav, phase, noise, nwaves, t, s):
+    knots = noise.shape[1]
+    p = s * (knots - 1)
+    i = int(p)
+    if i > knots - 2:
+        i = knots - 2
+    f = p - i
+    return (slope[t] * s + 0.5 * wav[t] * math.sin(2.0 * math.pi * nwaves * s + phase[t])
+            + noise[t, i] * (1.0 - f) + noise[t, i + 1] * f)
+
+
+@nb.njit(cache=True, parallel=True)
+def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, f_lo, f_hi, f_h, f_tooth,
+                   g_slope, g_wav, g_phase, g_noise, g_nw,
+                   p_slope, p_wav, p_phase, p_noise, p_nw,
+                   eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, x0, coef,
+                   rec_start, out):
+    n_batch = out.shape[0]
+    n_steps = mesh_pos.shape[0]
+    n_rec = out.shape[1]
+    ndof = x0.shape[0]
+    a0, a2, a3, a6, a7 = coef[0], coef[1], coef[2], coef[3], coef[4]
+    n_pairs = int(math.ceil(eps)) + 1
+    z_pin = p_slope.shape[1]
+    for b in nb.prange(n_batch):
+        x = x0.copy()
+        vel = np.zeros(ndof)
+        acc = np.zeros(ndof)
+        xb = np.zeros(ndof)
+        for n in range(n_steps):
+            tm = mesh_pos[n]
+            base = math.floor(tm)
+            kk = 0.0
+            fex = 0.0
+            for j in range(n_pairs):
+                nn = base - j
+                u = (tm - nn) / eps
+                if u < 0.0 or u >= 1.0:
+                    continue
+                gt = int(nn % z_gear)
+                pt = int(nn % z_pin)
+                faulty = gt == f_tooth[b]
+                if faulty:
+                    k = _interp_table(kf_tab[b], u)
+                else:
+                    k = _interp_table(k_tab, u)
+                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt,
+                                  1.0 - u)
+                     + _tooth_error(p_slope[b], p_wav[b], p_phase[b], p_noise[b], p_nw, pt,
+                                    u))
+                if faulty and u > f_lo[b] and u < f_hi[b]:
+                    rel = (u - f_lo[b]) / (f_hi[b] - f_lo[b])
+                    e -= f_h[b] * 0.5 * (1.0 - math.cos(2.0 * math.pi * rel))
+                kk += k
+                fex += k * e
+            ld = load[n]
+            ma = motor_acc[n]
+            for i in range(ndof):
+                acc_i = w[i] * fex + c_load[i] * ld + c_motor[i] * ma
+                for jj in range(ndof):
+                    acc_i += B1[i, jj] * x[jj] + B2[i, jj] * vel[jj] + B3[i, jj] * acc[jj]
+                xb[i] = acc_i
+            proj = 0.0
+            for i in range(ndof):
+                proj += v[i] * xb[i]
+            corr = kk * proj / (1.0 + kk * s)
+            for i in range(ndof):
+                xn = xb[i] - corr * w[i]
+                an = a0 * (xn - x[i]) - a2 * vel[i] - a3 * acc[i]
+                vel[i] = vel[i] + a6 * acc[i] + a7 * an
+                acc[i] = an
+                x[i] = xn
+            r = n - rec_start
+            if r >= 0 and r < n_rec:
+                out[b, r] = (acc[1] + acc[4]) / 9.80665
+
+
+# ----------------------------------------------------------------------------- inputs
+def _check_grade(grade):
+    return check_int(grade, "grade", minimum=1, maximum=12)
+
+
+def _check_sizes(fault_sizes):
+    arr = np.atleast_1d(np.asarray(fault_sizes, dtype=float)) if not isinstance(
+        fault_sizes, str) else None
+    if arr is None or arr.ndim != 1 or arr.size == 0:
+        raise GearshotError(f"fault_sizes must be a non-empty 1-D sequence; got "
+                            f"{describe(fault_sizes)}")
+    check_finite(arr, "fault_sizes")
+    bad = (arr < 0) | (arr > 1)
+    if bad.any():
+        raise GearshotError(f"fault_sizes must lie in [0, 1]; got {arr[bad][0]!r} "
+                            f"at index {int(np.flatnonzero(bad)[0])}")
+    return arr
+
+
+def _as_rng(rng, n=None):
+    if isinstance(rng, (list, tuple)):
+        if n is not None and len(rng) != n:
+            raise GearshotError(f"rng must hold one seed per signal ({n}); got {len(rng)}")
+        return [_as_rng(r) for r in rng]
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is None or isinstance(rng, (int, np.integer, np.random.SeedSequence)):
+        return np.random.default_rng(rng)
+    raise GearshotError(f"rng must be a numpy Generator, a seed or None; got {describe(rng)}")
+
+
+def _profile(value, name, times):
+    """Constant, callable f(t) or array (resampled onto ``times``) -> array over times."""
+    if callable(value):
+        arr = np.asarray(value(times), dtype=float)
+        if arr.shape == ():
+            arr = np.full(times.shape, float(arr))
+        if arr.shape != times.shape:
+            raise GearshotError(f"{name}(t) must return an array shaped like t {times.shape};"
+                                f" got shape {arr.shape}")
+    elif np.ndim(value) == 0:
+        arr = np.full(times.shape, check_positive(value, name))
+    else:
+        src = np.asarray(value, dtype=float)
+        if src.ndim != 1 or src.size < 2:
+            raise GearshotError(f"{name} must be a scalar, a callable or a 1-D array of "
+                                f">= 2 samples; got {describe(value)}")
+        arr = src
+    check_finite(arr, name)
+    if np.any(arr <= 0):
+        raise GearshotError(f"{name} must be > 0 everywhere; got minimum {arr.min()!r}")
+    return arr
+
+
+def _fault_list(pair, sizes, center, depth):
+    return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
+
+
+def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
+    n = len(faults)
+    kf = np.empty((n, _N_TABLE))
+    lo, hi, h, tooth = np.zeros(n), np.zeros(n), np.zeros(n), np.full(n, -1, dtype=np.int64)
+    healthy = _pair_table(pair, None)
+    for i, f in enumerate(faults):
+        if f is None or f.is_healthy:
+            kf[i] = healthy
+            continue
+        kf[i] = _pair_table(pair, f)
+        tooth[i] = f.tooth % pair.z_gear
+        if isinstance(f, FullToothFaceFault):
+            s0, s1 = f.window
+            lo[i], hi[i] = 1.0 - s1, 1.0 - s0
+            h[i] = f.transmission * f.deviation_depth(pair)
+    return kf, lo, hi, h, tooth
+
+
+def _stack_errors(errs: list[ToothProfileErrors]):
+    return (np.stack([e.slope for e in errs]), np.stack([e.waviness for e in errs]),
+            np.stack([e.phase for e in errs]), np.stack([e.noise for e in errs]),
+            float(errs[0].n_waves))
+
+
+def _run(pair, integ, mesh_pos, motor_acc, load, faults, gear_errs, pin_errs, rec_start,
+         n_rec):
+    kf, lo, hi, h, tooth = _fault_arrays(pair, faults)
+    g = _stack_errors(gear_errs)
+    p = _stack_errors(pin_errs)
+    out = np.empty((len(faults), n_rec))
+    _newmark_batch(mesh_pos, motor_acc, load, _pair_table(pair, None), kf, lo, hi, h, tooth,
+                   *g, *p, pair.contact_ratio, pair.z_gear, integ.B1, integ.B2, integ.B3,
+                   integ.w, integ.s, integ.v, integ.c_load, integ.c_motor, integ.x_static,
+                   integ.coef, rec_start, out)
+    return out
+
+
+def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
+    if isinstance(rng, list):          # one generator per signal
+        ge = [draw_profile_errors(pair.z_gear, grade, r) for r in rng]
+        pe = [draw_profile_errors(pair.z_pinion, grade, r) for r in rng]
+        if average_pinion:
+            pe = [e.mean_tooth() for e in pe]
+        return ge, pe
+    if same_gear:
+        ge = [draw_profile_errors(pair.z_gear, grade, rng)] * n
+        pe = [draw_profile_errors(pair.z_pinion, grade, rng)] * n
+    else:
+        ge, pe = [], []
+        for _ in range(n):
+            ge.append(draw_profile_errors(pair.z_gear, grade, rng))
+            pe.append(draw_profile_errors(pair.z_pinion, grade, rng))
+    if average_pinion:
+        pe = [e.mean_tooth() for e in pe]
+    return ge, pe
+
+
+def _warmup_time(pair: GearPair, integ: _Integrator) -> float:
+    # transients of the slowest mode decay to < 1e-4 of their start
+    return 9.2 / (pair.damping_ratio * integ.omega_min)
+
+
+# ----------------------------------------------------------------------------- public API
+def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes,
+                n_points: int = 2048, same_gear: bool = False, rng=None,
+                fault_center: float = 0.5, fault_depth: float = 0.5,
+                min_fs: float = DEFAULT_MIN_FS) -> np.ndarray:
+    """Synchronous averages over one revolution of the driven gear, steady state.
+
+    The SA of the vertical acceleration over the hunting period averages the pinion's
+    tooth-to-tooth errors to its mean tooth; the model is linear with gear-periodic
+    stiffness, so the SA equals the steady-state response of one gear revolution to
+    the gear's own errors plus the pinion's mean-tooth errors. That response is what is
+    integrated here (after a warm-up that damps the start transient below 1e-4), then
+    resampled to ``n_points`` by ideal FFT resampling (orders >= n_points/2 dropped).
+
+    Parameters
+    ----------
+    pair : GearPair
+    speed : float
+        Input (pinion) shaft speed, rev/s.
+    load : float
+        Load torque on the output shaft, N m.
+    grade : int
+        DIN 3962 quality grade 1 ... 12.
+    fault_sizes : sequence of float
+        FTFF sizes y in [0, 1] (0 = healthy), one signal each.
+    n_points : int
+        Points per SA cycle.
+    same_gear : bool
+        One gear pair (one draw of profile errors) for every signal, whose fault grows;
+        otherwise each signal draws its own.
+    rng : numpy.random.Generator, int, None, or a list of those (one per signal)
+        Source of the profile errors; a list gives each signal its own stream (a signal
+        is then reproducible alone from its seed).
+    fault_center, fault_depth : float
+        FTFF placement and depth coefficient.
+    min_fs : float
+        Lowest internal integration rate, Hz.
+
+    Returns
+    -------
+    ndarray (len(fault_sizes), n_points)
+        Vertical acceleration SAs, g.
+    """
+    speed = check_positive(speed, "speed")
+    load = check_positive(load, "load")
+    grade = _check_grade(grade)
+    sizes = _check_sizes(fault_sizes)
+    n_points = check_int(n_points, "n_points", minimum=16)
+    min_fs = check_positive(min_fs, "min_fs")
+    rng = _as_rng(rng, sizes.size)
+    faults = _fault_list(pair, sizes, fault_center, fault_depth)
+    t_rev = pair.z_gear / (pair.z_pinion * speed)
+    n_rev = max(2 * n_points, int(math.ceil(t_rev * min_fs)))
+    dt = t_rev / n_rev
+    integ = _integrator(pair, dt, load)
+    n_warm = int(math.ceil(_warmup_time(pair, integ) / dt))
+    n_steps = n_warm + n_rev
+    tau = (np.arange(n_steps) + 1 - n_warm) * dt        # record: tau = 0 ... t_rev - dt
+    mesh_pos = tau * speed * pair.z_pinion
+    zeros = np.zeros(n_steps)
+    loads = np.full(n_steps, load)
+    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=True)
+    out = np.empty((sizes.size, n_points))
+    for start in range(0, sizes.size, _BATCH_CHUNK):
+        sl = slice(start, start + _BATCH_CHUNK)
+        acc = _run(pair, integ, mesh_pos, zeros, loads, faults[sl], ge[sl], pe[sl],
+                   n_warm - 1, n_rev)
+        out[sl] = _fft_resample(acc, n_points)
+    return out
+
+
+def _fft_resample(x: np.ndarray, n_out: int) -> np.ndarray:
+    n = x.shape[-1]
+    X = np.fft.rfft(x, axis=-1)
+    Y = np.zeros(x.shape[:-1] + (n_out // 2 + 1,), dtype=complex)
+    keep = min(n_out // 2, X.shape[-1] - 1)
+    Y[..., :keep] = X[..., :keep]
+    if n_out % 2 == 0 and keep == n_out // 2:
+        Y[..., keep] = X[..., keep].real
+    return np.fft.irfft(Y, n=n_out, axis=-1) * (n_out / n)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Time signals of :func:`simulate`.
+
+    Attributes
+    ----------
+    acceleration : ndarray (n_signals, n_samples)
+        Vertical acceleration (sum of both bearings), g.
+    pinion_angle : ndarray (n_samples,)
+        Motor / pinion nominal rotation angle, rad (0 at the first sample).
+    time : ndarray (n_samples,)
+        s.
+    fs : float
+        Sampling rate, Hz.
+    """
+
+    acceleration: np.ndarray
+    pinion_angle: np.ndarray
+    time: np.ndarray
+    fs: float
+
+
+def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
+             duration: float | None = None, n_revs: float | None = None, rng=None,
+             same_gear: bool = False, fault_center: float = 0.5, fault_depth: float = 0.5,
+             min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
+    """Vertical-acceleration time signals, steady state from the first sample.
+
+    Parameters
+    ----------
+    pair : GearPair
+    speed : float, callable or 1-D array
+        Input shaft speed, rev/s: a constant, ``speed(t)`` (t in s, vectorised) or samples
+        at ``fs`` covering the output duration.
+    load : float, callable or 1-D array
+        Output load torque, N m, same forms as ``speed``.
+    grade : int
+        DIN grade 1 ... 12.
+    fault_sizes : sequence of float
+        FTFF sizes, one signal each.
+    fs : float
+        Output sampling rate, Hz; the integration runs at an integer multiple >= min_fs
+        and is decimated with an anti-aliasing filter.
+    duration, n_revs : float
+        Signal length in seconds, or in input-shaft revolutions (one of the two).
+    rng, same_gear, fault_center, fault_depth, min_fs
+        As in :func:`simulate_sa`.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    from scipy.signal import resample_poly
+
+    fs = check_positive(fs, "fs")
+    grade = _check_grade(grade)
+    sizes = _check_sizes(fault_sizes)
+    min_fs = check_positive(min_fs, "min_fs")
+    rng = _as_rng(rng)
+    if (duration is None) == (n_revs is None):
+        raise GearshotError("give exactly one of duration and n_revs; got "
+                            f"duration={duration!r}, n_revs={n_revs!r}")
+    up = max(1, int(math.ceil(min_fs / fs)))
+    dt = 1.0 / (fs * up)
+    probe = np.array([0.0])
+    speed0 = float(_profile(speed, "speed", probe)[0])
+    if duration is None:
+        n_revs = check_positive(n_revs, "n_revs")
+        if callable(speed) or np.ndim(speed):
+            raise GearshotError("n_revs needs a constant speed; give duration instead")
+        duration = n_revs / speed0
+    duration = check_positive(duration, "duration")
+    n_out = int(round(duration * fs))
+    if n_out < 2:
+        raise GearshotError(f"duration must span >= 2 samples at fs; got {duration!r} s")
+    n_fine = n_out * up
+    t_fine = np.arange(n_fine) * dt
+    if np.ndim(speed) and not callable(speed):
+        sp_src = _profile(speed, "speed", probe)
+        t_src = np.arange(sp_src.size) / fs
+        sp = np.interp(t_fine, t_src, sp_src)
+    else:
+        sp = _profile(speed, "speed", t_fine)
+    if np.ndim(load) and not callable(load):
+        ld_src = _profile(load, "load", probe)
+        ld = np.interp(t_fine, np.arange(ld_src.size) / fs, ld_src)
+    else:
+        ld = _profile(load, "load", t_fine)
+    integ = _integrator(pair, dt, float(ld[0]))
+    n_warm = int(math.ceil(_warmup_time(pair, integ) / dt))
+    # warm-up at the initial speed and load (tau < 0), then the requested profile
+    tau_warm = (np.arange(n_warm - 1) - (n_warm - 1)) * dt
+    theta_fine = 2 * np.pi * np.concatenate(
+        [[0.0], np.cumsum(0.5 * (sp[1:] + sp[:-1]) * dt)])
+    theta = np.concatenate([2 * np.pi * sp[0] * tau_warm, theta_fine])
+    omega = 2 * np.pi * np.concatenate([np.full(n_warm - 1, sp[0]), sp])
+    motor_acc = np.gradient(omega, dt)
+    loads = np.concatenate([np.full(n_warm - 1, ld[0]), ld])
+    mesh_pos = theta * pair.z_pinion / (2 * np.pi)
+    faults = _fault_list(pair, sizes, fault_center, fault_depth)
+    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=False)
+    acc = np.empty((sizes.size, n_out))
+    for start in range(0, sizes.size, _BATCH_CHUNK):
+        sl = slice(start, start + _BATCH_CHUNK)
+        fine = _run(pair, integ, mesh_pos, motor_acc, loads,
+                    faults[sl], ge[sl], pe[sl], n_warm - 1, n_fine)
+        acc[sl] = resample_poly(fine, 1, up, axis=-1) if up > 1 else fine
+    angle = theta_fine[::up]
+    return SimulationResult(acceleration=acc, pinion_angle=angle,
+                            time=np.arange(n_out) / fs, fs=fs)

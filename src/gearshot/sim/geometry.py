@@ -1,0 +1,205 @@
+"""Spur gear pair parameters and involute geometry (SI units throughout)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._errors import GearshotError
+from .._validation import check_int, check_positive, check_in_range
+
+__all__ = ["GearPair"]
+
+
+@dataclass(frozen=True)
+class GearPair:
+    """A spur gear pair on two shafts, with its test-rig surroundings.
+
+    The pinion (``z_pinion`` teeth) drives the gear (``z_gear`` teeth). All values SI.
+
+    Parameters
+    ----------
+    z_pinion, z_gear : int
+        Numbers of teeth (>= 12).
+    module : float
+        Module, m.
+    face_width : float
+        Face width, m.
+    pressure_angle : float
+        Nominal pressure angle, rad.
+    youngs_modulus : float
+        E, Pa.
+    poisson : float
+        Poisson's ratio.
+    density : float
+        kg/m^3 (used for default masses).
+    bore_radius : float
+        Bore (hub) radius of both wheels, m (fillet-foundation term, Sainsot).
+    addendum, dedendum : float
+        Addendum and dedendum coefficients (x module).
+    mass_pinion, mass_gear : float or None
+        Wheel masses, kg. ``None``: density x pi r_pitch^2 x face width.
+    inertia_pinion, inertia_gear : float or None
+        Polar moments of inertia, kg m^2. ``None``: mass x r_pitch^2 / 2.
+    inertia_brake : float
+        Brake (load) inertia on the output shaft, kg m^2.
+    shaft_radius : float
+        Radius of both shafts, m.
+    shaft_length_in, shaft_length_out : float
+        Torsional lengths of input and output shafts, m.
+    shear_modulus_shaft : float or None
+        G of the shafts, Pa. ``None``: E / (2 (1 + nu)).
+    bearing_stiffness : float
+        Lateral bearing stiffness per direction per wheel, N/m.
+    damping_ratio : float
+        Modal damping ratio applied to every mode.
+    """
+
+    z_pinion: int = 17
+    z_gear: int = 38
+    module: float = 3e-3
+    face_width: float = 15e-3
+    pressure_angle: float = math.radians(20.0)
+    youngs_modulus: float = 210e9
+    poisson: float = 0.3
+    density: float = 7850.0
+    bore_radius: float = 10e-3
+    addendum: float = 1.0
+    dedendum: float = 1.25
+    mass_pinion: float | None = None
+    mass_gear: float | None = None
+    inertia_pinion: float | None = None
+    inertia_gear: float | None = None
+    inertia_brake: float = 4.5e-3
+    shaft_radius: float = 10e-3
+    shaft_length_in: float = 0.2
+    shaft_length_out: float = 0.6
+    shear_modulus_shaft: float | None = None
+    bearing_stiffness: float = 1.9e8
+    damping_ratio: float = 0.05
+
+    def __post_init__(self) -> None:
+        check_int(self.z_pinion, "z_pinion", minimum=12)
+        check_int(self.z_gear, "z_gear", minimum=12)
+        for name in ("module", "face_width", "pressure_angle", "youngs_modulus", "density",
+                     "bore_radius", "addendum", "dedendum", "inertia_brake", "shaft_radius",
+                     "shaft_length_in", "shaft_length_out", "bearing_stiffness"):
+            check_positive(getattr(self, name), name)
+        for name in ("mass_pinion", "mass_gear", "inertia_pinion", "inertia_gear",
+                     "shear_modulus_shaft"):
+            if getattr(self, name) is not None:
+                check_positive(getattr(self, name), name)
+        check_in_range(self.poisson, "poisson", 0.0, 0.5, high_inclusive=False)
+        check_in_range(self.damping_ratio, "damping_ratio", 0.0, 1.0, low_inclusive=False)
+        check_in_range(self.pressure_angle, "pressure_angle", math.radians(10), math.radians(35))
+        if self.bore_radius >= self.root_radius(self.z_pinion) * 0.95:
+            raise GearshotError(
+                f"bore_radius must be well below the pinion root radius "
+                f"({self.root_radius(self.z_pinion):.4g} m); got {self.bore_radius!r}")
+        if not self.contact_ratio > 1.0:
+            raise GearshotError(f"the pair's contact ratio must exceed 1; got "
+                                f"{self.contact_ratio:.4g} (z={self.z_pinion}/{self.z_gear})")
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def paper(cls, **overrides) -> "GearPair":
+        """The pair of Matania et al. (2023): 17/38 teeth, m 3 mm, b 15 mm, 20 deg, steel,
+        wheel masses 0.8 / 3.2 kg, 5 % modal damping. Keyword overrides are applied."""
+        base = dict(z_pinion=17, z_gear=38, module=3e-3, face_width=15e-3,
+                    pressure_angle=math.radians(20.0), youngs_modulus=210e9, poisson=0.3,
+                    mass_pinion=0.8, mass_gear=3.2, damping_ratio=0.05)
+        base.update(overrides)
+        return cls(**base)
+
+    def replace(self, **changes) -> "GearPair":
+        """A copy with some fields changed (validated)."""
+        return dataclasses.replace(self, **changes)
+
+    # ------------------------------------------------------------------ geometry
+    def pitch_radius(self, z: int) -> float:
+        return 0.5 * self.module * z
+
+    def base_radius(self, z: int) -> float:
+        return self.pitch_radius(z) * math.cos(self.pressure_angle)
+
+    def tip_radius(self, z: int) -> float:
+        return self.pitch_radius(z) + self.addendum * self.module
+
+    def root_radius(self, z: int) -> float:
+        return self.pitch_radius(z) - self.dedendum * self.module
+
+    @property
+    def center_distance(self) -> float:
+        return 0.5 * self.module * (self.z_pinion + self.z_gear)
+
+    @property
+    def base_pitch(self) -> float:
+        """Base pitch, m (distance between successive pairs along the line of action)."""
+        return math.pi * self.module * math.cos(self.pressure_angle)
+
+    @property
+    def roll_limits(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Roll lengths (distance from the base-circle tangency, m) of the active profile,
+        ((pinion_low, pinion_tip), (gear_low, gear_tip))."""
+        rb1, rb2 = self.base_radius(self.z_pinion), self.base_radius(self.z_gear)
+        ra1, ra2 = self.tip_radius(self.z_pinion), self.tip_radius(self.z_gear)
+        total = self.center_distance * math.sin(self.pressure_angle)
+        l1_tip = math.sqrt(ra1 ** 2 - rb1 ** 2)
+        l2_tip = math.sqrt(ra2 ** 2 - rb2 ** 2)
+        return (total - l2_tip, l1_tip), (total - l1_tip, l2_tip)
+
+    @property
+    def contact_length(self) -> float:
+        """Length of the path of contact along the line of action, m."""
+        (p_lo, p_hi), _ = self.roll_limits
+        return p_hi - p_lo
+
+    @property
+    def contact_ratio(self) -> float:
+        """Transverse contact ratio (path of contact / base pitch)."""
+        (p_lo, p_hi), _ = self.roll_limits
+        if p_lo <= 0:  # interference: contact would start below the pinion base circle
+            return float("nan")
+        return self.contact_length / self.base_pitch
+
+    @property
+    def masses(self) -> tuple[float, float]:
+        """(pinion, gear) masses, kg."""
+        def default(z):
+            return self.density * math.pi * self.pitch_radius(z) ** 2 * self.face_width
+        m1 = self.mass_pinion if self.mass_pinion is not None else default(self.z_pinion)
+        m2 = self.mass_gear if self.mass_gear is not None else default(self.z_gear)
+        return m1, m2
+
+    @property
+    def inertias(self) -> tuple[float, float]:
+        """(pinion, gear) polar moments of inertia, kg m^2."""
+        m1, m2 = self.masses
+        j1 = (self.inertia_pinion if self.inertia_pinion is not None
+              else 0.5 * m1 * self.pitch_radius(self.z_pinion) ** 2)
+        j2 = (self.inertia_gear if self.inertia_gear is not None
+              else 0.5 * m2 * self.pitch_radius(self.z_gear) ** 2)
+        return j1, j2
+
+    @property
+    def shaft_torsional_stiffness(self) -> tuple[float, float]:
+        """(input, output) shaft torsional stiffness pi r^4 G / (2 L), N m/rad."""
+        g = (self.shear_modulus_shaft if self.shear_modulus_shaft is not None
+             else self.youngs_modulus / (2 * (1 + self.poisson)))
+        jp = math.pi * self.shaft_radius ** 4 / 2
+        return jp * g / self.shaft_length_in, jp * g / self.shaft_length_out
+
+    @property
+    def gear_ratio(self) -> float:
+        """z_gear / z_pinion."""
+        return self.z_gear / self.z_pinion
+
+
+def involute_half_angle(z: int, pressure_angle: float, r: np.ndarray, rb: float) -> np.ndarray:
+    """Half tooth angle psi(r) (rad) of a standard involute tooth at radius r >= rb."""
+    inv0 = math.tan(pressure_angle) - pressure_angle
+    a = np.arccos(np.clip(rb / r, -1.0, 1.0))
+    return math.pi / (2 * z) + inv0 - (np.tan(a) - a)

@@ -1,0 +1,88 @@
+"""Tooth-profile errors per tooth from the DIN 3962 quality grade.
+
+Along the roll length of the active profile (s in [0, 1]) tooth i deviates by
+``e_i(s) = fHa_i s + 0.5 ffa_i sin(2 pi n s + phi_i) + noise_i(s)`` with fHa_i, ffa_i drawn
+within +-10 % of the grade's values, n = 2.5 waves (z < 20) or 3.5, phi_i ~ U(-pi, pi) and
+noise_i piecewise linear between knots drawn from U(-c, c) (DESIGN.md section 2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import check_int
+
+__all__ = ["DIN_PROFILE_TOLERANCES", "ToothProfileErrors", "draw_profile_errors"]
+
+#: grade -> (fHa, ffa, c) in micrometres, DIN 3962 grades 1..12.
+DIN_PROFILE_TOLERANCES = {
+    g: (fh, ff, c) for g, fh, ff, c in zip(
+        range(1, 13),
+        (1, 1.5, 2, 3, 4.5, 6, 9, 12, 18, 28, 45, 71),
+        (1.5, 2, 3, 4, 6, 8, 11, 16, 22, 36, 56, 90),
+        (0.02, 0.04, 0.06, 0.08, 0.1, 0.2, 0.3, 0.4, 0.6, 1.0, 1.5, 2.3))
+}
+
+N_NOISE_KNOTS = 16
+
+
+@dataclass(frozen=True)
+class ToothProfileErrors:
+    """Profile errors of every tooth of one wheel (arrays over teeth; metres).
+
+    Attributes
+    ----------
+    slope : ndarray (z,)
+        fHa_i, m.
+    waviness : ndarray (z,)
+        ffa_i, m (peak-to-peak of the sine term).
+    phase : ndarray (z,)
+        phi_i, rad.
+    noise : ndarray (z, n_knots)
+        Noise knots, m, equally spaced over s in [0, 1].
+    n_waves : float
+        Waves per active profile.
+    """
+
+    slope: np.ndarray
+    waviness: np.ndarray
+    phase: np.ndarray
+    noise: np.ndarray
+    n_waves: float
+
+    def __call__(self, tooth, s) -> np.ndarray:
+        """Deviation (m) of tooth ``tooth`` at roll fractions ``s`` (broadcast)."""
+        tooth = np.asarray(tooth) % self.slope.size
+        s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
+        knots = self.noise.shape[1]
+        pos = s * (knots - 1)
+        i0 = np.minimum(pos.astype(int), knots - 2)
+        frac = pos - i0
+        noise = self.noise[tooth, i0] * (1 - frac) + self.noise[tooth, i0 + 1] * frac
+        return (self.slope[tooth] * s
+                + 0.5 * self.waviness[tooth] * np.sin(2 * np.pi * self.n_waves * s
+                                                      + self.phase[tooth])
+                + noise)
+
+    def mean_tooth(self) -> "ToothProfileErrors":
+        """The average over teeth as a one-tooth wheel (exact: the sine terms share one
+        frequency, so their mean is a sine)."""
+        phasor = np.mean(self.waviness * np.exp(1j * self.phase))
+        return ToothProfileErrors(
+            slope=np.array([self.slope.mean()]), waviness=np.array([np.abs(phasor)]),
+            phase=np.array([np.angle(phasor)]), noise=self.noise.mean(axis=0, keepdims=True),
+            n_waves=self.n_waves)
+
+
+def draw_profile_errors(z: int, grade: int, rng: np.random.Generator) -> ToothProfileErrors:
+    """Draw the profile errors of a ``z``-tooth wheel of DIN grade ``grade`` (1 ... 12)."""
+    z = check_int(z, "z", minimum=1)
+    grade = check_int(grade, "grade", minimum=1, maximum=12)
+    fh, ff, c = (v * 1e-6 for v in DIN_PROFILE_TOLERANCES[grade])
+    slope = fh * rng.uniform(0.9, 1.1, z)
+    waviness = ff * rng.uniform(0.9, 1.1, z)
+    phase = rng.uniform(-np.pi, np.pi, z)
+    noise = rng.uniform(-c, c, (z, N_NOISE_KNOTS))
+    return ToothProfileErrors(slope, waviness, phase, noise, 2.5 if z < 20 else 3.5)

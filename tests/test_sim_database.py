@@ -1,0 +1,80 @@
+"""Zarr database: contract, resumability after kill -9, bad input writes nothing."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearshot import GearshotError
+from gearshot.sim import build_database, load_database
+
+KW = dict(speeds=[15, 20], loads=[10], grades=[5, 7, 9], n_healthy=2, n_faulty=3, seed=4)
+
+
+def test_contract(tmp_path):
+    build_database(tmp_path / "db", client=False, progress=False, **KW)
+    ds = load_database(tmp_path / "db", speed=15, load=10)
+    assert ds.sa.dims == ("signal", "angle") and ds.sa.dtype == np.float64
+    assert ds.sa.shape == (15, 2048)
+    assert list(np.unique(ds.grade.values)) == [5, 7, 9]
+    assert np.all(ds.fault_size.values[:2] == 0) and ds.seed.dtype.kind == "i"
+    assert float(ds["speed"]) == 15 and float(ds["load"]) == 10  # ds.load is a method
+    one = load_database(tmp_path / "db", speed=20, load=10, grade=7)
+    assert one.sa.shape == (5, 2048) and np.all(one.grade.values == 7)
+
+
+def test_kill9_resume_identical(tmp_path):
+    ref = tmp_path / "ref"
+    build_database(ref, client=False, progress=False, **KW)
+    store = tmp_path / "killed"
+    code = (f"from gearshot.sim import build_database; "
+            f"build_database({str(store)!r}, client=False, progress=False, **{KW!r})")
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
+    proc = subprocess.Popen([sys.executable, "-c", code], env=env)
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        done = list((store / "blocks").glob("*.zarr")) if (store / "blocks").exists() else []
+        if len(done) >= 2:
+            break
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert len(list((store / "blocks").glob("*.zarr"))) < 6
+    build_database(store, client=False, progress=False, **KW)
+    for speed in (15, 20):
+        a = load_database(ref, speed=speed, load=10)
+        b = load_database(store, speed=speed, load=10)
+        assert a.sa.shape == b.sa.shape == (15, 2048)
+        np.testing.assert_array_equal(a.sa.values, b.sa.values)
+        np.testing.assert_array_equal(a.seed.values, b.seed.values)
+    assert not list((store / "blocks").glob(".*tmp"))
+
+
+@pytest.mark.parametrize("change, name", [
+    (dict(speeds=[15, -1]), "speeds"), (dict(loads=[0]), "loads"),
+    (dict(grades=[0]), "grades"), (dict(grades=[13]), "grades"),
+    (dict(speeds=[np.nan]), "speeds"), (dict(loads=[np.inf]), "loads")])
+def test_bad_input_writes_nothing(tmp_path, change, name):
+    kw = dict(KW)
+    kw.update(change)
+    with pytest.raises(GearshotError, match=name):
+        build_database(tmp_path / "db", client=False, progress=False, **kw)
+    assert not (tmp_path / "db").exists()
+
+
+def test_unwritable_store(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if os.access(locked, os.W_OK):
+            pytest.skip("running as a user who can write anywhere")
+        with pytest.raises(GearshotError, match="store"):
+            build_database(locked / "db", client=False, progress=False, **KW)
+        assert not (locked / "db").exists()
+    finally:
+        locked.chmod(0o700)
