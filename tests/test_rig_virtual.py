@@ -10,8 +10,8 @@ import pytest
 from scipy.signal import hilbert
 
 from gearshot import GearshotError
-from gearshot.rig import (INDEX_COLUMNS, PathTF, Recording, SurrogateEngine, VirtualRig,
-                          read_campaign, tacho_signal)
+from gearshot.rig import (INDEX_COLUMNS, PathTF, Recording, SimulatorEngine, SurrogateEngine,
+                          VirtualRig, read_campaign, tacho_signal)
 from gearshot.rig.interference import (add_noise, bearing_impacts, extra_shaft,
                                        motor_harmonics, rms)
 from gearshot.rig.path import apply_path, path_fir
@@ -21,9 +21,17 @@ ZG, ZP, N_SA = 38, 17, 2048
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
+ENGINES = {"sim": SimulatorEngine, "surrogate": SurrogateEngine}
+
+
 @pytest.fixture(scope="module")
 def rig():
-    return VirtualRig(seed=0)
+    return VirtualRig(seed=0)  # default engine: the simulator
+
+
+@pytest.fixture(scope="module", params=sorted(ENGINES))
+def any_rig(request):
+    return VirtualRig(seed=0, engine=request.param)
 
 
 def sa_of(rec, **kw):
@@ -114,10 +122,10 @@ def test_transfer_path_stretch_and_attenuation():
     assert 20 * np.log10(rms(noise) / rms(out)) == pytest.approx(10.0, abs=0.5)
 
 
-def test_fault_shows_in_sa_at_all_four_paper_conditions(rig):
+def test_fault_shows_in_sa_at_all_four_paper_conditions(any_rig):
     for speed in (15.0, 30.0):
         for load in (5.0, 10.0):
-            levels = [diff_rms(sa_of(rig.record(speed=speed, load=load, fault_size=y,
+            levels = [diff_rms(sa_of(any_rig.record(speed=speed, load=load, fault_size=y,
                                                 duration=8.0)))
                       for y in (0.32, 0.56, 0.66)]
             assert levels[0] < levels[1] < levels[2], (speed, load, levels)
@@ -134,13 +142,13 @@ def test_skipping_angular_resampling_degrades_rig_sa(rig):
     assert spread(bad) > 1.5 * spread(good)
 
 
-def nominal_sa(speed, load, seed):
-    """SAs of the nominal model: SurrogateEngine with reality=None, constant speed/load,
+def nominal_sa(engine, speed, load, seed):
+    """SA of the nominal model: the engine with reality=None, constant speed and load,
     no interference, transfer path or noise."""
     fs = 50_000.0
     t = np.arange(int(8.0 * fs)) / fs
     revs = speed * t
-    vib = SurrogateEngine()(motor_revs=revs, load_torque=np.full(t.size, load), fs=fs,
+    vib = ENGINES[engine]()(motor_revs=revs, load_torque=np.full(t.size, load), fs=fs,
                             fault_size=0.0, reality=None, rng=np.random.default_rng(seed))
     skip = int(fs) // 4  # drop the start-up transient
     rec = Recording(vib[skip:], tacho_signal(revs[skip:]), fs)
@@ -153,11 +161,11 @@ def order_spectrum(sa):
     return s / np.sqrt(np.mean(s ** 2, axis=-1, keepdims=True))
 
 
-def test_reality_gap_exceeds_recording_spread(rig):
+def test_reality_gap_exceeds_recording_spread(any_rig):
     speed, load = 15.0, 10.0
-    rig_sas = np.stack([sa_of(rig.record(speed=speed, load=load, duration=8.0,
-                                         repetition=r))[0] for r in range(3)])
-    nominal = nominal_sa(speed, load, seed=5)
+    rig_sas = np.stack([sa_of(any_rig.record(speed=speed, load=load, duration=8.0,
+                                             repetition=r))[0] for r in range(3)])
+    nominal = nominal_sa(any_rig.engine, speed, load, seed=5)
     # level: the rig's transfer path and true parameters change the level by far more
     # than the repetitions differ
     lvl_rig = np.sqrt(np.mean(rig_sas ** 2, axis=-1))

@@ -21,7 +21,8 @@ The physics engine is pluggable: any callable
 ``motor_revs``/``load_torque`` arrays of shape (n,) (rev, N m), ``reality`` a
 :class:`~gearshot.rig.reality.RigReality` (``None`` = the nominal model) and ``rng`` a
 ``numpy.random.Generator``, returning the vibration in g, shape (n,). The default is
-:class:`~gearshot.rig.surrogate.SurrogateEngine`.
+:class:`~gearshot.rig.sim_engine.SimulatorEngine` (the gear-pair simulator, integrating the
+whole run); :class:`~gearshot.rig.surrogate.SurrogateEngine` is a fast stand-in.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from .motion import load_torque, motor_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
 from .reality import RigReality, draw_reality
 from .recording import Recording
+from .sim_engine import SimulatorEngine
 from .surrogate import SurrogateEngine
 from .tacho import tacho_signal
 
@@ -64,8 +66,10 @@ class VirtualRig:
     seed : int
         Seeds everything: the hidden reality (drawn once) and, together with the condition
         and repetition, every recording -- the same call gives the same recording.
-    engine : callable, optional
-        Physics engine (see the module docstring); default :class:`SurrogateEngine`.
+    engine : {"sim", "surrogate"} or callable, optional
+        Physics engine (see the module docstring): ``"sim"`` (default,
+        :class:`~gearshot.rig.sim_engine.SimulatorEngine`, the gear-pair simulator),
+        ``"surrogate"`` (:class:`SurrogateEngine`, a fast stand-in) or any callable.
     tf_bank : folder path or sequence of TFs, optional
         Transfer-path bank (measured FRFs or TF-like objects with ``freqs``/``values``);
         default: 8 synthetic modal TFs drawn from ``seed``. The reality picks one.
@@ -81,7 +85,7 @@ class VirtualRig:
     Arguments are stored as given; the reality, the TF and its FIR are built on first use.
     """
 
-    def __init__(self, seed: int = 0, *, engine: Callable[..., np.ndarray] | None = None,
+    def __init__(self, seed: int = 0, *, engine: str | Callable[..., np.ndarray] | None = None,
                  tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = 38,
                  pinion_teeth: int = 17, settle: float = 0.25):
         self.seed = seed
@@ -118,9 +122,14 @@ class VirtualRig:
         return self._build()[0]
 
     def _engine(self) -> Callable[..., np.ndarray]:
-        if self.engine is not None:
-            return self.engine
-        return SurrogateEngine(gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
+        if self.engine is None or self.engine == "sim":
+            return SimulatorEngine()
+        if self.engine == "surrogate":
+            return SurrogateEngine(gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
+        if not callable(self.engine):
+            raise GearshotError(f"engine must be 'sim', 'surrogate' or a callable; got "
+                                f"{self.engine!r}")
+        return self.engine
 
     # ------------------------------------------------------------------ one recording
     def record(self, *, speed: float, load: float, fault_size: float = 0.0,
@@ -157,7 +166,9 @@ class VirtualRig:
         n_settle = int(round(self.settle * fs))
         n = int(round(duration * fs))
         t = np.arange(n_settle + n) / fs
-        start = rng.uniform(0.0, float(self.gear_teeth))  # relative position of the wheels
+        # relative position of the wheels at the start: a whole number of pinion turns
+        # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
+        start = float(rng.integers(0, self.gear_teeth))
         motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
                             ripple=reality.speed_ripple, rng=rng, start=start)
         torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
