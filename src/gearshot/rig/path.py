@@ -84,7 +84,8 @@ def as_tf_list(bank: Any) -> list[PathTF]:
             from ..transfer import TransferFunctionBank
         except ImportError as exc:  # pragma: no cover - depends on the transfer module
             raise GearshotError(f"reading a TF folder needs gearshot.transfer: {exc}") from None
-        bank = list(TransferFunctionBank.from_folder(folder))
+        bank = [PathTF(np.asarray(tf.freqs), np.asarray(tf.values), name=name)
+                for name, tf in TransferFunctionBank.from_folder(folder).items()]
     if isinstance(bank, PathTF):
         return [bank]
     if not isinstance(bank, Sequence) and hasattr(bank, "__iter__"):
