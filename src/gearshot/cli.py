@@ -184,7 +184,10 @@ def experiment_simulated(
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if full else (speed, load)
-    store = store or default_database_path(f"sim-db-grade{grade}-s{seed}")
+    tag = "paper" if full else "-".join(f"{s:g}" for s in speeds) + "rps-" + \
+        "-".join(f"{ld:g}" for ld in loads) + "Nm"
+    store = store or default_database_path(
+        f"sim-db-{tag}-grade{grade}-h{n_healthy}-f{n_faulty}-s{seed}")
     client = _client(scheduler, workers, needed=len(speeds) * len(loads) > 1)
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=[grade],
@@ -239,7 +242,8 @@ def experiment_rig(
 
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
-    store = store or default_database_path(f"sim-db-s{seed}")
+    store = store or default_database_path(
+        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
     client = _client(scheduler, workers, needed=True)
     try:
         build_database(store, GearPair.paper(), speeds=[speed], loads=[load],

@@ -20,7 +20,7 @@ __all__ = ["run_demo"]
 SPEED, LOAD = 15.0, 10.0
 
 
-def run_demo(out="gearshot-demo", *, seed=0, n_healthy=20, n_faulty=100, duration=30.0,
+def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duration=30.0,
              repetitions=6, console=None):
     """Run the demo; returns the output folder.
 

@@ -110,10 +110,14 @@ def plot_tuning_curve(curve, true_size=None, *, ax=None):
     """Step 2: predicted size of the faulty example for each simulated grade."""
     ax = _ax(ax, figsize=(5, 3.5))
     lines = ax.plot(curve["grade"], curve["prediction"], "o-", label="predicted example size")
+    if "smoothed" in curve:
+        lines += ax.plot(curve["grade"], curve["smoothed"], "-", lw=2, alpha=0.6,
+                         label="monotone fit")
     if true_size is not None:
         lines.append(ax.axhline(true_size, color="k", ls="--", lw=1, label="true size"))
     best = int(np.argmin(curve["abs_error"]))
-    lines += ax.plot([curve["grade"][best]], [curve["prediction"][best]], "r*", ms=14,
+    lines += ax.plot([curve["grade"][best]], [curve.get("smoothed", curve["prediction"])[best]],
+                     "r*", ms=14,
                      label="chosen grade")
     ax.set_xlabel("DIN grade of the simulation")
     ax.set_ylabel("predicted size y")

@@ -78,6 +78,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         No faulty example: choose the grade by matching healthy-signal statistics.
     upsample : int, default 100
         Delay resolution (1/upsample sample) of target harmonic suppression.
+    tuning_smoothing : {"isotonic", "none"}, default "isotonic"
+        Fit the example's predicted size over the grades by a monotone curve before
+        choosing (robust to KNN scatter); "none" is the paper's literal nearest rule.
     random_state : int, numpy Generator/RandomState or None
 
     Attributes
@@ -94,7 +97,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  select_features=True, tune_simulation=True, nominal_grade=7,
                  rms_normalization=True, transfer_function="estimate",
                  n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
-                 zero_shot=False, upsample=100, random_state=None):
+                 zero_shot=False, upsample=100, tuning_smoothing="isotonic",
+                 random_state=None):
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -108,6 +112,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.mesh_order = mesh_order
         self.zero_shot = zero_shot
         self.upsample = upsample
+        self.tuning_smoothing = tuning_smoothing
         self.random_state = random_state
 
     # ------------------------------------------------------------------ validation
@@ -284,8 +289,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                 models[g] = self._model_for_grade(g, cols, seed)
                 return models[g].predict(x_example)[0]
 
-            self.grade_, self.tuning_curve_ = steps.tune_grade(predict_example, grades,
-                                                               faulty_size)
+            self.grade_, self.tuning_curve_ = steps.tune_grade(
+                predict_example, grades, faulty_size, smoothing=self.tuning_smoothing)
             self.model_ = models[self.grade_]
         else:
             self.grade_ = nominal if not self.tune_simulation else grades[0]
