@@ -8,7 +8,7 @@ import numpy as np
 import xarray as xr
 
 from .._errors import GearshotError
-from .._validation import check_in_range
+from .._validation import check_in_range, check_int
 from ..transfer import propagate
 
 __all__ = ["SimulatedDataset", "simulated_dataset"]
@@ -46,7 +46,7 @@ class SimulatedDataset:
                 self.healthy_long)
 
 
-def simulated_dataset(sa, fault_size, tf, *, grade=0, attenuation_db=10.0,
+def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
                       noise_fraction=0.1, target_fraction=0.25, n_long_cycles=128,
                       cycles_per_sa=50, random_state=None):
     """Build a Sec. 4.1 dataset from one grade's simulated SAs and a measured TF.
@@ -64,8 +64,8 @@ def simulated_dataset(sa, fault_size, tf, *, grade=0, attenuation_db=10.0,
     sa : ndarray (n_signals, n_points)
     fault_size : ndarray (n_signals,)
     tf : ndarray of complex (n_points,) or TransferFunction
-    grade : int
-        Grade label stored in the training database.
+    grade : int, default 7
+        DIN grade of ``sa``, stored in the training database.
     attenuation_db : float, >= 0
     noise_fraction : float, >= 0
     target_fraction : float in (0, 1)
@@ -80,6 +80,7 @@ def simulated_dataset(sa, fault_size, tf, *, grade=0, attenuation_db=10.0,
     sa = np.asarray(sa, float)
     y = np.asarray(fault_size, float)
     n_points = sa.shape[1]
+    grade = check_int(grade, "grade", minimum=1, maximum=12)
     attenuation_db = check_in_range(attenuation_db, "attenuation_db", 0, 200)
     noise_fraction = check_in_range(noise_fraction, "noise_fraction", 0, 10)
     target_fraction = check_in_range(target_fraction, "target_fraction", 0, 1,
