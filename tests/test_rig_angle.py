@@ -115,7 +115,8 @@ def test_tacho_dropout_longer_than_a_revolution(tmp_path):
     tach = rec.tacho.copy()
     tach[(revs > 100.5) & (revs < 101.5)] = 0.0  # pulse 101 missing
     path = Recording(rec.acceleration, tach, FS, speed=30.0).write(tmp_path / "drop.h5")
-    with pytest.raises(GearshotError, match=r"drop\.h5.*tacho dropout .*t=3\.3"):
+    with pytest.raises(GearshotError,
+                       match=r"drop\.h5.*tacho dropout .*more than one revolution.*t=3\.3"):
         Recording.read(path).to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
 
 
@@ -150,3 +151,27 @@ def test_tacho_signal_jitter_and_pulses_per_rev():
     assert 1e-6 < np.std(dev) < 4e-5  # ~2e-4 rev / 10 rev/s = 2e-5 s
     with pytest.raises(GearshotError, match="rng"):
         tacho_signal(revs, jitter=1e-4)
+
+
+def test_short_dropout_bridged_with_several_pulses_per_rev_and_glitch_rejected():
+    t = np.arange(int(6.0 * FS)) / FS
+    revs = pinion_revs(t, 30.0, drift=0.01, drift_period=6.0)
+    acc = template(revs * ZP / ZG)
+    tach = tacho_signal(revs, pulses_per_rev=4)
+    full = Recording(acc, tach, FS, tacho_pulses_per_rev=4)
+    ref = full.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    holed = tach.copy()
+    holed[(revs > 50.1) & (revs < 50.6)] = 0.0  # two of four pulses in one revolution
+    rec = Recording(acc, holed, FS, tacho_pulses_per_rev=4)
+    assert rec.pulse_times().size == full.pulse_times().size
+    sa = rec.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    assert np.sqrt(np.mean((sa - ref) ** 2)) < 0.01 * np.sqrt(np.mean(ref ** 2))
+    long_hole = tach.copy()
+    long_hole[(revs > 50.1) & (revs < 51.3)] = 0.0  # more than a revolution
+    with pytest.raises(GearshotError, match="more than one revolution"):
+        Recording(acc, long_hole, FS, tacho_pulses_per_rev=4).pulse_times()
+    glitch = tach.copy()
+    k = np.flatnonzero((revs > 20.12) & (revs < 20.13))
+    glitch[k] = 5.0  # a spike between two pulses
+    with pytest.raises(GearshotError, match="extra tacho pulse"):
+        Recording(acc, glitch, FS, tacho_pulses_per_rev=4).pulse_times()

@@ -121,6 +121,11 @@ class VirtualRig:
         """The hidden reality -- for validating the rig only; an estimator must not use it."""
         return self._build()[0]
 
+    def reveal_path(self) -> tuple[str, np.ndarray]:
+        """Name of the hidden transfer-path TF and its FIR (per sample) -- validation only."""
+        _, fir, name = self._build()
+        return name, fir.copy()
+
     def _engine(self) -> Callable[..., np.ndarray]:
         if self.engine is None or self.engine == "sim":
             return SimulatorEngine()
@@ -154,9 +159,9 @@ class VirtualRig:
         Recording
             Acceleration in g, the input-shaft tacho, metadata (no hidden parameters).
         """
-        reality, fir, tf_name = self._build()
+        reality, fir, _ = self._build()
         speed = check_positive(speed, "speed")
-        load = check_positive(load, "load", allow_zero=True)
+        load = check_positive(load, "load")
         fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
         duration = check_positive(duration, "duration")
         repetition = check_int(repetition, "repetition", minimum=0)
@@ -195,7 +200,7 @@ class VirtualRig:
             acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
             source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
             extras={"repetition": repetition, "rig_seed": int(self.seed),
-                    "engine": type(self._engine()).__name__, "transfer_path": tf_name})
+                    "engine": type(self._engine()).__name__})
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod
@@ -226,7 +231,7 @@ class VirtualRig:
         """
         folder = Path(folder)
         speed = check_positive(speed, "speed")
-        load = check_positive(load, "load", allow_zero=True)
+        load = check_positive(load, "load")
         healthy = check_int(healthy, "healthy", minimum=0)
         repetitions = check_int(repetitions, "repetitions", minimum=0)
         sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
