@@ -31,15 +31,6 @@ def _rms(x):
 PAIR = GearPair.paper()
 
 
-def test_signature_rises_above_small_sizes():
-    sizes = np.linspace(0.3, 0.95, 14)
-    sa = simulate_sa(PAIR, speed=15, load=10, grade=7, fault_sizes=sizes, same_gear=True,
-                     rng=11)
-    assert spearmanr(sizes, _rms(_diff(sa))).statistic >= 0.95
-
-
-@pytest.mark.xfail(strict=False, reason="known: diff-RMS is flat/non-monotone for y < 0.3 "
-                   "(Spearman ~0.93-0.96 depending on the gear draw); see RESULTS_sim.md")
 def test_signature_rises_with_size():
     sizes = np.linspace(0.05, 0.95, 20)
     sa = simulate_sa(PAIR, speed=15, load=10, grade=7, fault_sizes=sizes, same_gear=True,

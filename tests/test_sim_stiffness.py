@@ -117,3 +117,15 @@ def test_fault_leaving_profile():
 def test_nonfinite_angle():
     with pytest.raises(GearshotError, match="pinion_angle"):
         mesh_stiffness(GearPair.paper(), [0.0, np.inf])
+
+
+def test_faulty_table_matches_direct_evaluation():
+    from gearshot.sim.stiffness import _N_TABLE, _pair_table
+    pair = GearPair.paper()
+    u = np.linspace(0, 1, _N_TABLE)
+    for y in (0.1, 0.6):
+        fault = Fault.ftff(y)
+        fast = _pair_table(pair, fault)
+        exact = pair_stiffness(pair, u, fault=fault)
+        rel = np.abs(fast - exact) / exact
+        assert np.sum(rel > 1e-3) <= 1          # only the one grid point on the jump

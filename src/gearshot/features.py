@@ -31,7 +31,6 @@ from typing import Callable
 
 import numpy as np
 import scipy.fft
-import scipy.signal
 
 from ._errors import GearshotError
 from ._validation import as_signal_array, check_int, check_positive
@@ -43,6 +42,7 @@ __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
 _TINY_RMS = 1e-10
 _SHAFT_ORDERS = (1, 2)
+_WORKERS = -1  # scipy.fft threads: all cores
 
 
 class _Parts:
@@ -57,21 +57,27 @@ class _Parts:
 
     @cached_property
     def spectrum(self):
-        return scipy.fft.rfft(self.sa, axis=-1)
+        return scipy.fft.rfft(self.sa, axis=-1, workers=_WORKERS)
 
     def _keep(self, orders, *, invert=False):
         mask = np.zeros(self.n // 2 + 1, dtype=bool)
         mask[orders] = True
         if invert:
             mask = ~mask
-        return scipy.fft.irfft(self.spectrum * mask, n=self.n, axis=-1)
+        return scipy.fft.irfft(self.spectrum * mask, n=self.n, axis=-1, workers=_WORKERS)
 
     def _mesh(self, n_sidebands):
         return mesh_band_orders(self.n, self.mesh_order, n_sidebands)
 
     @cached_property
+    def diff_spectrum(self):
+        mask = np.ones(self.n // 2 + 1, dtype=bool)
+        mask[self._mesh(self.n_sidebands)] = False
+        return self.spectrum * mask
+
+    @cached_property
     def diff(self):
-        return self._keep(self._mesh(self.n_sidebands), invert=True)
+        return scipy.fft.irfft(self.diff_spectrum, n=self.n, axis=-1, workers=_WORKERS)
 
     @cached_property
     def rms_diff(self):
@@ -79,8 +85,14 @@ class _Parts:
 
     @cached_property
     def envelope(self):
-        env = np.abs(scipy.signal.hilbert(self.diff, axis=-1))
-        return env - env.mean(axis=-1, keepdims=True)
+        # analytic signal straight from the one-sided spectrum (as scipy.signal.hilbert)
+        n, half = self.n, self.diff_spectrum
+        analytic = np.zeros(half.shape[:-1] + (n,), dtype=complex)
+        analytic[..., : half.shape[-1]] = half
+        analytic[..., 1:(n + 1) // 2] *= 2.0
+        env = np.abs(scipy.fft.ifft(analytic, axis=-1, overwrite_x=True, workers=_WORKERS))
+        env -= env.mean(axis=-1, keepdims=True)
+        return env
 
     @cached_property
     def regular_mesh(self):
@@ -100,9 +112,13 @@ class _Parts:
 def _moment_ratio(x, order, *, variance=None):
     """Biased normalized central moment ``mean(m^order) / var^(order/2)``; 0 if RMS tiny."""
     centred = x - x.mean(axis=-1, keepdims=True)
-    own_var = np.mean(centred ** 2, axis=-1)
+    square = centred * centred
+    own_var = np.mean(square, axis=-1)
     var = own_var if variance is None else np.broadcast_to(variance, own_var.shape)
-    num = np.mean(centred ** order, axis=-1)
+    power = centred if order % 2 else square  # integer powers by multiplication: fast
+    for _ in range(order // 2 - (0 if order % 2 else 1)):
+        power = power * square
+    num = np.mean(power, axis=-1)
     small = np.sqrt(own_var) < _TINY_RMS
     with np.errstate(divide="ignore", invalid="ignore"):
         out = num / var ** (order / 2)

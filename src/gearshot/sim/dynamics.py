@@ -147,7 +147,7 @@ def _tooth_error(slope, wav, phase, noise, nwaves, t, s):
 
 
 @nb.njit(cache=True, parallel=True)
-def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, f_lo, f_hi, f_h, f_tooth,
+def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                    g_slope, g_wav, g_phase, g_noise, g_nw,
                    p_slope, p_wav, p_phase, p_noise, p_nw,
                    eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, x0, coef,
@@ -185,9 +185,8 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, f_lo, f_hi, f_h, f_
                                   1.0 - u)
                      + _tooth_error(p_slope[b], p_wav[b], p_phase[b], p_noise[b], p_nw, pt,
                                     u))
-                if faulty and u > f_lo[b] and u < f_hi[b]:
-                    rel = (u - f_lo[b]) / (f_hi[b] - f_lo[b])
-                    e -= f_h[b] * 0.5 * (1.0 - math.cos(2.0 * math.pi * rel))
+                if faulty:
+                    e += _interp_table(ef_tab[b], u)
                 kk += k
                 fex += k * e
             ld = load[n]
@@ -271,21 +270,22 @@ def _fault_list(pair, sizes, center, depth):
 
 
 def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
+    """Per-signal tables over the contact position u of the faulty pair's stiffness and
+    displacement excitation (from the fault's hooks), and the faulty tooth index."""
     n = len(faults)
     kf = np.empty((n, _N_TABLE))
-    lo, hi, h, tooth = np.zeros(n), np.zeros(n), np.zeros(n), np.full(n, -1, dtype=np.int64)
+    ef = np.zeros((n, _N_TABLE))
+    tooth = np.full(n, -1, dtype=np.int64)
     healthy = _pair_table(pair, None)
+    u = np.linspace(0.0, 1.0, _N_TABLE)
     for i, f in enumerate(faults):
         if f is None or f.is_healthy:
             kf[i] = healthy
             continue
         kf[i] = _pair_table(pair, f)
+        ef[i] = f.displacement(pair, 1.0 - u)
         tooth[i] = f.tooth % pair.z_gear
-        if isinstance(f, FullToothFaceFault):
-            s0, s1 = f.window
-            lo[i], hi[i] = 1.0 - s1, 1.0 - s0
-            h[i] = f.transmission * f.deviation_depth(pair)
-    return kf, lo, hi, h, tooth
+    return kf, ef, tooth
 
 
 def _stack_errors(errs: list[ToothProfileErrors]):
@@ -296,11 +296,11 @@ def _stack_errors(errs: list[ToothProfileErrors]):
 
 def _run(pair, integ, mesh_pos, motor_acc, load, faults, gear_errs, pin_errs, rec_start,
          n_rec):
-    kf, lo, hi, h, tooth = _fault_arrays(pair, faults)
+    kf, ef, tooth = _fault_arrays(pair, faults)
     g = _stack_errors(gear_errs)
     p = _stack_errors(pin_errs)
     out = np.empty((len(faults), n_rec))
-    _newmark_batch(mesh_pos, motor_acc, load, _pair_table(pair, None), kf, lo, hi, h, tooth,
+    _newmark_batch(mesh_pos, motor_acc, load, _pair_table(pair, None), kf, ef, tooth,
                    *g, *p, pair.contact_ratio, pair.z_gear, integ.B1, integ.B2, integ.B3,
                    integ.w, integ.s, integ.v, integ.c_load, integ.c_motor, integ.x_static,
                    integ.coef, rec_start, out)

@@ -50,6 +50,11 @@ class ToothFault:
         ``x`` (m from the gear centre along the tooth's centre line)."""
         return np.zeros_like(np.asarray(x, dtype=float))
 
+    def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
+        """(s_min, breakpoints): the pair stiffness differs from healthy only for gear
+        roll fractions s >= s_min and is smooth between the breakpoints."""
+        return 1.0, np.array([])
+
     def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
         """Roll fraction where the load actually acts when the nominal contact is at ``s``
         (0 = lowest contact point, 1 = tip of the gear tooth)."""
@@ -80,25 +85,21 @@ class FullToothFaceFault(ToothFault):
     tooth : int
         Faulty gear tooth.
     transmission : float
-        Fraction of the cut's geometric deviation that reaches the mesh as displacement
-        excitation. A linear mesh model lets the mating flank follow the whole cut, while
-        in the real pair the neighbouring pairs take over part of the load; the default
-        0.275 is calibrated so that diff-RMS(y = 0.7) / diff-RMS(healthy) at DIN 7,
-        15 rps, 10 Nm matches the lab's model (7.7; benchmarks/RESULTS_sim.md). Use 1.0
-        for the purely geometric deviation.
+        Scale of the displacement excitation (1 = the geometric value of
+        :meth:`deviation_depth`; 0 = stiffness change only). For sensitivity studies.
     """
 
     size: float = 0.0
     center: float = 0.5
     depth: float = 0.5
-    transmission: float = 0.275
+    transmission: float = 1.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check_in_range(self.size, "size", 0.0, 1.0)
         check_in_range(self.center, "center", 0.0, 1.0)
         check_in_range(self.depth, "depth", 0.0, 1.0, low_inclusive=False)
-        check_in_range(self.transmission, "transmission", 0.0, 1.0)
+        check_in_range(self.transmission, "transmission", 0.0, 10.0)
         lo, hi = self.window
         if lo < -1e-12 or hi > 1 + 1e-12:
             raise GearshotError(
@@ -160,6 +161,12 @@ class FullToothFaceFault(ToothFault):
         out[inside] = np.maximum(h_flank - h_arc, 0.0)
         return out
 
+    def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
+        s0, s1 = self.window
+        if self.is_healthy:
+            return 1.0, np.array([])
+        return s0, np.array([s0, 0.5 * (s0 + s1), s1])
+
     def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
         """While the nominal contact lies in the tip-side half of the cut, the mating flank
         bridges the hollow and pivots on the cut's tip-side edge, so the load stays there;
@@ -173,40 +180,82 @@ class FullToothFaceFault(ToothFault):
         out[(s > mid) & (s < s1)] = s1
         return out
 
-    def deviation_depth(self, pair: GearPair) -> float:
-        """Peak displacement excitation h (m): the cut's sagitta plus the bulge of the
-        mating pinion involute over the corresponding stretch of its flank."""
-        if self.is_healthy:
-            return 0.0
-        _, _, _, sag = self._arc(pair)
-        # pinion flank stretch that meets the cut
-        z1 = pair.z_pinion
-        rb1 = pair.base_radius(z1)
-        total = pair.center_distance * math.sin(pair.pressure_angle)
+    def _flank_points(self, pair: GearPair, margin: float = 0.25, n: int = 160):
+        """Polar (radius, angle from the tooth centre line) of the cut flank near the cut:
+        the arc, plus the involute up to ``margin`` of the active profile beyond it."""
+        z = pair.z_gear
+        rb = pair.base_radius(z)
         _, (l_lo, l_hi) = pair.roll_limits
         s0, s1 = self.window
-        lp = total - (l_lo + np.linspace(s0, s1, 201) * (l_hi - l_lo))
-        r = np.hypot(rb1, lp)
-        psi = involute_half_angle(z1, pair.pressure_angle, r, rb1)
-        px, ph = r * np.cos(psi), r * np.sin(psi)
-        dx, dh = px[-1] - px[0], ph[-1] - ph[0]
-        norm = math.hypot(dx, dh)
-        if norm == 0:
-            return sag
-        dist = np.abs((px - px[0]) * dh - (ph - ph[0]) * dx) / norm
-        return sag + float(dist.max())
+        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, n // 2),
+                    np.linspace(s1, min(s1 + margin, 1.0), n // 2)]
+        ls = l_lo + np.concatenate(pieces_s) * (l_hi - l_lo)
+        r = np.hypot(rb, np.maximum(ls, 0.0))
+        psi = involute_half_angle(z, pair.pressure_angle, r, rb)
+        (xa, xb), (cx, ch), radius, _ = self._arc(pair)
+        xx = np.linspace(xa, xb, n)
+        hh = ch - np.sqrt(np.maximum(radius ** 2 - (xx - cx) ** 2, 0.0))
+        return (np.concatenate([r, np.hypot(xx, hh)]),
+                np.concatenate([psi, np.arctan2(hh, xx)]))
+
+    def _retreat(self, pair: GearPair, u: np.ndarray) -> np.ndarray:
+        """Rigid-body retreat (m, >= 0) of the mating pinion flank when the nominal
+        contact is at line-of-action fraction ``u``: the smallest normal gap between the
+        pinion involute (through the nominal contact point) and the remaining gear flank
+        (cut arc and the involute beyond its edges), points within the pinion's flank."""
+        z1, z2 = pair.z_pinion, pair.z_gear
+        a0 = pair.pressure_angle
+        rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
+        ra1 = pair.tip_radius(z1)
+        (p_lo, p_hi), _ = pair.roll_limits
+        inv0 = math.tan(a0) - a0
+
+        def inv_r(r, rb):
+            al = np.arccos(np.clip(rb / r, -1.0, 1.0))
+            return np.tan(al) - al
+
+        d = np.array([math.sin(a0), math.cos(a0)])
+        t1 = rb1 * np.array([math.cos(a0), -math.sin(a0)])
+        o2 = np.array([pair.center_distance, 0.0])
+        lam = p_lo + np.asarray(u, dtype=float) * (p_hi - p_lo)
+        c = t1[None, :] + lam[:, None] * d[None, :]               # contact points
+        phi_p = np.arctan2(c[:, 1], c[:, 0]) + inv_r(np.hypot(c[:, 0], c[:, 1]), rb1)
+        cg = c - o2
+        phi_g = np.arctan2(cg[:, 1], cg[:, 0]) + inv_r(np.hypot(cg[:, 0], cg[:, 1]), rb2)
+        centre = phi_g - math.pi / (2 * z2) - inv0                 # gear tooth centre line
+        r, ang = self._flank_points(pair)
+        px = o2[0] + r[None, :] * np.cos(centre[:, None] + ang[None, :])
+        py = o2[1] + r[None, :] * np.sin(centre[:, None] + ang[None, :])
+        rp = np.hypot(px, py)
+        gap = rb1 * (np.arctan2(py, px) + inv_r(np.maximum(rp, rb1), rb1) - phi_p[:, None])
+        gap = (gap + math.pi * rb1) % (2 * math.pi * rb1) - math.pi * rb1
+        gap = np.where((rp >= rb1) & (rp <= ra1), gap, np.inf)
+        return np.clip(gap.min(axis=1), 0.0, None)
+
+    def deviation_depth(self, pair: GearPair) -> float:
+        """Peak displacement excitation (m) over the cut (see :meth:`displacement`)."""
+        if self.is_healthy:
+            return 0.0
+        s0, s1 = self.window
+        s = np.linspace(s0, s1, 257)
+        return float(-self.displacement(pair, s).min())
 
     def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
-        """Raised-cosine dip of depth :meth:`deviation_depth` across the cut."""
+        """Loss of approach along the line of action while the nominal contact lies in
+        the cut: the mating flank bridges the hollow and bears on the cut's edges (or its
+        floor, for shallow cuts), so the pair's transmission error drops by the rigid
+        gap computed from the exact involute geometry (:meth:`_retreat`)."""
         s = np.asarray(s, dtype=float)
-        if self.is_healthy:
-            return np.zeros_like(s)
-        s0, s1 = self.window
-        h = self.transmission * self.deviation_depth(pair)
-        rel = (s1 - s) / (s1 - s0)  # contact runs from tip (s = 1) to root
-        inside = (rel > 0) & (rel < 1)
         out = np.zeros_like(s)
-        out[inside] = -h * 0.5 * (1 - np.cos(2 * np.pi * rel[inside]))
+        if self.is_healthy:
+            return out
+        s0, s1 = self.window
+        inside = (s > s0) & (s < s1)
+        if inside.any():
+            # the retreat is smooth but for one kink: sample it on 193 points, interpolate
+            knots = np.linspace(s0, s1, 193)
+            ret = self._retreat(pair, 1.0 - knots)
+            out[inside] = -self.transmission * np.interp(s[inside], knots, ret)
         return out
 
 

@@ -117,12 +117,53 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 
 _N_TABLE = 1025
+_N_SEGMENT = 48  # exact evaluations per smooth segment of a faulty tooth's compliance
+
+
+@functools.lru_cache(maxsize=32)
+def _healthy_compliances(pair: GearPair):
+    """Pinion and gear tooth compliance tables over u (the healthy pair)."""
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    (p_lo, p_hi), (g_lo, g_hi) = pair.roll_limits
+    inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + u * (p_hi - p_lo))
+    inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + (1.0 - u) * (g_hi - g_lo))
+    return inv_p, inv_g
+
+
+def _faulty_gear_compliance(pair: GearPair, fault: ToothFault) -> np.ndarray:
+    """Gear-tooth compliance over the u table for a faulty tooth: exact on a few points
+    of each smooth segment (between the fault's breakpoints) and interpolated, healthy
+    outside the affected range."""
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    s = 1.0 - u
+    _, inv_g = _healthy_compliances(pair)
+    out = inv_g.copy()
+    (_, _), (g_lo, g_hi) = pair.roll_limits
+    s_min, breaks = fault.affected_range(pair)
+    edges = np.unique(np.clip(np.concatenate([[s_min, 1.0], breaks]), s_min, 1.0))
+    sec = functools.partial(fault.section_loss, pair)
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b - a <= 0:
+            continue
+        sel = (s >= a) & (s <= b) if b == 1.0 else (s >= a) & (s < b)
+        if not sel.any():
+            continue
+        # evaluate just inside the segment so one-sided limits are respected
+        eta = 1e-9 * (b - a)
+        knots = np.linspace(a + eta, b - eta, _N_SEGMENT)
+        roll = g_lo + fault.contact_roll(pair, knots) * (g_hi - g_lo)
+        vals = _tooth_compliance(pair, pair.z_gear, roll, sec)
+        out[sel] = np.interp(s[sel], knots, vals)
+    return out
 
 
 @functools.lru_cache(maxsize=256)
 def _pair_table(pair: GearPair, fault: ToothFault | None) -> np.ndarray:
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    tab = pair_stiffness(pair, u, fault=fault)
+    inv_p, inv_g = _healthy_compliances(pair)
+    if fault is not None and not fault.is_healthy:
+        inv_g = _faulty_gear_compliance(pair, fault)
+    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+    tab = 1.0 / (1.0 / k_h + inv_p + inv_g)
     tab.setflags(write=False)
     return tab
 

@@ -83,6 +83,11 @@ def estimate_transfer_function(healthy_signal, n_out, *, nfft=2**15, segment_siz
     spectrum = amplitude_spectrum(x, nfft=nfft)
     background = acs_background(spectrum, segment_size=segment_size, overlap=overlap,
                                 percentile=percentile)
+    if not np.any(background > 0):
+        raise GearshotError(
+            "healthy_signal has no spectral background (a strictly periodic signal has "
+            "energy only at its orders); the TF estimate needs non-synchronous content "
+            "such as a real recording's noise")
     tf_mp = minimum_phase(background)
     return resample_transfer_function(tf_mp[: tf_mp.size // 2 + 1], n_out)
 
