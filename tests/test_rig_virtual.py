@@ -257,3 +257,22 @@ def test_tf_bank_from_measured_frf_folder():
     assert rig.reveal_path()[0] in {p.stem for p in folder.glob("*.uff")}
     assert "transfer_path" not in rec.extras
     assert np.all(np.isfinite(rec.acceleration))
+
+
+def test_forced_grade_and_with_reality():
+    base = VirtualRig(seed=0)
+    assert VirtualRig(seed=0, grade=11).reveal().grade == 11
+    loud = base.with_reality(attenuation_db=0.0, snr_db=60.0)
+    r = loud.reveal()
+    assert (r.attenuation_db, r.snr_db) == (0.0, 60.0)
+    assert r.grade == base.reveal().grade and r.mass_factor == base.reveal().mass_factor
+    a = base.record(speed=30.0, load=5.0, duration=0.5)
+    b = loud.record(speed=30.0, load=5.0, duration=0.5)
+    gain = 10 ** ((base.reveal().attenuation_db - 0.0) / 20)
+    assert rms(b.acceleration) / rms(a.acceleration) == pytest.approx(gain, rel=0.1)
+    with pytest.raises(GearshotError, match="no field 'colour'"):
+        base.with_reality(colour=3)
+    with pytest.raises(GearshotError, match="grade must be <= 12"):
+        VirtualRig(seed=0, grade=13).reveal()
+    with pytest.raises(GearshotError, match="snr_db must lie in"):
+        base.with_reality(snr_db=-5.0)
