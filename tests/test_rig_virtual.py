@@ -276,3 +276,26 @@ def test_forced_grade_and_with_reality():
         VirtualRig(seed=0, grade=13).reveal()
     with pytest.raises(GearshotError, match="snr_db must lie in"):
         base.with_reality(snr_db=-5.0)
+
+
+def test_irregular_face_fault_hooks():
+    from gearshot.rig import IrregularFaceFault
+    from gearshot.sim import FullToothFaceFault, GearPair
+
+    pair = GearPair.paper()
+    arc = FullToothFaceFault(size=0.5, center=0.5, depth=0.5)
+    rough = IrregularFaceFault(size=0.5, center=0.5, depth=0.5, roughness=(0.3, -0.2))
+    s = np.linspace(0.0, 1.0, 401)
+    d_arc, d_rough = arc.displacement(pair, s), rough.displacement(pair, s)
+    outside = (s < 0.25) | (s > 0.75)
+    assert np.all(d_rough[outside] == 0) and np.all(d_arc[outside] == 0)
+    inside = ~outside & (d_arc != 0)
+    ratio = d_rough[inside] / d_arc[inside]
+    np.testing.assert_allclose(ratio, rough.depth_profile(s[inside]))
+    assert ratio.min() < 0.8 and ratio.max() > 1.05  # not a scaled arc
+    x = np.linspace(0.05, 0.12, 300)
+    loss_arc, loss_rough = arc.section_loss(pair, x), rough.section_loss(pair, x)
+    assert np.all((loss_rough > 0) == (loss_arc > 0)) and np.any(loss_arc > 0)
+    assert not np.allclose(loss_rough, loss_arc)
+    with pytest.raises(GearshotError, match="roughness"):
+        IrregularFaceFault(size=0.5, roughness=(0.7, 0.5))
