@@ -133,7 +133,8 @@ def test_wrong_fs_is_detected_from_speed_metadata(tmp_path):
     path = tmp_path / "r.csv"
     wrong = Recording(rec.acceleration, rec.tacho, FS / 2, speed=30.0)  # fs mislabelled
     wrong.write(path)
-    with pytest.raises(GearshotError, match=r"r\.csv.*input speed of 1[45]\.?[0-9]* rev/s at fs=25000 Hz"):
+    with pytest.raises(GearshotError,
+                       match=r"r\.csv.*input speed of 1[45]\.?[0-9]* rev/s at fs=25000 Hz"):
         Recording.read(path).to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP, cycles_per_segment=5)
     ok = Recording.read(path, metadata={"speed": 15.0})
     assert ok.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP, cycles_per_segment=5).shape[0] > 0

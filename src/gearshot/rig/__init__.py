@@ -22,4 +22,5 @@ from .virtual import INDEX_COLUMNS, INDEX_NAME, VirtualRig, read_campaign
 
 __all__ = ["Recording", "FORMATS", "gear_cycle_times", "check_pulse_train", "tacho_signal",
            "VirtualRig", "read_campaign", "INDEX_NAME", "INDEX_COLUMNS", "RigReality",
-           "draw_reality", "IrregularFaceFault", "SimulatorEngine", "SurrogateEngine", "PathTF", "synthetic_path_tfs"]
+           "draw_reality", "IrregularFaceFault", "SimulatorEngine", "SurrogateEngine",
+           "PathTF", "synthetic_path_tfs"]
