@@ -176,3 +176,21 @@ def test_short_dropout_bridged_with_several_pulses_per_rev_and_glitch_rejected()
     glitch[k] = 5.0  # a spike between two pulses
     with pytest.raises(GearshotError, match="extra tacho pulse"):
         Recording(acc, glitch, FS, tacho_pulses_per_rev=4).pulse_times()
+
+
+def test_output_shaft_tacho_gives_the_same_sa():
+    t = np.arange(int(8.0 * FS)) / FS
+    revs = pinion_revs(t, 30.0, drift=0.01, drift_period=6.0)
+    gear = revs * ZP / ZG
+    acc = template(gear)
+    on_input = Recording(acc, tacho_signal(revs), FS)
+    on_output = Recording(acc, tacho_signal(gear, pulses_per_rev=2), FS, tacho_shaft="output",
+                          tacho_pulses_per_rev=2)
+    sa_out = on_output.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    phase0 = float(np.interp(on_output.pulse_times()[0], t, gear))
+    want = template(phase0 + np.arange(N_SA) / N_SA)
+    assert np.sqrt(np.mean((sa_out - want) ** 2)) < 0.01 * np.sqrt(np.mean(want ** 2))
+    # both tachos see the same number of gear revolutions
+    n_in = on_input.angle_domain(gear_teeth=ZG, pinion_teeth=ZP).size // N_SA
+    n_out = on_output.angle_domain(gear_teeth=ZG, pinion_teeth=ZP).size // N_SA
+    assert abs(n_in - n_out) <= 1
