@@ -115,7 +115,8 @@ def test_tacho_dropout_longer_than_a_revolution(tmp_path):
     tach = rec.tacho.copy()
     tach[(revs > 100.5) & (revs < 101.5)] = 0.0  # pulse 101 missing
     path = Recording(rec.acceleration, tach, FS, speed=30.0).write(tmp_path / "drop.h5")
-    with pytest.raises(GearshotError, match=r"drop\.h5.*tacho dropout .*t=3\.3"):
+    with pytest.raises(GearshotError,
+                       match=r"drop\.h5.*tacho dropout .*more than one revolution.*t=3\.3"):
         Recording.read(path).to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
 
 
@@ -132,7 +133,8 @@ def test_wrong_fs_is_detected_from_speed_metadata(tmp_path):
     path = tmp_path / "r.csv"
     wrong = Recording(rec.acceleration, rec.tacho, FS / 2, speed=30.0)  # fs mislabelled
     wrong.write(path)
-    with pytest.raises(GearshotError, match=r"r\.csv.*input speed of 1[45]\.?[0-9]* rev/s at fs=25000 Hz"):
+    with pytest.raises(GearshotError,
+                       match=r"r\.csv.*input speed of 1[45]\.?[0-9]* rev/s at fs=25000 Hz"):
         Recording.read(path).to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP, cycles_per_segment=5)
     ok = Recording.read(path, metadata={"speed": 15.0})
     assert ok.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP, cycles_per_segment=5).shape[0] > 0
@@ -150,3 +152,45 @@ def test_tacho_signal_jitter_and_pulses_per_rev():
     assert 1e-6 < np.std(dev) < 4e-5  # ~2e-4 rev / 10 rev/s = 2e-5 s
     with pytest.raises(GearshotError, match="rng"):
         tacho_signal(revs, jitter=1e-4)
+
+
+def test_short_dropout_bridged_with_several_pulses_per_rev_and_glitch_rejected():
+    t = np.arange(int(6.0 * FS)) / FS
+    revs = pinion_revs(t, 30.0, drift=0.01, drift_period=6.0)
+    acc = template(revs * ZP / ZG)
+    tach = tacho_signal(revs, pulses_per_rev=4)
+    full = Recording(acc, tach, FS, tacho_pulses_per_rev=4)
+    ref = full.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    holed = tach.copy()
+    holed[(revs > 50.1) & (revs < 50.6)] = 0.0  # two of four pulses in one revolution
+    rec = Recording(acc, holed, FS, tacho_pulses_per_rev=4)
+    assert rec.pulse_times().size == full.pulse_times().size
+    sa = rec.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    assert np.sqrt(np.mean((sa - ref) ** 2)) < 0.01 * np.sqrt(np.mean(ref ** 2))
+    long_hole = tach.copy()
+    long_hole[(revs > 50.1) & (revs < 51.3)] = 0.0  # more than a revolution
+    with pytest.raises(GearshotError, match="more than one revolution"):
+        Recording(acc, long_hole, FS, tacho_pulses_per_rev=4).pulse_times()
+    glitch = tach.copy()
+    k = np.flatnonzero((revs > 20.12) & (revs < 20.13))
+    glitch[k] = 5.0  # a spike between two pulses
+    with pytest.raises(GearshotError, match="extra tacho pulse"):
+        Recording(acc, glitch, FS, tacho_pulses_per_rev=4).pulse_times()
+
+
+def test_output_shaft_tacho_gives_the_same_sa():
+    t = np.arange(int(8.0 * FS)) / FS
+    revs = pinion_revs(t, 30.0, drift=0.01, drift_period=6.0)
+    gear = revs * ZP / ZG
+    acc = template(gear)
+    on_input = Recording(acc, tacho_signal(revs), FS)
+    on_output = Recording(acc, tacho_signal(gear, pulses_per_rev=2), FS, tacho_shaft="output",
+                          tacho_pulses_per_rev=2)
+    sa_out = on_output.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)
+    phase0 = float(np.interp(on_output.pulse_times()[0], t, gear))
+    want = template(phase0 + np.arange(N_SA) / N_SA)
+    assert np.sqrt(np.mean((sa_out - want) ** 2)) < 0.01 * np.sqrt(np.mean(want ** 2))
+    # both tachos see the same number of gear revolutions
+    n_in = on_input.angle_domain(gear_teeth=ZG, pinion_teeth=ZP).size // N_SA
+    n_out = on_output.angle_domain(gear_teeth=ZG, pinion_teeth=ZP).size // N_SA
+    assert abs(n_in - n_out) <= 1

@@ -7,6 +7,8 @@ import json
 import h5py
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 import scipy.io
 import scipy.io.wavfile
 
@@ -225,3 +227,24 @@ def test_constructor_validation():
         Recording(np.zeros(10), None, 100.0, extras={"f": object()})
     with pytest.raises(GearshotError, match="acceleration must be finite"):
         Recording(np.array([0.0, np.nan, 1.0]), None, 100.0)
+
+
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64),
+                       min_size=2, max_size=40),
+       fs=st.floats(min_value=1e-3, max_value=1e7, allow_nan=False),
+       speed=st.one_of(st.none(), st.floats(min_value=1e-6, max_value=1e4)),
+       text=st.text(max_size=20),
+       extra=st.dictionaries(st.text(min_size=1, max_size=8),
+                             st.one_of(st.integers(-10**9, 10**9), st.text(max_size=8),
+                                       st.booleans(), st.none()), max_size=4),
+       fmt=st.sampled_from(["hdf5", "csv", "mat5", "mat73"]))
+def test_round_trip_property(tmp_path, values, fs, speed, text, extra, fmt):
+    acc = np.array(values)
+    rec = Recording(acc, acc[::-1].copy(), fs, speed=speed, source=text, extras=extra)
+    suffix = {"hdf5": ".h5", "csv": ".csv", "mat5": ".mat", "mat73": ".mat"}[fmt]
+    back = Recording.read(rec.write(tmp_path / f"p{suffix}", format=fmt))
+    np.testing.assert_array_equal(back.acceleration, rec.acceleration)
+    np.testing.assert_array_equal(back.tacho, rec.tacho)
+    assert back.fs == rec.fs and back.metadata == rec.metadata

@@ -254,5 +254,48 @@ def test_tf_bank_from_measured_frf_folder():
     pytest.importorskip("gearshot.transfer.bank", reason="gearshot.transfer not merged yet")
     rig = VirtualRig(seed=2, tf_bank=folder)
     rec = rig.record(speed=15.0, load=5.0, duration=0.5)
-    assert rec.extras["transfer_path"] in {p.stem for p in folder.glob("*.uff")}
+    assert rig.reveal_path()[0] in {p.stem for p in folder.glob("*.uff")}
+    assert "transfer_path" not in rec.extras
     assert np.all(np.isfinite(rec.acceleration))
+
+
+def test_forced_grade_and_with_reality():
+    base = VirtualRig(seed=0)
+    assert VirtualRig(seed=0, grade=11).reveal().grade == 11
+    loud = base.with_reality(attenuation_db=0.0, snr_db=60.0)
+    r = loud.reveal()
+    assert (r.attenuation_db, r.snr_db) == (0.0, 60.0)
+    assert r.grade == base.reveal().grade and r.mass_factor == base.reveal().mass_factor
+    a = base.record(speed=30.0, load=5.0, duration=0.5)
+    b = loud.record(speed=30.0, load=5.0, duration=0.5)
+    gain = 10 ** ((base.reveal().attenuation_db - 0.0) / 20)
+    assert rms(b.acceleration) / rms(a.acceleration) == pytest.approx(gain, rel=0.1)
+    with pytest.raises(GearshotError, match="no field 'colour'"):
+        base.with_reality(colour=3)
+    with pytest.raises(GearshotError, match="grade must be <= 12"):
+        VirtualRig(seed=0, grade=13).reveal()
+    with pytest.raises(GearshotError, match="snr_db must lie in"):
+        base.with_reality(snr_db=-5.0)
+
+
+def test_irregular_face_fault_hooks():
+    from gearshot.rig import IrregularFaceFault
+    from gearshot.sim import FullToothFaceFault, GearPair
+
+    pair = GearPair.paper()
+    arc = FullToothFaceFault(size=0.5, center=0.5, depth=0.5)
+    rough = IrregularFaceFault(size=0.5, center=0.5, depth=0.5, roughness=(0.3, -0.2))
+    s = np.linspace(0.0, 1.0, 401)
+    d_arc, d_rough = arc.displacement(pair, s), rough.displacement(pair, s)
+    outside = (s < 0.25) | (s > 0.75)
+    assert np.all(d_rough[outside] == 0) and np.all(d_arc[outside] == 0)
+    inside = ~outside & (d_arc != 0)
+    ratio = d_rough[inside] / d_arc[inside]
+    np.testing.assert_allclose(ratio, rough.depth_profile(s[inside]))
+    assert ratio.min() < 0.8 and ratio.max() > 1.05  # not a scaled arc
+    x = np.linspace(0.05, 0.12, 300)
+    loss_arc, loss_rough = arc.section_loss(pair, x), rough.section_loss(pair, x)
+    assert np.all((loss_rough > 0) == (loss_arc > 0)) and np.any(loss_arc > 0)
+    assert not np.allclose(loss_rough, loss_arc)
+    with pytest.raises(GearshotError, match="roughness"):
+        IrregularFaceFault(size=0.5, roughness=(0.7, 0.5))

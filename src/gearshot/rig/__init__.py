@@ -15,11 +15,12 @@ from .angle import check_pulse_train, gear_cycle_times
 from .path import PathTF, synthetic_path_tfs
 from .reality import RigReality, draw_reality
 from .recording import FORMATS, Recording
-from .sim_engine import SimulatorEngine
+from .sim_engine import IrregularFaceFault, SimulatorEngine
 from .surrogate import SurrogateEngine
 from .tacho import tacho_signal
 from .virtual import INDEX_COLUMNS, INDEX_NAME, VirtualRig, read_campaign
 
 __all__ = ["Recording", "FORMATS", "gear_cycle_times", "check_pulse_train", "tacho_signal",
            "VirtualRig", "read_campaign", "INDEX_NAME", "INDEX_COLUMNS", "RigReality",
-           "draw_reality", "SimulatorEngine", "SurrogateEngine", "PathTF", "synthetic_path_tfs"]
+           "draw_reality", "IrregularFaceFault", "SimulatorEngine", "SurrogateEngine",
+           "PathTF", "synthetic_path_tfs"]

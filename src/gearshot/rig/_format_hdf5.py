@@ -7,15 +7,11 @@ Layout (``format_version`` 1)::
         format_version      1
         fs                  float64, Hz
         n_samples           int64
-        units               str, acceleration units (e.g. "g", "m/s^2")
-        source              str, where the data come from (free text)
-        speed               float64, input-shaft speed in rev/s (absent = unknown)
-        load                float64, load torque in N m (absent = unknown)
-        fault_size          float64, fault size y in [0, 1] (absent = unknown)
-        tacho_pulses_per_rev int64, tacho pulses per revolution of its shaft
-        tacho_shaft         "input" (pinion) or "output" (driven gear)
-        extras_json         str, JSON object of free-form metadata
-    /acceleration           (n_samples,) float64 or float32
+        metadata_json       str, ASCII JSON object: speed (input-shaft rev/s or null),
+                            load (N m or null), fault_size (y in [0, 1] or null), units,
+                            source, tacho_pulses_per_rev, tacho_shaft ("input"/"output"),
+                            extras (free-form JSON object)
+    /acceleration           (n_samples,) float64 or float32; attribute units
     /tacho                  (n_samples,) same dtype, LZF-compressed (absent = no tacho)
 
 Files are written to a temporary name in the target folder and moved into place with
@@ -40,7 +36,6 @@ __all__ = ["read_hdf5", "write_hdf5", "FORMAT_NAME", "FORMAT_VERSION"]
 
 FORMAT_NAME = "gearshot.recording"
 FORMAT_VERSION = 1
-_FLOAT_META = ("speed", "load", "fault_size")
 
 
 def _attr(value: Any) -> Any:
@@ -83,17 +78,9 @@ def read_hdf5(path: Path) -> RawFile:
                 if v.shape != (n,):
                     raise GearshotError(f"{str(path)!r}: /{k} has shape {v.shape}, expected "
                                         f"({n},) (truncated or corrupt file?)")
-            meta: dict[str, Any] = {}
-            for key in _FLOAT_META:
-                if key in attrs:
-                    meta[key] = float(attrs[key])
-            for key in ("units", "source", "tacho_shaft"):
-                if key in attrs:
-                    meta[key] = str(attrs[key])
-            if "tacho_pulses_per_rev" in attrs:
-                meta["tacho_pulses_per_rev"] = int(attrs["tacho_pulses_per_rev"])
-            if "extras_json" in attrs:
-                meta["extras"] = json.loads(attrs["extras_json"])
+            meta = json.loads(attrs.get("metadata_json", "{}"))
+            if not isinstance(meta, dict):
+                raise GearshotError(f"{str(path)!r}: metadata_json is not a JSON object")
             return RawFile(Path(path), chans, attrs.get("fs"), meta)
         # generic HDF5: numeric datasets at the root
         chans = {}
@@ -125,15 +112,7 @@ def write_hdf5(rec: Any, path: Path, *, dtype: Any = np.float64) -> None:
             f.attrs["format_version"] = FORMAT_VERSION
             f.attrs["fs"] = float(rec.fs)
             f.attrs["n_samples"] = int(rec.acceleration.size)
-            f.attrs["units"] = rec.units
-            f.attrs["source"] = rec.source
-            for key in _FLOAT_META:
-                value = getattr(rec, key)
-                if value is not None:
-                    f.attrs[key] = float(value)
-            f.attrs["tacho_pulses_per_rev"] = int(rec.tacho_pulses_per_rev)
-            f.attrs["tacho_shaft"] = rec.tacho_shaft
-            f.attrs["extras_json"] = json.dumps(dict(rec.extras), sort_keys=True)
+            f.attrs["metadata_json"] = json.dumps(rec.metadata, sort_keys=True)
             d = f.create_dataset("acceleration", data=rec.acceleration.astype(dtype, copy=False))
             d.attrs["units"] = rec.units
             if rec.tacho is not None:

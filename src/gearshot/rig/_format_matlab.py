@@ -2,10 +2,13 @@
 
 Variables: every numeric vector (or each row/column of a numeric matrix, named
 ``name[i]``) is a channel; ``fs`` (or ``Fs``, ``sample_rate``, ...) is the sampling rate;
-the scalar/string variables ``speed``, ``load``, ``fault_size``, ``units``, ``source``,
-``tacho_pulses_per_rev``, ``tacho_shaft`` and ``extras_json`` (a JSON object) are metadata.
-The writers produce exactly that layout (v7.3: HDF5 with the 512-byte MATLAB user block,
-``MATLAB_class`` attributes and MATLAB's reversed dimension order).
+``metadata_json`` (an ASCII JSON object with all metadata fields) holds the metadata. Files
+from elsewhere may instead carry scalar/string variables ``speed``, ``load``,
+``fault_size``, ``units``, ``source``, ``tacho_pulses_per_rev``, ``tacho_shaft``; they are
+read when there is no ``metadata_json``. The writers store ``acceleration``, ``tacho``,
+``fs``, ``metadata_json`` and, for MATLAB users' convenience, ``speed``, ``load`` and
+``fault_size`` when known (v7.3: HDF5 with the 512-byte MATLAB user block,
+``MATLAB_class`` attributes, UTF-16 chars and MATLAB's reversed dimension order).
 """
 
 from __future__ import annotations
@@ -26,7 +29,6 @@ __all__ = ["read_mat", "write_mat"]
 
 _STR_META = ("units", "source", "tacho_shaft")
 _FLOAT_META = ("speed", "load", "fault_size")
-_META_NAMES = set(_STR_META) | set(_FLOAT_META) | {"tacho_pulses_per_rev", "extras_json"}
 
 
 def _is_v73(path: Path) -> bool:
@@ -39,6 +41,7 @@ def _is_v73(path: Path) -> bool:
 def _collect(path: Path, variables: dict[str, Any]) -> RawFile:
     chans: dict[str, np.ndarray] = {}
     meta: dict[str, Any] = {}
+    full: dict[str, Any] | None = None
     fs = None
     for name, value in variables.items():
         if name.startswith("__"):
@@ -48,12 +51,14 @@ def _collect(path: Path, variables: dict[str, Any]) -> RawFile:
             text = str(value) if not isinstance(value, np.ndarray) else "".join(value.ravel())
             if name in _STR_META:
                 meta[name] = text
-            elif name == "extras_json":
+            elif name == "metadata_json":
                 try:
-                    meta["extras"] = json.loads(text) if text else {}
+                    full = json.loads(text)
                 except ValueError as exc:
-                    raise GearshotError(f"{str(path)!r}: variable extras_json is not valid "
+                    raise GearshotError(f"{str(path)!r}: variable metadata_json is not valid "
                                         f"JSON ({exc})") from None
+                if not isinstance(full, dict):
+                    raise GearshotError(f"{str(path)!r}: metadata_json is not a JSON object")
             continue
         arr = np.asarray(value)
         if arr.dtype.kind not in "iufb":
@@ -76,7 +81,7 @@ def _collect(path: Path, variables: dict[str, Any]) -> RawFile:
             rows = arr if arr.shape[0] < arr.shape[1] else arr.T
             for i, row in enumerate(rows):
                 chans[f"{name}[{i}]"] = row
-    return RawFile(Path(path), chans, fs, meta)
+    return RawFile(Path(path), chans, fs, full if full is not None else meta)
 
 
 def _read_v73_dataset(ds: h5py.Dataset) -> Any:
@@ -86,7 +91,7 @@ def _read_v73_dataset(ds: h5py.Dataset) -> Any:
         return "" if cls == "char" else np.zeros(0)
     data = np.asarray(ds[()])
     if cls == "char":
-        return "".join(chr(c) for c in data.T.ravel())
+        return data.T.ravel().astype("<u2").tobytes().decode("utf-16-le", "surrogatepass")
     return data.T  # MATLAB stores column-major: h5py sees the dimensions reversed
 
 
@@ -109,13 +114,10 @@ def _mat_variables(rec: Any) -> dict[str, Any]:
     if rec.tacho is not None:
         out["tacho"] = rec.tacho
     out["fs"] = float(rec.fs)
+    out["metadata_json"] = json.dumps(rec.metadata, sort_keys=True)  # ASCII
     for key in _FLOAT_META:
         if getattr(rec, key) is not None:
             out[key] = float(getattr(rec, key))
-    for key in _STR_META:
-        out[key] = str(getattr(rec, key))
-    out["tacho_pulses_per_rev"] = float(rec.tacho_pulses_per_rev)
-    out["extras_json"] = json.dumps(dict(rec.extras), sort_keys=True)
     return out
 
 
@@ -127,7 +129,8 @@ def _write_v73(variables: dict[str, Any], path: Path) -> None:
                     ds = f.create_dataset(name, data=np.array([0, 0], dtype=np.uint64))
                     ds.attrs["MATLAB_empty"] = np.uint8(1)
                 else:
-                    codes = np.array([ord(c) for c in value], dtype=np.uint16)
+                    codes = np.frombuffer(value.encode("utf-16-le", "surrogatepass"),
+                                          dtype="<u2")
                     ds = f.create_dataset(name, data=codes.reshape(-1, 1))
                     ds.attrs["MATLAB_int_decode"] = np.int32(2)
                 ds.attrs["MATLAB_class"] = np.bytes_("char")

@@ -45,10 +45,19 @@ DROPOUT_FACTOR = 1.5
 
 
 def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) -> np.ndarray:
-    """Validate tacho pulse times (s): enough pulses, increasing, no dropout.
+    """Validate tacho pulse times (s): enough pulses, increasing, no glitch, no long dropout.
 
-    A gap longer than ``DROPOUT_FACTOR`` median pulse intervals (a missing pulse) cannot be
-    bridged reliably once it is as long as a revolution, so any such gap raises.
+    A gap longer than ``DROPOUT_FACTOR`` median pulse intervals is a dropout (missing
+    pulses). A dropout that spans more than one revolution (more than ``pulses_per_rev``
+    intervals; with one pulse per revolution, *any* missing pulse) cannot be bridged
+    reliably and raises. Shorter dropouts (possible with several pulses per revolution)
+    are bridged by inserting the missing pulses evenly. An interval shorter than half the
+    median (an extra pulse: electrical glitch, double trigger) raises.
+
+    Returns
+    -------
+    ndarray
+        The pulse times, with bridged dropouts filled in.
     """
     pulses = np.asarray(pulses, dtype=np.float64).ravel()
     if pulses.size < 2 * pulses_per_rev + 1:
@@ -58,13 +67,30 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
     if np.any(gaps <= 0):
         raise GearshotError(f"{label}: tacho pulse times are not increasing")
     med = float(np.median(gaps))
+    short = np.flatnonzero(gaps < 0.5 * med)
+    if short.size:
+        i = int(short[0])
+        raise GearshotError(
+            f"{label}: extra tacho pulse at t={pulses[i + 1]:.4g} s ({gaps[i] / med:.2f} "
+            f"median intervals after the previous one); {short.size} such glitch(es)")
     long = np.flatnonzero(gaps > DROPOUT_FACTOR * med)
     if long.size:
-        i = int(long[0])
-        raise GearshotError(
-            f"{label}: tacho dropout of {gaps[i]:.4g} s ({gaps[i] / med:.2f} pulse intervals) "
-            f"after the pulse at t={pulses[i]:.4g} s; {long.size} gap(s) exceed "
-            f"{DROPOUT_FACTOR} x the median interval {med:.4g} s")
+        spans = np.rint(gaps[long] / med).astype(np.int64)  # intervals the gap covers
+        bad = np.flatnonzero(spans > pulses_per_rev)
+        if bad.size:
+            i = int(long[bad[0]])
+            raise GearshotError(
+                f"{label}: tacho dropout of {gaps[i]:.4g} s ({gaps[i] / med:.2f} pulse "
+                f"intervals, more than one revolution at tacho_pulses_per_rev="
+                f"{pulses_per_rev}) after the pulse at t={pulses[i]:.4g} s; {bad.size} such "
+                f"gap(s)")
+        pieces = [pulses[: long[0] + 1]]
+        for j, (i, k) in enumerate(zip(long, spans)):
+            a, b = pulses[i], pulses[i + 1]
+            pieces.append(a + (b - a) * np.arange(1, k) / k)
+            stop = long[j + 1] + 1 if j + 1 < long.size else pulses.size
+            pieces.append(pulses[i + 1: stop])
+        pulses = np.concatenate(pieces)
     return pulses
 
 

@@ -84,8 +84,10 @@ def as_tf_list(bank: Any) -> list[PathTF]:
             from ..transfer import TransferFunctionBank
         except ImportError as exc:  # pragma: no cover - depends on the transfer module
             raise GearshotError(f"reading a TF folder needs gearshot.transfer: {exc}") from None
-        bank = [PathTF(np.asarray(tf.freqs), np.asarray(tf.values), name=name)
-                for name, tf in TransferFunctionBank.from_folder(folder).items()]
+        bank = TransferFunctionBank.from_folder(folder)
+    if hasattr(bank, "items") and hasattr(bank, "names"):  # a TransferFunctionBank
+        return [PathTF(np.asarray(tf.freqs), np.asarray(tf.values), name=str(name))
+                for name, tf in bank.items()]
     if isinstance(bank, PathTF):
         return [bank]
     if not isinstance(bank, Sequence) and hasattr(bank, "__iter__"):

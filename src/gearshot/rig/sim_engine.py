@@ -11,9 +11,11 @@ How the hidden reality reaches the simulator:
   every run (the rig always runs the same wheels);
 * the fault: the reality's centre and depth coefficient; its edge offsets widen/narrow and
   shift the cut, so the physical fault differs from the nominal label ``y``.
-  ``simulate`` models the cut as a circular arc of uniform depth; the reality's
-  ``fault_roughness`` (depth varying along the profile) is therefore not applied by this
-  engine (it is by :class:`~gearshot.rig.surrogate.SurrogateEngine`).
+  ``simulate`` builds its own :class:`~gearshot.sim.FullToothFaceFault` (a circular arc)
+  from size/centre/depth and takes no fault object, so the reality's ``fault_roughness``
+  (depth varying along the profile) is not applied by this engine yet (it is by
+  :class:`~gearshot.rig.surrogate.SurrogateEngine`). :class:`IrregularFaceFault` is the
+  fault object to pass once ``simulate`` accepts one.
 """
 
 from __future__ import annotations
@@ -22,10 +24,57 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._errors import GearshotError
 from .._validation import check_int
+from ..sim.faults import FullToothFaceFault
 from .reality import RigReality
 
-__all__ = ["SimulatorEngine", "perturbed_pair", "physical_fault"]
+__all__ = ["SimulatorEngine", "IrregularFaceFault", "perturbed_pair", "physical_fault"]
+
+
+@dataclass(frozen=True)
+class IrregularFaceFault(FullToothFaceFault):
+    """A full tooth face fault whose depth varies along the profile: the arc-shaped cut of
+    :class:`~gearshot.sim.FullToothFaceFault` scaled by
+    ``1 + sum_k roughness[k] cos((k + 1) pi x)``, x = 0 ... 1 across the cut, in both the
+    section loss (stiffness) and the displacement excitation.
+
+    Parameters
+    ----------
+    roughness : tuple of float
+        Relative amplitudes; their absolute sum must stay below 1 (the cut stays a cut).
+    """
+
+    roughness: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        rough = tuple(float(r) for r in self.roughness)
+        if not all(np.isfinite(rough)) or sum(abs(r) for r in rough) >= 1.0:
+            raise GearshotError(f"roughness must be finite with absolute sum < 1; got "
+                                f"{self.roughness!r}")
+        object.__setattr__(self, "roughness", rough)
+
+    def depth_profile(self, s: np.ndarray) -> np.ndarray:
+        """Depth factor at roll fractions ``s`` (1 outside the cut)."""
+        s = np.asarray(s, dtype=float)
+        s0, s1 = self.window
+        if s1 <= s0:
+            return np.ones_like(s)
+        x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
+        return 1.0 + sum(r * np.cos((k + 1) * np.pi * x) for k, r in enumerate(self.roughness))
+
+    def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
+        base = super().section_loss(pair, x)
+        if self.is_healthy:
+            return base
+        (xa, _), (xb, _) = self._edges(pair)
+        s0, s1 = self.window
+        s = s0 + (np.asarray(x, dtype=float) - xa) / (xb - xa) * (s1 - s0)  # ~linear map
+        return base * self.depth_profile(s)
+
+    def displacement(self, pair, s: np.ndarray) -> np.ndarray:
+        return super().displacement(pair, s) * self.depth_profile(s)
 
 
 def perturbed_pair(pair, reality: RigReality | None):

@@ -46,7 +46,8 @@ def tacho_signal(shaft_revs: np.ndarray, *, pulses_per_rev: int = 1, duty: float
     amplitude = check_positive(amplitude, "amplitude")
     jitter = check_positive(jitter, "jitter", allow_zero=True)
     if not duty + 2 * edge * ppr < 1.0:
-        raise GearshotError(f"duty + 2*edge*pulses_per_rev must be < 1; got duty={duty}, edge={edge}")
+        raise GearshotError(f"duty + 2*edge*pulses_per_rev must be < 1; got duty={duty}, "
+                            f"edge={edge}")
     a = revs * ppr
     k = np.floor(a).astype(np.int64)
     if jitter > 0:

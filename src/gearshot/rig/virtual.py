@@ -27,10 +27,11 @@ whole run); :class:`~gearshot.rig.surrogate.SurrogateEngine` is a fast stand-in.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import shutil
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +80,11 @@ class VirtualRig:
         Tooth counts (38, 17: the paper's pair); the tacho is on the pinion shaft.
     settle : float
         Seconds simulated before each recording and dropped.
+    grade : int, optional
+        Force the rig's true DIN grade (default: drawn, hidden).
+    reality_overrides : mapping, optional
+        Fields of the hidden :class:`RigReality` to set instead of drawing them (see
+        :meth:`with_reality`).
 
     Notes
     -----
@@ -87,7 +93,8 @@ class VirtualRig:
 
     def __init__(self, seed: int = 0, *, engine: str | Callable[..., np.ndarray] | None = None,
                  tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = 38,
-                 pinion_teeth: int = 17, settle: float = 0.25):
+                 pinion_teeth: int = 17, settle: float = 0.25, grade: int | None = None,
+                 reality_overrides: Mapping[str, Any] | None = None):
         self.seed = seed
         self.engine = engine
         self.tf_bank = tf_bank
@@ -95,7 +102,24 @@ class VirtualRig:
         self.gear_teeth = gear_teeth
         self.pinion_teeth = pinion_teeth
         self.settle = settle
+        self.grade = grade
+        self.reality_overrides = reality_overrides
         self._built: tuple[RigReality, np.ndarray, str] | None = None
+
+    def _params(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in ("seed", "engine", "tf_bank", "fs", "gear_teeth",
+                                              "pinion_teeth", "settle", "grade",
+                                              "reality_overrides")}
+
+    def with_reality(self, **changes: Any) -> VirtualRig:
+        """A copy of this rig whose hidden reality has some fields set (e.g.
+        ``attenuation_db=20``, ``grade=9``, ``snr_db=25``); everything else is unchanged.
+        For controlled experiments; see :class:`RigReality` for the fields."""
+        params = self._params()
+        params["reality_overrides"] = {**(self.reality_overrides or {}), **changes}
+        rig = VirtualRig(**params)
+        rig._build()  # validate now
+        return rig
 
     # ------------------------------------------------------------------ hidden state
     def _build(self) -> tuple[RigReality, np.ndarray, str]:
@@ -111,6 +135,10 @@ class VirtualRig:
                 tfs = as_tf_list(self.tf_bank)
             reality = draw_reality(np.random.default_rng([seed, 1]), n_tfs=len(tfs),
                                    gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
+            overrides = dict(self.reality_overrides or {})
+            if self.grade is not None:
+                overrides["grade"] = self.grade
+            reality = _override(reality, overrides, n_tfs=len(tfs))
             tf = tfs[reality.tf_index]
             fir = path_fir(tf, fs, attenuation_db=reality.attenuation_db,
                            n_taps=min(2 * (tf.freqs.size - 1), 16384))
@@ -120,6 +148,11 @@ class VirtualRig:
     def reveal(self) -> RigReality:
         """The hidden reality -- for validating the rig only; an estimator must not use it."""
         return self._build()[0]
+
+    def reveal_path(self) -> tuple[str, np.ndarray]:
+        """Name of the hidden transfer-path TF and its FIR (per sample) -- validation only."""
+        _, fir, name = self._build()
+        return name, fir.copy()
 
     def _engine(self) -> Callable[..., np.ndarray]:
         if self.engine is None or self.engine == "sim":
@@ -154,9 +187,9 @@ class VirtualRig:
         Recording
             Acceleration in g, the input-shaft tacho, metadata (no hidden parameters).
         """
-        reality, fir, tf_name = self._build()
+        reality, fir, _ = self._build()
         speed = check_positive(speed, "speed")
-        load = check_positive(load, "load", allow_zero=True)
+        load = check_positive(load, "load")
         fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
         duration = check_positive(duration, "duration")
         repetition = check_int(repetition, "repetition", minimum=0)
@@ -195,7 +228,7 @@ class VirtualRig:
             acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
             source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
             extras={"repetition": repetition, "rig_seed": int(self.seed),
-                    "engine": type(self._engine()).__name__, "transfer_path": tf_name})
+                    "engine": type(self._engine()).__name__})
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod
@@ -226,7 +259,7 @@ class VirtualRig:
         """
         folder = Path(folder)
         speed = check_positive(speed, "speed")
-        load = check_positive(load, "load", allow_zero=True)
+        load = check_positive(load, "load")
         healthy = check_int(healthy, "healthy", minimum=0)
         repetitions = check_int(repetitions, "repetitions", minimum=0)
         sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
@@ -270,6 +303,42 @@ class VirtualRig:
         out = new.copy()
         out["path"] = [str((folder / p).resolve()) for p in out["path"]]
         return out
+
+
+_RANGES = {  # field -> (low, high) accepted by with_reality / reality_overrides
+    "snr_db": (0.0, 200.0), "attenuation_db": (-60.0, 200.0), "speed_drift": (0.0, 0.05),
+    "speed_ripple": (0.0, 0.05), "load_ripple": (0.0, 0.5), "motor_level": (0.0, 10.0),
+    "extra_level": (0.0, 10.0), "impact_level": (0.0, 10.0), "tacho_jitter": (0.0, 0.01),
+    "fault_center": (0.0, 1.0), "fault_depth": (0.01, 1.0), "damping_factor": (0.1, 10.0),
+    "bearing_stiffness_factor": (0.1, 10.0), "shaft_stiffness_factor": (0.1, 10.0),
+    "mesh_stiffness_factor": (0.1, 10.0), "motor_slip": (0.0, 0.5),
+    "impact_frequency": (1.0, 1e6), "extra_order": (0.01, 1000.0),
+    "impact_order": (0.01, 1000.0),
+}
+
+
+def _override(reality: RigReality, changes: Mapping[str, Any], *, n_tfs: int) -> RigReality:
+    """``reality`` with validated field changes."""
+    fields = set(reality.as_dict())
+    out: dict[str, Any] = {}
+    for key, value in changes.items():
+        if key not in fields:
+            raise GearshotError(f"reality has no field {key!r}; fields: {sorted(fields)}")
+        if key == "grade":
+            out[key] = check_int(value, "grade", minimum=1, maximum=12)
+        elif key == "tf_index":
+            out[key] = check_int(value, "tf_index", minimum=0, maximum=n_tfs - 1)
+        elif key in ("profile_seed", "motor_pole_pairs"):
+            out[key] = check_int(value, key, minimum=0 if key == "profile_seed" else 1)
+        elif key in _RANGES:
+            out[key] = check_in_range(value, key, *_RANGES[key])
+        else:  # tuples: mass/inertia factors, fault edges/roughness
+            arr = tuple(float(v) for v in value)
+            if len(arr) != len(getattr(reality, key)):
+                raise GearshotError(f"{key} must hold {len(getattr(reality, key))} numbers; "
+                                    f"got {value!r}")
+            out[key] = arr
+    return dataclasses.replace(reality, **out)
 
 
 def read_campaign(folder: str | os.PathLike) -> pd.DataFrame:
