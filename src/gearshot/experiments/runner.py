@@ -19,13 +19,14 @@ __all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summa
 
 
 def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
-                      random_state=0, keep_estimators=False, **params):
+                      random_state=0, keep_estimators=False, coverage=0.9, **params):
     """Fit every variant on one dataset and score it on its test set.
 
     Returns
     -------
     list of dict
         One row per variant: ``variant``, ``mae``, ``grade``, ``selected``, ``n_neighbors``,
+        ``coverage`` (share of test sizes inside the ``coverage`` prediction interval),
         ``seconds``, plus ``prediction`` (array) and, with ``keep_estimators``, ``estimator``.
     """
     from ..estimator import OneFaultShotEstimator
@@ -37,10 +38,13 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
                                     **{**params, **variant_params(name)})
         est.fit(*fit_args, selection_tf=selection_tf)
         pred = est.predict(test_sa)
+        seconds = time.perf_counter() - t0
+        low, high = est.predict_interval(test_sa, coverage=coverage)
+        inside = (test_size >= low - 1e-12) & (test_size <= high + 1e-12)
         row = dict(variant=name, mae=float(np.mean(np.abs(pred - test_size))),
                    grade=est.grade_, selected=",".join(est.selected_features_),
-                   n_neighbors=est.n_neighbors_, seconds=time.perf_counter() - t0,
-                   prediction=pred)
+                   n_neighbors=est.n_neighbors_, coverage=float(np.mean(inside)),
+                   seconds=seconds, prediction=pred)
         if keep_estimators:
             row["estimator"] = est
         rows.append(row)

@@ -19,6 +19,8 @@ VARIANTS = MappingProxyType({
     "no_tuning": dict(tune_simulation=False),
     # the full algorithm
     "full": dict(),
+    # no faulty example at all: grade from healthy statistics (the paper's future work)
+    "zero_shot": dict(zero_shot=True),
 })
 
 SIMULATED_VARIANTS = ("before_da", "rms_only", "full")
