@@ -150,7 +150,7 @@ class FullToothFaceFault(ToothFault):
         z = pair.z_gear
         rb = pair.base_radius(z)
         # healthy flank half-thickness at x (invert x(r) on a fine table)
-        r_tab = np.linspace(rb, pair.tip_radius(z), 2001)
+        r_tab = np.linspace(rb, pair.tip_radius(z), 601)
         psi = involute_half_angle(z, pair.pressure_angle, r_tab, rb)
         x_tab, h_tab = r_tab * np.cos(psi), r_tab * np.sin(psi)
         inside = (x > xa) & (x < xb)
@@ -180,15 +180,17 @@ class FullToothFaceFault(ToothFault):
         out[(s > mid) & (s < s1)] = s1
         return out
 
-    def _flank_points(self, pair: GearPair, margin: float = 0.25, n: int = 160):
+    def _flank_points(self, pair: GearPair, margin: float = 0.04, n: int = 80):
         """Polar (radius, angle from the tooth centre line) of the cut flank near the cut:
-        the arc, plus the involute up to ``margin`` of the active profile beyond it."""
+        ``n`` points on the arc, plus a few on the involute up to ``margin`` of the active
+        profile beyond its edges (on conjugate flanks the gap grows away from the nominal
+        contact, so the edges bound the healthy part)."""
         z = pair.z_gear
         rb = pair.base_radius(z)
         _, (l_lo, l_hi) = pair.roll_limits
         s0, s1 = self.window
-        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, n // 2),
-                    np.linspace(s1, min(s1 + margin, 1.0), n // 2)]
+        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, 5),
+                    np.linspace(s1, min(s1 + margin, 1.0), 5)]
         ls = l_lo + np.concatenate(pieces_s) * (l_hi - l_lo)
         r = np.hypot(rb, np.maximum(ls, 0.0))
         psi = involute_half_angle(z, pair.pressure_angle, r, rb)
@@ -252,8 +254,8 @@ class FullToothFaceFault(ToothFault):
         s0, s1 = self.window
         inside = (s > s0) & (s < s1)
         if inside.any():
-            # the retreat is smooth but for one kink: sample it on 193 points, interpolate
-            knots = np.linspace(s0, s1, 193)
+            # the retreat is smooth but for one kink: sample it on 129 points, interpolate
+            knots = np.linspace(s0, s1, 129)
             ret = self._retreat(pair, 1.0 - knots)
             out[inside] = -self.transmission * np.interp(s[inside], knots, ret)
         return out

@@ -117,7 +117,7 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 
 _N_TABLE = 1025
-_N_SEGMENT = 48  # exact evaluations per smooth segment of a faulty tooth's compliance
+_N_SEGMENT = 24  # exact evaluations per smooth segment of a faulty tooth's compliance
 
 
 @functools.lru_cache(maxsize=32)
