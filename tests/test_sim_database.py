@@ -78,3 +78,43 @@ def test_unwritable_store(tmp_path):
         assert not (locked / "db").exists()
     finally:
         locked.chmod(0o700)
+
+
+def test_store_below_a_file_is_refused(tmp_path):
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("x")
+    with pytest.raises(GearshotError, match="store"):
+        build_database(blocker / "db", client=False, progress=False, **KW)
+    assert blocker.read_text() == "x"
+    with pytest.raises(GearshotError, match="store"):
+        build_database(blocker, client=False, progress=False, **KW)
+
+
+def test_other_build_in_store_is_refused(tmp_path):
+    small = dict(KW, speeds=[15], grades=[7])
+    build_database(tmp_path / "db", client=False, progress=False, **small)
+    with pytest.raises(GearshotError, match="seed"):
+        build_database(tmp_path / "db", client=False, progress=False, **dict(small, seed=5))
+
+
+def test_missing_condition_and_store(tmp_path):
+    build_database(tmp_path / "db", client=False, progress=False,
+                   **dict(KW, speeds=[15], grades=[7]))
+    with pytest.raises(GearshotError, match="speed"):
+        load_database(tmp_path / "db", speed=25, load=10)
+    with pytest.raises(GearshotError, match="grade"):
+        load_database(tmp_path / "db", speed=15, load=10, grade=3)
+    with pytest.raises(GearshotError, match="manifest"):
+        load_database(tmp_path / "nothing", speed=15, load=10)
+
+
+def test_dask_client_gives_same_content(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    small = dict(KW, speeds=[15], grades=[5, 7])
+    build_database(tmp_path / "a", client=False, progress=False, **small)
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=None) as client:
+        build_database(tmp_path / "b", client=client, progress=False, **small)
+    a = load_database(tmp_path / "a", speed=15, load=10)
+    b = load_database(tmp_path / "b", speed=15, load=10)
+    np.testing.assert_array_equal(a.sa.values, b.sa.values)
