@@ -130,3 +130,8 @@ def test_faulty_table_matches_direct_evaluation():
         exact = pair_stiffness(pair, u, fault=fault)
         rel = np.abs(fast - exact) / exact
         assert np.sum(rel > 5e-3) <= 1          # only the one grid point on the jump
+
+
+def test_interference_is_refused():
+    with pytest.raises(GearshotError, match="interference"):
+        GearPair(z_pinion=12, z_gear=60)
