@@ -27,12 +27,16 @@ def test_contract(tmp_path):
     assert one.sa.shape == (5, 2048) and np.all(one.grade.values == 7)
 
 
+KILL_KW = dict(speeds=[15, 20, 25], loads=[10], grades=[5, 7, 9], n_healthy=2, n_faulty=12,
+               seed=4)
+
+
 def test_kill9_resume_identical(tmp_path):
     ref = tmp_path / "ref"
-    build_database(ref, client=False, progress=False, **KW)
+    build_database(ref, client=False, progress=False, **KILL_KW)
     store = tmp_path / "killed"
     code = (f"from gearshot.sim import build_database; "
-            f"build_database({str(store)!r}, client=False, progress=False, **{KW!r})")
+            f"build_database({str(store)!r}, client=False, progress=False, **{KILL_KW!r})")
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
     proc = subprocess.Popen([sys.executable, "-c", code], env=env)
     deadline = time.time() + 120
@@ -43,12 +47,13 @@ def test_kill9_resume_identical(tmp_path):
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
-    assert len(list((store / "blocks").glob("*.zarr"))) < 6
-    build_database(store, client=False, progress=False, **KW)
-    for speed in (15, 20):
+    assert len(list((store / "blocks").glob("*.zarr"))) < 9, "build finished before the kill"
+    build_database(store, client=False, progress=False, **KILL_KW)
+    assert len(list((store / "blocks").glob("*.zarr"))) == 9
+    for speed in (15, 20, 25):
         a = load_database(ref, speed=speed, load=10)
         b = load_database(store, speed=speed, load=10)
-        assert a.sa.shape == b.sa.shape == (15, 2048)
+        assert a.sa.shape == b.sa.shape == (42, 2048)
         np.testing.assert_array_equal(a.sa.values, b.sa.values)
         np.testing.assert_array_equal(a.seed.values, b.seed.values)
     assert not list((store / "blocks").glob(".*tmp"))
