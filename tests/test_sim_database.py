@@ -118,7 +118,7 @@ def test_dask_client_gives_same_content(tmp_path):
     small = dict(KW, speeds=[15], grades=[5, 7])
     build_database(tmp_path / "a", client=False, progress=False, **small)
     with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
-                            dashboard_address=None) as client:
+                            dashboard_address=":0") as client:
         build_database(tmp_path / "b", client=client, progress=False, **small)
     a = load_database(tmp_path / "a", speed=15, load=10)
     b = load_database(tmp_path / "b", speed=15, load=10)

@@ -176,7 +176,7 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     if client is None and len(todo) > _SMALL_BUILD:
         from dask.distributed import Client, LocalCluster
         own_cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
-                                   processes=True)
+                                   processes=True, dashboard_address=":0")
         client = Client(own_cluster)
     try:
         _run_tasks(store, pair, todo, len(tasks), n_healthy, n_faulty, seed, n_points,

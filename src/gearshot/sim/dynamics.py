@@ -151,19 +151,19 @@ def _tooth_error(slope, wav, phase, noise, nwaves, t, s):
 def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                    g_slope, g_wav, g_phase, g_noise, g_nw,
                    p_slope, p_wav, p_phase, p_noise, p_nw,
-                   eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, x0, coef,
+                   eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, X, V, A, coef,
                    rec_start, out):
     n_batch = out.shape[0]
     n_steps = mesh_pos.shape[0]
     n_rec = out.shape[1]
-    ndof = x0.shape[0]
+    ndof = X.shape[1]
     a0, a2, a3, a6, a7 = coef[0], coef[1], coef[2], coef[3], coef[4]
     n_pairs = int(math.ceil(eps)) + 1
     z_pin = p_slope.shape[1]
     for b in nb.prange(n_batch):
-        x = x0.copy()
-        vel = np.zeros(ndof)
-        acc = np.zeros(ndof)
+        x = X[b].copy()
+        vel = V[b].copy()
+        acc = A[b].copy()
         xb = np.zeros(ndof)
         for n in range(n_steps):
             tm = mesh_pos[n]
@@ -210,6 +210,9 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
             r = n - rec_start
             if r >= 0 and r < n_rec:
                 out[b, r] = (acc[1] + acc[4]) / 9.80665
+        X[b] = x
+        V[b] = vel
+        A[b] = acc
 
 
 # ----------------------------------------------------------------------------- inputs
@@ -295,17 +298,37 @@ def _stack_errors(errs: list[ToothProfileErrors]):
             float(errs[0].n_waves))
 
 
+class _Batch:
+    """Prepared per-signal tables and the integration state of a batch of signals."""
+
+    def __init__(self, pair, integ, faults, gear_errs, pin_errs):
+        self.pair, self.integ = pair, integ
+        self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
+        self.g = _stack_errors(gear_errs)
+        self.p = _stack_errors(pin_errs)
+        n = len(faults)
+        self.X = np.tile(integ.x_static, (n, 1))
+        self.V = np.zeros((n, integ.x_static.size))
+        self.A = np.zeros((n, integ.x_static.size))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+        """Advance over the given steps; return the vertical acceleration (g) of steps
+        ``rec_start ... rec_start + n_rec - 1``."""
+        pair, integ = self.pair, self.integ
+        out = np.empty((self.X.shape[0], n_rec))
+        _newmark_batch(np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
+                       np.ascontiguousarray(load), _pair_table(pair, None), self.kf,
+                       self.ef, self.tooth, *self.g, *self.p, pair.contact_ratio,
+                       pair.z_gear, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
+                       integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
+                       rec_start, out)
+        return out
+
+
 def _run(pair, integ, mesh_pos, motor_acc, load, faults, gear_errs, pin_errs, rec_start,
          n_rec):
-    kf, ef, tooth = _fault_arrays(pair, faults)
-    g = _stack_errors(gear_errs)
-    p = _stack_errors(pin_errs)
-    out = np.empty((len(faults), n_rec))
-    _newmark_batch(mesh_pos, motor_acc, load, _pair_table(pair, None), kf, ef, tooth,
-                   *g, *p, pair.contact_ratio, pair.z_gear, integ.B1, integ.B2, integ.B3,
-                   integ.w, integ.s, integ.v, integ.c_load, integ.c_motor, integ.x_static,
-                   integ.coef, rec_start, out)
-    return out
+    return _Batch(pair, integ, faults, gear_errs, pin_errs).run(mesh_pos, motor_acc, load,
+                                                              rec_start, n_rec)
 
 
 def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
@@ -469,7 +492,7 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
     -------
     SimulationResult
     """
-    from scipy.signal import resample_poly
+    from scipy.signal import firwin, oaconvolve
 
     fs = check_positive(fs, "fs")
     grade = _check_grade(grade)
@@ -481,49 +504,93 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
                             f"duration={duration!r}, n_revs={n_revs!r}")
     up = max(1, int(math.ceil(min_fs / fs)))
     dt = 1.0 / (fs * up)
-    probe = np.array([0.0])
-    speed0 = float(_profile(speed, "speed", probe)[0])
+    speed_fn = _profile_fn(speed, "speed", fs)
+    load_fn = _profile_fn(load, "load", fs)
     if duration is None:
         n_revs = check_positive(n_revs, "n_revs")
         if callable(speed) or np.ndim(speed):
             raise GearshotError("n_revs needs a constant speed; give duration instead")
-        duration = n_revs / speed0
+        duration = n_revs / float(speed)
     duration = check_positive(duration, "duration")
     n_out = int(round(duration * fs))
     if n_out < 2:
         raise GearshotError(f"duration must span >= 2 samples at fs; got {duration!r} s")
+    if not callable(speed) and np.ndim(speed) and np.size(speed) < n_out:
+        raise GearshotError(f"speed holds {np.size(speed)} samples; the duration needs "
+                            f"{n_out} at fs")
+    if not callable(load) and np.ndim(load) and np.size(load) < n_out:
+        raise GearshotError(f"load holds {np.size(load)} samples; the duration needs "
+                            f"{n_out} at fs")
     n_fine = n_out * up
-    t_fine = np.arange(n_fine) * dt
-    if np.ndim(speed) and not callable(speed):
-        sp_src = _profile(speed, "speed", probe)
-        t_src = np.arange(sp_src.size) / fs
-        sp = np.interp(t_fine, t_src, sp_src)
-    else:
-        sp = _profile(speed, "speed", t_fine)
-    if np.ndim(load) and not callable(load):
-        ld_src = _profile(load, "load", probe)
-        ld = np.interp(t_fine, np.arange(ld_src.size) / fs, ld_src)
-    else:
-        ld = _profile(load, "load", t_fine)
-    integ = _integrator(pair, dt, float(ld[0]))
-    n_warm = int(math.ceil(_warmup_time(pair, integ) / dt))
-    # warm-up at the initial speed and load (tau < 0), then the requested profile
-    tau_warm = (np.arange(n_warm - 1) - (n_warm - 1)) * dt
-    theta_fine = 2 * np.pi * np.concatenate(
-        [[0.0], np.cumsum(0.5 * (sp[1:] + sp[:-1]) * dt)])
-    theta = np.concatenate([2 * np.pi * sp[0] * tau_warm, theta_fine])
-    omega = 2 * np.pi * np.concatenate([np.full(n_warm - 1, sp[0]), sp])
-    motor_acc = np.gradient(omega, dt)
-    loads = np.concatenate([np.full(n_warm - 1, ld[0]), ld])
-    mesh_pos = theta * pair.z_pinion / (2 * np.pi)
+    sp0 = float(speed_fn(np.zeros(1))[0])
+    ld0 = float(load_fn(np.zeros(1))[0])
+    integ = _integrator(pair, dt, ld0)
+    # anti-aliasing FIR (Kaiser, like scipy's resample_poly), centred: half length D
+    half = 10 * up if up > 1 else 0
+    h = firwin(2 * half + 1, 1.0 / up, window=("kaiser", 5.0)) if up > 1 else np.ones(1)
+    n_warm = max(int(math.ceil(_warmup_time(pair, integ) / dt)), half + 1)
     faults = _fault_list(pair, sizes, fault_center, fault_depth)
     ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=False)
     acc = np.empty((sizes.size, n_out))
+    z1 = pair.z_pinion
+    chunk = 1 << 16
     for start in range(0, sizes.size, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        fine = _run(pair, integ, mesh_pos, motor_acc, loads,
-                    faults[sl], ge[sl], pe[sl], n_warm - 1, n_fine)
-        acc[sl] = resample_poly(fine, 1, up, axis=-1) if up > 1 else fine
-    angle = theta_fine[::up]
+        batch = _Batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        # warm-up at the initial speed and load, t = -(n_warm - 1) dt ... 0; keep the
+        # samples from t = -half dt to 0 (the filter's history and the first sample)
+        tau = (np.arange(n_warm) - (n_warm - 1)) * dt
+        zero = np.zeros(n_warm)
+        tail = batch.run(sp0 * z1 * tau, zero, np.full(n_warm, ld0), n_warm - 1 - half,
+                         half + 1)
+        theta = 0.0
+        k_next = 0
+        g0 = -half              # fine time index of tail[:, 0]
+        n_total = n_fine + half
+        for c0 in range(1, n_total, chunk):
+            c1 = min(c0 + chunk, n_total)
+            t = np.arange(c0 - 1, c1 + 1) * dt          # one step of margin each side
+            sp = speed_fn(t)
+            omega = 2 * np.pi * sp
+            inc = np.pi * (sp[1:-1] + sp[:-2]) * dt      # trapezoid, steps c0 ... c1-1
+            th = theta + np.cumsum(inc)
+            theta = th[-1]
+            motor_acc = (omega[2:] - omega[:-2]) / (2 * dt)
+            fine = batch.run(th * z1 / (2 * np.pi), motor_acc, load_fn(t[1:-1]), 0,
+                             c1 - c0)
+            zz = np.concatenate([tail, fine], axis=1)
+            if up == 1:
+                idx = np.arange(zz.shape[1]) + g0
+                keep = (idx >= 0) & (idx < n_out)
+                acc[sl, idx[keep]] = zz[:, keep]
+                tail = zz[:, :0]
+                g0 += zz.shape[1]
+                continue
+            conv = oaconvolve(zz, h[None, :], mode="valid", axes=-1)
+            centre = g0 + half + np.arange(conv.shape[1])  # fine index of each output
+            pick = (centre % up == 0) & (centre // up >= k_next) & (centre // up < n_out)
+            ks = centre[pick] // up
+            acc[sl, ks] = conv[:, pick]
+            if ks.size:
+                k_next = int(ks[-1]) + 1
+            tail = zz[:, -(2 * half):]
+            g0 += zz.shape[1] - 2 * half
+    angle = 2 * np.pi * _cumtrapz0(speed_fn(np.arange(n_out) / fs), 1.0 / fs)
     return SimulationResult(acceleration=acc, pinion_angle=angle,
                             time=np.arange(n_out) / fs, fs=fs)
+
+
+def _cumtrapz0(y, dx):
+    return np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * dx)])
+
+
+def _profile_fn(value, name, fs):
+    """A vectorised f(t) for a constant, a callable or samples at ``fs``."""
+    if callable(value):
+        return lambda t: _profile(value, name, t)
+    if np.ndim(value) == 0:
+        v = check_positive(value, name)
+        return lambda t: np.full(np.shape(t), v)
+    src = _profile(value, name, np.zeros(1))
+    t_src = np.arange(src.size) / fs
+    return lambda t: np.interp(t, t_src, src)
