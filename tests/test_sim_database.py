@@ -123,3 +123,15 @@ def test_dask_client_gives_same_content(tmp_path):
     a = load_database(tmp_path / "a", speed=15, load=10)
     b = load_database(tmp_path / "b", speed=15, load=10)
     np.testing.assert_array_equal(a.sa.values, b.sa.values)
+
+
+def test_signal_reproducible_from_its_seed(tmp_path):
+    from gearshot.sim import GearPair, simulate_sa
+
+    build_database(tmp_path / "db", client=False, progress=False,
+                   **dict(KW, speeds=[15], grades=[7]))
+    ds = load_database(tmp_path / "db", speed=15, load=10, grade=7)
+    i = 3
+    sa = simulate_sa(GearPair.paper(), speed=15, load=10, grade=7,
+                     fault_sizes=[float(ds.fault_size[i])], rng=[int(ds.seed[i])])
+    np.testing.assert_allclose(sa[0], ds.sa.values[i], rtol=0, atol=1e-9)

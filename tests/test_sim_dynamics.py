@@ -150,3 +150,33 @@ def test_simulate_bad_profiles():
                  fs=25_600, duration=1.0)
     with pytest.raises(GearshotError, match="duration"):
         simulate(PAIR, speed=15, load=5, grade=7, fault_sizes=[0.0], fs=25_600)
+
+
+def test_custom_fault_type_plugs_in():
+    """A new fault type only implements the ToothFault hooks."""
+    from dataclasses import dataclass
+
+    from gearshot.sim import ToothFault
+
+    @dataclass(frozen=True)
+    class Dent(ToothFault):
+        depth_m: float = 5e-6
+
+        @property
+        def is_healthy(self):
+            return False
+
+        def displacement(self, pair, s):
+            s = np.asarray(s, dtype=float)
+            return np.where((s > 0.4) & (s < 0.6), -self.depth_m, 0.0)
+
+    kw = dict(speed=15, load=10, grade=5, same_gear=True, rng=1)
+    sa = simulate_sa(PAIR, faults=[None, Dent(), Dent(depth_m=20e-6)], **kw)
+    r = _rms(_diff(sa))
+    assert r[0] < r[1] < r[2]
+    with pytest.raises(GearshotError, match="faults"):
+        simulate_sa(PAIR, faults=[0.3], **kw)
+    with pytest.raises(GearshotError, match="not both"):
+        simulate_sa(PAIR, faults=[Dent()], fault_sizes=[0.2], **kw)
+    with pytest.raises(GearshotError, match="fault_sizes"):
+        simulate_sa(PAIR, fault_sizes=["a"], **kw)

@@ -221,8 +221,11 @@ def _check_grade(grade):
 
 
 def _check_sizes(fault_sizes):
-    arr = np.atleast_1d(np.asarray(fault_sizes, dtype=float)) if not isinstance(
-        fault_sizes, str) else None
+    try:
+        arr = (None if isinstance(fault_sizes, str)
+               else np.atleast_1d(np.asarray(fault_sizes, dtype=float)))
+    except (TypeError, ValueError):
+        arr = None
     if arr is None or arr.ndim != 1 or arr.size == 0:
         raise GearshotError(f"fault_sizes must be a non-empty 1-D sequence; got "
                             f"{describe(fault_sizes)}")
@@ -269,7 +272,22 @@ def _profile(value, name, times):
     return arr
 
 
-def _fault_list(pair, sizes, center, depth):
+def _resolve_faults(fault_sizes, faults, center, depth) -> list[ToothFault]:
+    """One fault object per signal, from FTFF sizes or from given fault objects."""
+    if faults is not None:
+        if fault_sizes is not None:
+            raise GearshotError("give fault_sizes or faults, not both")
+        faults = list(faults) if not isinstance(faults, ToothFault) else [faults]
+        if not faults:
+            raise GearshotError("faults must not be empty")
+        for i, f in enumerate(faults):
+            if f is not None and not isinstance(f, ToothFault):
+                raise GearshotError(f"faults[{i}] must be a ToothFault (e.g. Fault.ftff(0.3))"
+                                    f" or None; got {describe(f)}")
+        return [f if f is not None else ToothFault() for f in faults]
+    if fault_sizes is None:
+        raise GearshotError("give fault_sizes (FTFF sizes) or faults (fault objects)")
+    sizes = _check_sizes(fault_sizes)
     return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
 
 
@@ -359,9 +377,9 @@ def _warmup_time(pair: GearPair, integ: _Integrator) -> float:
 
 
 # ----------------------------------------------------------------------------- public API
-def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes,
+def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes=None,
                 n_points: int = 2048, same_gear: bool = False, rng=None,
-                fault_center: float = 0.5, fault_depth: float = 0.5,
+                fault_center: float = 0.5, fault_depth: float = 0.5, faults=None,
                 min_fs: float = DEFAULT_MIN_FS) -> np.ndarray:
     """Synchronous averages over one revolution of the driven gear, steady state.
 
@@ -393,22 +411,25 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
         is then reproducible alone from its seed).
     fault_center, fault_depth : float
         FTFF placement and depth coefficient.
+    faults : sequence of ToothFault, optional
+        Instead of ``fault_sizes``: one fault object per signal (any fault type; None =
+        healthy).
     min_fs : float
         Lowest internal integration rate, Hz.
 
     Returns
     -------
-    ndarray (len(fault_sizes), n_points)
+    ndarray (n_signals, n_points)
         Vertical acceleration SAs, g.
     """
     speed = check_positive(speed, "speed")
     load = check_positive(load, "load")
     grade = _check_grade(grade)
-    sizes = _check_sizes(fault_sizes)
+    faults = _resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    n_sig = len(faults)
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = _as_rng(rng, sizes.size)
-    faults = _fault_list(pair, sizes, fault_center, fault_depth)
+    rng = _as_rng(rng, n_sig)
     t_rev = pair.z_gear / (pair.z_pinion * speed)
     n_rev = sp_fft.next_fast_len(max(2 * n_points, int(math.ceil(t_rev * min_fs))), real=True)
     dt = t_rev / n_rev
@@ -419,9 +440,9 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     mesh_pos = tau * speed * pair.z_pinion
     zeros = np.zeros(n_steps)
     loads = np.full(n_steps, load)
-    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=True)
-    out = np.empty((sizes.size, n_points))
-    for start in range(0, sizes.size, _BATCH_CHUNK):
+    ge, pe = _draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=True)
+    out = np.empty((n_sig, n_points))
+    for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
         acc = _run(pair, integ, mesh_pos, zeros, loads, faults[sl], ge[sl], pe[sl],
                    n_warm - 1, n_rev)
@@ -462,10 +483,10 @@ class SimulationResult:
     fs: float
 
 
-def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
+def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: float,
              duration: float | None = None, n_revs: float | None = None, rng=None,
              same_gear: bool = False, fault_center: float = 0.5, fault_depth: float = 0.5,
-             min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
+             faults=None, min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
     """Vertical-acceleration time signals, steady state from the first sample.
 
     Parameters
@@ -485,7 +506,7 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
         and is decimated with an anti-aliasing filter.
     duration, n_revs : float
         Signal length in seconds, or in input-shaft revolutions (one of the two).
-    rng, same_gear, fault_center, fault_depth, min_fs
+    rng, same_gear, fault_center, fault_depth, faults, min_fs
         As in :func:`simulate_sa`.
 
     Returns
@@ -496,9 +517,10 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
 
     fs = check_positive(fs, "fs")
     grade = _check_grade(grade)
-    sizes = _check_sizes(fault_sizes)
+    faults = _resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    n_sig = len(faults)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = _as_rng(rng)
+    rng = _as_rng(rng, n_sig)
     if (duration is None) == (n_revs is None):
         raise GearshotError("give exactly one of duration and n_revs; got "
                             f"duration={duration!r}, n_revs={n_revs!r}")
@@ -529,12 +551,11 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
     half = 10 * up if up > 1 else 0
     h = firwin(2 * half + 1, 1.0 / up, window=("kaiser", 5.0)) if up > 1 else np.ones(1)
     n_warm = max(int(math.ceil(_warmup_time(pair, integ) / dt)), half + 1)
-    faults = _fault_list(pair, sizes, fault_center, fault_depth)
-    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=False)
-    acc = np.empty((sizes.size, n_out))
+    ge, pe = _draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=False)
+    acc = np.empty((n_sig, n_out))
     z1 = pair.z_pinion
     chunk = 1 << 16
-    for start in range(0, sizes.size, _BATCH_CHUNK):
+    for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
         batch = _Batch(pair, integ, faults[sl], ge[sl], pe[sl])
         # warm-up at the initial speed and load, t = -(n_warm - 1) dt ... 0; keep the
