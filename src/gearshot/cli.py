@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import sys
+from pathlib import Path
+from typing import List, Optional
 
 import typer
 
@@ -16,6 +19,12 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+experiment_app = typer.Typer(help="Run the paper's experiments (Sec. 4.1 and 4.2).",
+                             no_args_is_help=True)
+app.add_typer(experiment_app, name="experiment")
+
+PAPER_SPEEDS = [float(s) for s in range(10, 36)]
+PAPER_LOADS = [5.0, 10.0, 15.0, 20.0]
 
 
 def _version_callback(value: bool) -> None:
@@ -32,23 +41,314 @@ def _root(
     """One-fault-shot gear tooth-fault size estimation."""
 
 
+def _client(scheduler: Optional[str], workers: int, *, needed: bool):
+    """A Dask client: the given scheduler, a LocalCluster when useful, or None."""
+    if scheduler:
+        from dask.distributed import Client
+
+        try:
+            return Client(scheduler, timeout="10s")
+        except Exception as exc:
+            raise GearshotError(f"cannot reach the Dask scheduler at --scheduler "
+                                f"{scheduler!r}: {exc}") from None
+    if needed and workers > 1:
+        from dask.distributed import Client, LocalCluster
+
+        return Client(LocalCluster(n_workers=workers, threads_per_worker=1,
+                                   dashboard_address=None))
+    return None
+
+
+def _write_json(path: Optional[Path], payload: dict) -> None:
+    if path is None:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(json.dumps(payload, indent=2, default=float))
+    tmp.replace(path)
+
+
 @app.command()
 def demo(
-    out: str = typer.Option("gearshot-demo", "--out", help="Folder for figures and report."),
+    out: Path = typer.Option(Path("gearshot-demo"), "--out", help="Folder for figures, "
+                             "tables and the report."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
 ) -> None:
-    """Run the main pipeline on a small built-in example and write a report."""
+    """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
     from .demo import run_demo
 
-    run_demo(out)
+    run_demo(out, seed=seed)
+
+
+@app.command()
+def simulate(
+    store: Optional[Path] = typer.Option(None, "--store", help="Zarr store (default under "
+                                         "gearshot's data home)."),
+    speed: List[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps."),
+    load: List[float] = typer.Option([10.0], "--load", help="Load(s), Nm."),
+    grade: List[int] = typer.Option(list(range(1, 13)), "--grade", help="DIN grade(s)."),
+    n_healthy: int = typer.Option(100, "--n-healthy"),
+    n_faulty: int = typer.Option(700, "--n-faulty"),
+    seed: int = typer.Option(0, "--seed"),
+    paper: bool = typer.Option(False, "--paper", help="All paper speeds (10–35 rps) and "
+                               "loads (5–20 Nm)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of a "
+                                            "running Dask scheduler."),
+    workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
+                                "--scheduler is given."),
+) -> None:
+    """Build (or finish) a simulated database; resumable."""
+    from .sim import GearPair, build_database, default_database_path
+
+    store = store or default_database_path()
+    speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
+    n_blocks = len(speeds) * len(loads) * len(grade)
+    client = _client(scheduler, workers, needed=n_blocks > 1)
+    try:
+        build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+    finally:
+        if client is not None:
+            client.close()
+    typer.echo(f"database ready: {store}")
+
+
+@app.command()
+def rig(
+    folder: Path = typer.Argument(..., help="Campaign folder (created)."),
+    speed: float = typer.Option(15.0, "--speed"),
+    load: float = typer.Option(10.0, "--load"),
+    duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
+    healthy: int = typer.Option(6, "--healthy"),
+    size: List[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
+    repetitions: int = typer.Option(6, "--repetitions"),
+    seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
+    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder", help="Measured FRFs "
+                                              "for the transfer path (default synthetic)."),
+    rig_grade: Optional[int] = typer.Option(None, "--rig-grade", help="Force the rig's true "
+                                            "surface grade (default: hidden, drawn)."),
+) -> None:
+    """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
+    from .rig import VirtualRig
+
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    rig_obj = _make_rig(seed, frf_folder, rig_grade)
+    index = rig_obj.campaign(folder, speed=speed, load=load, duration=duration,
+                             healthy=healthy, sizes=tuple(size), repetitions=repetitions)
+    typer.echo(f"{len(index)} recordings written to {folder}")
+
+
+def _make_rig(seed, frf_folder, rig_grade):
+    from .rig import VirtualRig
+
+    kwargs = {}
+    if frf_folder is not None:
+        kwargs["tf_bank"] = str(frf_folder)
+    if rig_grade is not None:
+        if not 1 <= rig_grade <= 12:
+            raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
+        kwargs["grade"] = rig_grade
+    try:
+        return VirtualRig(seed=seed, **kwargs)
+    except TypeError:
+        raise GearshotError("this VirtualRig does not accept --rig-grade") from None
+
+
+@experiment_app.command("simulated")
+def experiment_simulated(
+    store: Optional[Path] = typer.Option(None, "--store", help="Database store (built if "
+                                         "missing)."),
+    speed: List[float] = typer.Option([15.0], "--speed"),
+    load: List[float] = typer.Option([10.0], "--load"),
+    grade: int = typer.Option(7, "--grade", help="Grade of the simulated signals."),
+    attenuation_db: List[float] = typer.Option([10.0], "--attenuation-db"),
+    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder", help="Measured FRFs "
+                                              "(default: a synthetic bank of 24)."),
+    selection_tf: Optional[str] = typer.Option(None, "--selection-tf", help="Name of the "
+                                               "held-out TF (default the bank's last)."),
+    seed: int = typer.Option(0, "--seed"),
+    full: bool = typer.Option(False, "--full", help="The paper's sweep: 26 speeds × 4 loads "
+                              "× 23 TFs."),
+    n_healthy: int = typer.Option(100, "--n-healthy"),
+    n_faulty: int = typer.Option(700, "--n-faulty"),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write results as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for figures and report."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler"),
+    workers: int = typer.Option(2, "--workers"),
+) -> None:
+    """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
+    from .experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
+    from .sim import GearPair, build_database, default_database_path
+
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if full else (speed, load)
+    tag = "paper" if full else "-".join(f"{s:g}" for s in speeds) + "rps-" + \
+        "-".join(f"{ld:g}" for ld in loads) + "Nm"
+    store = store or default_database_path(
+        f"sim-db-{tag}-grade{grade}-h{n_healthy}-f{n_faulty}-s{seed}")
+    client = _client(scheduler, workers, needed=len(speeds) * len(loads) > 1)
+    try:
+        build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=[grade],
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+        results = simulated_experiment(store, speeds=speeds, loads=loads, grade=grade,
+                                       frf_folder=frf_folder, selection_tf=selection_tf,
+                                       attenuations_db=attenuation_db, seed=seed,
+                                       client=client)
+    finally:
+        if client is not None:
+            client.close()
+    table = summarize(results)
+    typer.echo(table.to_string(index=False))
+    by_variant = dict(zip(table["variant"], table["mae_percent"]))
+    payload = {"experiment": "simulated", "mae": by_variant.get("full"),
+               "ablations": by_variant, "n_datasets": int(len(results) / len(SIMULATED_VARIANTS)),
+               "rows": results.to_dict(orient="records")}
+    _write_json(json_out, payload)
+    if out is not None:
+        from .figures import simulated_figures
+
+        simulated_figures(results, out)
+
+
+@experiment_app.command("rig")
+def experiment_rig(
+    campaign: Optional[Path] = typer.Option(None, "--campaign", help="Campaign folder "
+                                            "(recorded if missing)."),
+    store: Optional[Path] = typer.Option(None, "--store"),
+    speed: float = typer.Option(15.0, "--speed"),
+    load: float = typer.Option(10.0, "--load"),
+    seed: int = typer.Option(0, "--seed"),
+    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder"),
+    rig_grade: Optional[int] = typer.Option(None, "--rig-grade"),
+    attenuation_db: Optional[float] = typer.Option(None, "--attenuation-db",
+                                                   help="Rig path attenuation (default "
+                                                   "hidden, 10–30 dB)."),
+    duration: float = typer.Option(60.0, "--duration"),
+    repeats: int = typer.Option(5, "--repeats", help="Random example draws."),
+    n_healthy: int = typer.Option(100, "--n-healthy"),
+    n_faulty: int = typer.Option(700, "--n-faulty"),
+    json_out: Optional[Path] = typer.Option(None, "--json"),
+    out: Optional[Path] = typer.Option(None, "--out"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler"),
+    workers: int = typer.Option(2, "--workers"),
+) -> None:
+    """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
+    from . import data_home
+    from .experiments import RIG_VARIANTS, rig_experiment, summarize
+    from .sim import GearPair, build_database, default_database_path, load_database
+    from .transfer import TransferFunctionBank
+
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    store = store or default_database_path(
+        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
+    client = _client(scheduler, workers, needed=True)
+    try:
+        build_database(store, GearPair.paper(), speeds=[speed], loads=[load],
+                       grades=range(1, 13), n_healthy=n_healthy, n_faulty=n_faulty,
+                       seed=seed, client=client)
+    finally:
+        if client is not None:
+            client.close()
+    database = load_database(store, speed=speed, load=load)
+    if campaign is None:
+        tag = f"campaign-s{seed}-{speed:g}rps-{load:g}Nm-g{rig_grade}-a{attenuation_db}"
+        campaign = data_home() / tag
+    if not (campaign / "index.csv").is_file():
+        rig_obj = _make_rig(seed, frf_folder, rig_grade)
+        if attenuation_db is not None:
+            rig_obj = _with_attenuation(rig_obj, attenuation_db)
+        rig_obj.campaign(campaign, speed=speed, load=load, duration=duration)
+    selection = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
+    results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
+                                          selection_tf=selection, variants=RIG_VARIANTS,
+                                          n_repeats=repeats, seed=seed)
+    table = summarize(results)
+    typer.echo(table.to_string(index=False))
+    by_variant = dict(zip(table["variant"], table["mae_percent"]))
+    payload = {"experiment": "rig", "speed": speed, "load": load,
+               "mae": by_variant.get("full"), "ablations": by_variant,
+               "rows": results.to_dict(orient="records")}
+    _write_json(json_out, payload)
+    if out is not None:
+        from .figures import rig_figures
+
+        rig_figures(results, predictions, out)
+
+
+def _with_attenuation(rig_obj, attenuation_db):
+    if hasattr(rig_obj, "with_reality"):
+        return rig_obj.with_reality(attenuation_db=attenuation_db)
+    raise GearshotError("this VirtualRig does not accept --attenuation-db")
+
+
+@app.command()
+def predict(
+    database: Path = typer.Option(..., "--database", help="Simulated database store."),
+    healthy: List[Path] = typer.Option(..., "--healthy", help="Healthy recording file(s)."),
+    faulty: Path = typer.Option(..., "--faulty", help="The one faulty recording."),
+    faulty_size: float = typer.Option(..., "--faulty-size", help="Its fault size in (0, 1]."),
+    recordings: Path = typer.Option(..., "--recordings", help="Folder (or file) of "
+                                    "recordings to estimate."),
+    speed: float = typer.Option(..., "--speed", help="Condition of the database slice, rps."),
+    load: float = typer.Option(..., "--load", help="Nm."),
+    out: Path = typer.Option(Path("predictions.csv"), "--out", help="CSV or JSON output."),
+    coverage: float = typer.Option(0.9, "--coverage", help="Prediction-interval coverage."),
+    gear_teeth: int = typer.Option(38, "--gear-teeth"),
+    pinion_teeth: int = typer.Option(17, "--pinion-teeth"),
+    seed: int = typer.Option(0, "--seed"),
+) -> None:
+    """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    from .predict_files import predict_from_files
+
+    frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
+                               speed=speed, load=load, coverage=coverage,
+                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.suffix.lower() == ".json":
+        out.write_text(frame.to_json(orient="records", indent=2))
+    else:
+        frame.to_csv(out, index=False)
+    typer.echo(frame.groupby("recording")["predicted"].mean().to_string())
+    typer.echo(f"predictions written to {out}")
+
+
+@app.command()
+def report(
+    results: Path = typer.Argument(..., help="A results JSON written by --json."),
+    out: Path = typer.Option(Path("gearshot-report"), "--out"),
+) -> None:
+    """Figures and a Markdown report from a results JSON."""
+    from .figures import report_from_json
+
+    path = report_from_json(results, out)
+    typer.echo(f"report: {path}")
 
 
 def main() -> None:
     """Console entry point: user errors become one line and a non-zero exit."""
     try:
-        app(standalone_mode=True)
+        app(standalone_mode=False)
     except GearshotError as exc:
         typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
         sys.exit(2)
+    except FileNotFoundError as exc:
+        typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
+        sys.exit(2)
+    except KeyboardInterrupt:
+        typer.secho("gearshot: interrupted", err=True)
+        sys.exit(130)
+    except typer.Exit as exc:
+        sys.exit(exc.exit_code)
+    except typer.Abort:
+        sys.exit(1)
+    except Exception as exc:  # usage errors of typer's click: show them, exit 2
+        if hasattr(exc, "show") and hasattr(exc, "exit_code"):
+            exc.show()
+            sys.exit(exc.exit_code)
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover

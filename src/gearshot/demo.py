@@ -1,0 +1,159 @@
+"""``gearshot demo``: the whole method end to end on one operating condition.
+
+Builds (and caches under :func:`gearshot.data_home`) a small simulated database for
+15 rps / 10 Nm over the 12 DIN grades, records a virtual-rig campaign, fits the estimator
+and its four ablations, and writes figures plus a Markdown report into a folder.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+__all__ = ["run_demo"]
+
+SPEED, LOAD = 15.0, 10.0
+
+
+def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duration=30.0,
+             repetitions=6, console=None):
+    """Run the demo; returns the output folder.
+
+    Parameters
+    ----------
+    out : path
+        Folder for the figures, tables and report (created).
+    seed : int
+        Seeds the database, the rig's hidden reality and every split.
+    n_healthy, n_faulty : int
+        Simulated signals per grade in the cached demo database.
+    duration : float
+        Seconds per rig recording.
+    repetitions : int
+        Recordings per fault size (6 healthy recordings are always made).
+    """
+    from . import data_home
+    from .experiments import RIG_VARIANTS, rig_experiment
+    from .rig import VirtualRig
+    from .sim import GearPair, build_database, load_database
+    from .transfer import TransferFunctionBank
+
+    console = console or Console()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    t_start = time.perf_counter()
+    home = data_home()
+    store = home / f"demo-db-h{n_healthy}-f{n_faulty}-s{seed}"
+    console.rule("1. simulated database (15 rps, 10 Nm, DIN grades 1–12)")
+    build_database(store, GearPair.paper(), speeds=[SPEED], loads=[LOAD], grades=range(1, 13),
+                   n_healthy=n_healthy, n_faulty=n_faulty, seed=seed)
+    database = load_database(store, speed=SPEED, load=LOAD)
+    console.print(f"{database.sizes['signal']} simulated SAs in {store}")
+
+    console.rule("2. virtual-rig campaign")
+    campaign = home / f"demo-campaign-s{seed}-d{duration:g}-r{repetitions}"
+    rig = VirtualRig(seed=seed)
+    if not (campaign / "index.csv").is_file():
+        rig.campaign(campaign, speed=SPEED, load=LOAD, duration=duration,
+                     repetitions=repetitions)
+    console.print(f"recordings in {campaign}")
+
+    console.rule("3. one-fault-shot estimation and ablations")
+    selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
+    results, predictions = rig_experiment(campaign, database, speed=SPEED, load=LOAD,
+                                          selection_tf=selection_tf, variants=RIG_VARIANTS,
+                                          seed=seed, keep_estimators=True)
+    full = results[results["variant"] == "full"].iloc[0]
+    est = full["estimator"]
+    table = Table(title="MAE of the fault-size estimate on the rig's test segments")
+    for col in ("variant", "MAE [%]", "grade", "features", "K"):
+        table.add_column(col)
+    for _, row in results.iterrows():
+        table.add_row(row["variant"], f"{100 * row['mae']:.1f}", str(row["grade"]),
+                      row["selected"], str(row["n_neighbors"]))
+    console.print(table)
+    full_pred = predictions[predictions["variant"] == "full"]
+    sizes = Table(title="full algorithm: predicted vs true size")
+    for col in ("true size", "n segments", "mean predicted", "std"):
+        sizes.add_column(col)
+    for size, part in full_pred.groupby("true"):
+        sizes.add_row(f"{size:.2f}", str(len(part)), f"{part['predicted'].mean():.3f}",
+                      f"{part['predicted'].std():.3f}")
+    console.print(sizes)
+    console.print(f"example: size {full['example_size']:.2f}; chosen grade {est.grade_} "
+                  f"(hidden rig grade {rig.reveal().grade})")
+
+    console.rule("4. figures and report")
+    figures = _figures(out, est, results, full_pred, campaign, rig)
+    summary = {
+        "speed": SPEED, "load": LOAD, "seed": seed,
+        "mae": float(full["mae"]) * 100,
+        "ablations": {r["variant"]: float(r["mae"]) * 100 for _, r in results.iterrows()},
+        "grade": int(est.grade_), "rig_grade": int(rig.reveal().grade),
+        "selected_features": list(est.selected_features_),
+        "feature_errors": est.feature_errors_, "n_neighbors": int(est.n_neighbors_),
+        "seconds": time.perf_counter() - t_start,
+    }
+    (out / "results.json").write_text(json.dumps(summary, indent=2))
+    results.drop(columns=["estimator"]).to_csv(out / "ablations.csv", index=False)
+    full_pred.to_csv(out / "predictions.csv", index=False)
+    from .report import write_report
+
+    report = write_report(out, summary, figures)
+    console.print(f"report: {report.resolve()}")
+    console.print(f"done in {summary['seconds']:.0f} s; outputs in {out.resolve()}")
+    return out
+
+
+def _figures(out, est, results, full_pred, campaign, rig):
+    """The demo's figures; returns {caption: png path}."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from . import plotting
+    from .experiments import recording_segments
+    from .rig import read_campaign
+    from .signal import acs_background, amplitude_spectrum
+
+    figs = {}
+    fig, ax = plt.subplots(figsize=(4.5, 4.5))
+    plotting.plot_predicted_vs_true(full_pred["true"], full_pred["predicted"], ax=ax)
+    figs["Predicted vs true size (full algorithm), Fig. 14a"] = \
+        plotting.save_figure(fig, out / "fig14a_predicted_vs_true")[0]
+    fig, ax = plt.subplots(figsize=(6.5, 3.5))
+    plotting.plot_ablation(dict(zip(results["variant"], results["mae"])), ax=ax)
+    figs["MAE of the ablations, Fig. 14b"] = plotting.save_figure(fig, out / "fig14b_ablation")[0]
+    if est.tuning_curve_ is not None:
+        fig, ax = plt.subplots(figsize=(5, 3.5))
+        plotting.plot_tuning_curve(est.tuning_curve_, est.faulty_size_, ax=ax)
+        figs["Simulation tuning: example prediction per DIN grade"] = \
+            plotting.save_figure(fig, out / "tuning_curve")[0]
+    index = read_campaign(campaign)
+    healthy_path = index[index["fault_size"] == 0]["path"].iloc[0]
+    faulty_path = index[index["fault_size"] == index["fault_size"].max()]["path"].iloc[0]
+    _, long = recording_segments(healthy_path, long=True)
+    spec = amplitude_spectrum(long)
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    plotting.plot_spectrum_background(spec, acs_background(spec), ax=ax)
+    figs["Spectrum of a long healthy signal and its ACS background"] = \
+        plotting.save_figure(fig, out / "spectrum_acs")[0]
+    true_tf = rig.true_transfer_function(est.n_points_) \
+        if hasattr(rig, "true_transfer_function") else None
+    if true_tf is not None:
+        fig, ax = plt.subplots(figsize=(8, 3.5))
+        plotting.plot_tf_estimate(true_tf, est.transfer_function_, ax=ax)
+        figs["Transfer-function estimate vs the rig's hidden path"] = \
+            plotting.save_figure(fig, out / "tf_estimate")[0]
+    sa = recording_segments(faulty_path)[0]
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    plotting.plot_sa_and_difference(sa, est.mesh_order, ax=ax)
+    figs["A faulty SA and its difference signal"] = \
+        plotting.save_figure(fig, out / "sa_difference")[0]
+    return figs

@@ -1,0 +1,57 @@
+"""Saving and loading fitted estimators (joblib, with version metadata)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import warnings
+from pathlib import Path
+
+import joblib
+import sklearn
+
+from .. import __version__
+from .._errors import GearshotError
+
+__all__ = ["save_estimator", "load_estimator"]
+
+_FORMAT = "gearshot-estimator/1"
+
+
+def save_estimator(estimator, path):
+    """Write ``estimator`` to ``path`` atomically (temporary file, then rename)."""
+    from sklearn.utils.validation import check_is_fitted
+
+    check_is_fitted(estimator, "model_")
+    path = Path(path)
+    payload = {"format": _FORMAT, "gearshot_version": __version__,
+               "sklearn_version": sklearn.__version__, "estimator": estimator}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        joblib.dump(payload, tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def load_estimator(path):
+    """Read an estimator written by :func:`save_estimator`; warn on version differences."""
+    path = Path(path)
+    if not path.is_file():
+        raise GearshotError(f"estimator file {str(path)!r} does not exist")
+    try:
+        payload = joblib.load(path)
+    except Exception as exc:
+        raise GearshotError(f"{str(path)!r} is not a readable gearshot estimator ({exc})") \
+            from None
+    if not isinstance(payload, dict) or payload.get("format") != _FORMAT:
+        raise GearshotError(f"{str(path)!r} is not a gearshot estimator file")
+    for key, now in (("gearshot_version", __version__), ("sklearn_version",
+                                                        sklearn.__version__)):
+        if payload.get(key) != now:
+            warnings.warn(f"{path} was saved with {key.split('_')[0]} {payload.get(key)}; "
+                          f"this is {now}", UserWarning, stacklevel=3)
+    return payload["estimator"]

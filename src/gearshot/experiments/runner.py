@@ -1,0 +1,208 @@
+"""Running the paper's experiments: many datasets × estimator variants, resumably, on Dask."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .._errors import GearshotError
+from .variants import RIG_VARIANTS, SIMULATED_VARIANTS, variant_params
+
+__all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summarize"]
+
+
+def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
+                      random_state=0, keep_estimators=False, **params):
+    """Fit every variant on one dataset and score it on its test set.
+
+    Returns
+    -------
+    list of dict
+        One row per variant: ``variant``, ``mae``, ``grade``, ``selected``, ``n_neighbors``,
+        ``seconds``, plus ``prediction`` (array) and, with ``keep_estimators``, ``estimator``.
+    """
+    from ..estimator import OneFaultShotEstimator
+
+    rows = []
+    for name in variants:
+        t0 = time.perf_counter()
+        est = OneFaultShotEstimator(random_state=random_state,
+                                    **{**params, **variant_params(name)})
+        est.fit(*fit_args, selection_tf=selection_tf)
+        pred = est.predict(test_sa)
+        row = dict(variant=name, mae=float(np.mean(np.abs(pred - test_size))),
+                   grade=est.grade_, selected=",".join(est.selected_features_),
+                   n_neighbors=est.n_neighbors_, seconds=time.perf_counter() - t0,
+                   prediction=pred)
+        if keep_estimators:
+            row["estimator"] = est
+        rows.append(row)
+    return rows
+
+
+# ------------------------------------------------------------------ resumable result store
+def _task_key(spec: dict) -> str:
+    text = json.dumps(spec, sort_keys=True, default=str)
+    return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+def _write_parquet_atomic(frame: pd.DataFrame, path: Path) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        frame.to_parquet(tmp, index=False)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _simulated_task(spec: dict) -> pd.DataFrame:
+    """One (speed, load, attenuation): every test TF × variant. Runs on a Dask worker."""
+    from ..sim import load_database
+    from ..transfer import TransferFunctionBank
+    from .simulated import simulated_dataset
+
+    db = load_database(spec["store"], speed=spec["speed"], load=spec["load"],
+                       grade=spec["grade"])
+    sa = db["sa"].values
+    y = db["fault_size"].values
+    bank = _bank(spec)
+    selection = bank[spec["selection_tf"]]
+    rows = []
+    for name in spec["tfs"]:
+        ds = simulated_dataset(sa, y, bank[name], grade=spec["grade"],
+                               attenuation_db=spec["attenuation_db"],
+                               random_state=[spec["seed"], spec["tfs"].index(name)])
+        for row in evaluate_variants(ds.fit_args(), ds.test_sa, ds.test_size,
+                                     variants=spec["variants"], selection_tf=selection,
+                                     random_state=spec["seed"]):
+            row.pop("prediction")
+            rows.append(dict(speed=spec["speed"], load=spec["load"], tf=name,
+                             attenuation_db=spec["attenuation_db"], seed=spec["seed"], **row))
+    return pd.DataFrame(rows)
+
+
+def _bank(spec):
+    from ..transfer import TransferFunctionBank
+
+    if spec.get("frf_folder"):
+        return TransferFunctionBank.from_folder(spec["frf_folder"])
+    return TransferFunctionBank.synthetic(spec.get("n_synthetic", 24),
+                                          rng=np.random.default_rng(spec["seed"]))
+
+
+def _run_specs(specs, task, results_dir: Path, client, description: str) -> pd.DataFrame:
+    """Run tasks whose result file is missing; return all results. Resumable."""
+    from rich.progress import Progress
+
+    results_dir.mkdir(parents=True, exist_ok=True)
+    todo = []
+    for spec in specs:
+        path = results_dir / f"{_task_key(spec)}.parquet"
+        if not path.exists():
+            todo.append((spec, path))
+    with Progress(transient=False) as bar:
+        job = bar.add_task(description, total=len(specs), completed=len(specs) - len(todo))
+        if client is None:
+            for spec, path in todo:
+                _write_parquet_atomic(task(spec), path)
+                bar.advance(job)
+        else:
+            from dask.distributed import as_completed
+
+            futures = {client.submit(task, spec, pure=False): path for spec, path in todo}
+            for fut in as_completed(futures):
+                _write_parquet_atomic(fut.result(), futures[fut])
+                bar.advance(job)
+    frames = [pd.read_parquet(results_dir / f"{_task_key(s)}.parquet") for s in specs]
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def simulated_experiment(store, *, speeds, loads, grade=7, frf_folder=None,
+                         selection_tf=None, attenuations_db=(10.0,), variants=SIMULATED_VARIANTS,
+                         seed=0, results_dir=None, client=None):
+    """The paper's Sec. 4.1 sweep: datasets over TFs × speeds × loads × attenuations.
+
+    Parameters
+    ----------
+    store : path
+        Simulated database (built with :func:`gearshot.sim.build_database`) holding every
+        requested speed and load at ``grade``.
+    speeds, loads : sequences of float
+    grade : int
+        Grade of the simulated signals (training and test share it in Sec. 4.1).
+    frf_folder : path, optional
+        Folder of measured FRFs (UFF58/CSV); default a synthetic bank of 24.
+    selection_tf : str, optional
+        Name of the TF held out for feature selection (default the bank's last).
+    attenuations_db : sequence of float
+    variants : sequence of str
+    seed : int
+    results_dir : path, optional
+        Where per-task results are kept (resumable); default ``<store>/experiments/...``.
+    client : dask.distributed.Client, optional
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (speed, load, tf, attenuation, variant) with its MAE.
+    """
+    store = Path(store)
+    bank_spec = dict(frf_folder=str(frf_folder) if frf_folder else None, seed=seed)
+    bank = _bank(bank_spec)
+    names = list(bank.names)
+    held = selection_tf if selection_tf is not None else names[-1]
+    if held not in names:
+        raise GearshotError(f"selection_tf {held!r} is not in the bank {names}")
+    tfs = [n for n in names if n != held]
+    specs = [dict(store=str(store), speed=float(s), load=float(ld), grade=int(grade),
+                  attenuation_db=float(a), tfs=tfs, selection_tf=held,
+                  variants=list(variants), **bank_spec)
+             for s in speeds for ld in loads for a in attenuations_db]
+    results_dir = Path(results_dir) if results_dir else store / "experiments" / "simulated"
+    return _run_specs(specs, _simulated_task, results_dir, client,
+                      "simulated datasets")
+
+
+def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RIG_VARIANTS,
+                   n_repeats=1, seed=0, keep_estimators=False):
+    """The paper's Sec. 4.2 experiment on one condition's campaign.
+
+    Returns
+    -------
+    results : pandas.DataFrame
+        One row per (repeat, variant) with the MAE and fitted grade/features.
+    predictions : pandas.DataFrame
+        ``repeat, variant, true, predicted, recording``.
+    """
+    from .rig import rig_dataset
+
+    cache: dict = {}
+    rows, preds = [], []
+    for r in range(int(n_repeats)):
+        ds = rig_dataset(campaign, speed=speed, load=load, random_state=[seed, r],
+                         segments=cache)
+        for row in evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
+                                     variants=variants, selection_tf=selection_tf,
+                                     random_state=seed + r, keep_estimators=keep_estimators):
+            pred = row.pop("prediction")
+            preds.append(pd.DataFrame(dict(repeat=r, variant=row["variant"],
+                                           true=ds.test_size, predicted=pred,
+                                           recording=ds.test_recording)))
+            rows.append(dict(repeat=r, speed=speed, load=load,
+                             example_size=ds.faulty_size, **row))
+    return pd.DataFrame(rows), pd.concat(preds, ignore_index=True)
+
+
+def summarize(results: pd.DataFrame, by=("variant",)) -> pd.DataFrame:
+    """Mean MAE (in %) grouped by ``by``."""
+    out = results.groupby(list(by))["mae"].mean().mul(100).rename("mae_percent")
+    return out.reset_index()

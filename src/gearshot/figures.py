@@ -1,0 +1,95 @@
+"""Experiment figures and reports (used by the CLI)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._errors import GearshotError
+
+__all__ = ["simulated_figures", "rig_figures", "report_from_json"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def simulated_figures(results: pd.DataFrame, out) -> dict:
+    """Fig. 13 a–d: MAE vs speed and vs TF (per load and averaged), one line per variant."""
+    from . import plotting
+
+    plt = _plt()
+    out = Path(out)
+    figs = {}
+    for by, name in (("speed", "fig13a_error_vs_speed"), ("tf", "fig13b_error_vs_tf"),
+                     ("load", "fig13c_error_vs_load"),
+                     ("attenuation_db", "fig13d_error_vs_attenuation")):
+        if results[by].nunique() < 1:
+            continue
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+        plotting.plot_error_vs(results, by, ax=ax)
+        figs[f"MAE vs {by}"] = plotting.save_figure(fig, out / name)[0]
+    from .report import write_report
+
+    table = results.groupby("variant")["mae"].mean() * 100
+    write_report(out, {"mae": float(table.get("full", np.nan)),
+                       "ablations": table.to_dict()}, figs)
+    return figs
+
+
+def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out) -> dict:
+    """Fig. 14 a–b: predicted vs true (full algorithm) and the ablation errors."""
+    from . import plotting
+
+    plt = _plt()
+    out = Path(out)
+    figs = {}
+    full = predictions[predictions["variant"] == "full"]
+    fig, ax = plt.subplots(figsize=(4.5, 4.5))
+    plotting.plot_predicted_vs_true(full["true"], full["predicted"], ax=ax)
+    figs["Predicted vs true (Fig. 14a)"] = plotting.save_figure(fig, out / "fig14a")[0]
+    fig, ax = plt.subplots(figsize=(6.5, 3.5))
+    mae = results.groupby("variant", sort=False)["mae"].mean()
+    plotting.plot_ablation(mae.to_dict(), ax=ax)
+    figs["Ablations (Fig. 14b)"] = plotting.save_figure(fig, out / "fig14b")[0]
+    from .report import write_report
+
+    write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,
+                       "ablations": (mae * 100).to_dict()}, figs)
+    return figs
+
+
+def report_from_json(path, out) -> Path:
+    """Rebuild figures and a report from a results JSON written by ``--json``."""
+    path = Path(path)
+    if not path.is_file():
+        raise GearshotError(f"results file {str(path)!r} does not exist")
+    try:
+        payload = json.loads(path.read_text())
+        rows = pd.DataFrame(payload["rows"])
+    except (ValueError, KeyError) as exc:
+        raise GearshotError(f"{str(path)!r} is not a gearshot results JSON ({exc})") from None
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if payload.get("experiment") == "simulated":
+        simulated_figures(rows, out)
+    else:
+        from . import plotting
+        from .report import write_report
+
+        plt = _plt()
+        fig, ax = plt.subplots(figsize=(6.5, 3.5))
+        mae = rows.groupby("variant", sort=False)["mae"].mean()
+        plotting.plot_ablation(mae.to_dict(), ax=ax)
+        figs = {"Ablations (Fig. 14b)": plotting.save_figure(fig, out / "fig14b")[0]}
+        write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,
+                           "ablations": (mae * 100).to_dict()}, figs)
+    return out / "report.md"

@@ -1,0 +1,194 @@
+"""Figures of the paper and of gearshot's diagnostics (matplotlib).
+
+Every function takes ``ax=None`` (a new figure is made when omitted) and returns the
+artists it drew; :func:`save_figure` writes PNG and PDF side by side.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "save_figure",
+    "plot_sa_and_difference",
+    "plot_spectrum_background",
+    "plot_tf_estimate",
+    "plot_tuning_curve",
+    "plot_feature_invariance",
+    "plot_predicted_vs_true",
+    "plot_ablation",
+    "plot_error_vs",
+]
+
+VARIANT_LABELS = {
+    "before_da": "before DA",
+    "rms_only": "RMS normalization only",
+    "no_feature_selection": "no feature selection",
+    "no_tuning": "no tuning",
+    "full": "full algorithm",
+}
+
+
+def _ax(ax, **kw):
+    if ax is None:
+        import matplotlib
+
+        if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg") and \
+                not matplotlib.is_interactive():
+            matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(**kw)
+    return ax
+
+
+def save_figure(fig, path) -> list[Path]:
+    """Save ``fig`` as ``path`` with suffixes .png and .pdf; returns the written paths."""
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    out = []
+    for suffix in (".png", ".pdf"):
+        target = path.with_suffix(suffix)
+        fig.savefig(target, dpi=130, bbox_inches="tight")
+        out.append(target)
+    plt.close(fig)
+    return out
+
+
+def plot_sa_and_difference(sa, mesh_order, *, ax=None, n_sidebands=2):
+    """An SA and its difference signal over one cycle."""
+    from .signal import difference_signal
+
+    ax = _ax(ax, figsize=(8, 3.5))
+    sa = np.asarray(sa, float)
+    angle = np.arange(sa.size) / sa.size * 360
+    lines = ax.plot(angle, sa, lw=0.8, label="synchronous average")
+    lines += ax.plot(angle, difference_signal(sa, mesh_order, n_sidebands=n_sidebands),
+                     lw=0.8, label="difference signal")
+    ax.set_xlabel("gear angle [deg]")
+    ax.set_ylabel("acceleration")
+    ax.legend(loc="upper right", fontsize=8)
+    return lines
+
+
+def plot_spectrum_background(spectrum, background, *, ax=None, fs=None):
+    """A one-sided amplitude spectrum with its ACS background."""
+    ax = _ax(ax, figsize=(8, 3.5))
+    n = spectrum.size // 2 + 1
+    x = np.arange(n) if fs is None else np.arange(n) * fs / spectrum.size
+    lines = ax.semilogy(x, spectrum[:n], lw=0.5, label="amplitude spectrum")
+    lines += ax.semilogy(x, background[:n], lw=1.5, label="ACS background")
+    ax.set_xlabel("frequency [Hz]" if fs else "bin (cycle-domain order × nfft/cycle)")
+    ax.set_ylabel("amplitude")
+    ax.legend(fontsize=8)
+    return lines
+
+
+def plot_tf_estimate(tf_true, tf_est, *, ax=None):
+    """Magnitude of a true TF and its estimate on the SA grid (each scaled to unit RMS)."""
+    ax = _ax(ax, figsize=(8, 3.5))
+    n = len(tf_true) // 2 + 1
+    orders = np.arange(n)
+
+    def db(h):
+        h = np.abs(np.asarray(h)[:n])
+        return 20 * np.log10(h / np.sqrt(np.mean(h ** 2)))
+
+    lines = ax.plot(orders, db(tf_true), lw=0.7, label="true TF")
+    lines += ax.plot(orders, db(tf_est), lw=1.5, label="estimate (ACS + minimum phase)")
+    ax.set_xlabel("order (SA grid)")
+    ax.set_ylabel("|H| [dB re RMS]")
+    ax.legend(fontsize=8)
+    return lines
+
+
+def plot_tuning_curve(curve, true_size=None, *, ax=None):
+    """Step 2: predicted size of the faulty example for each simulated grade."""
+    ax = _ax(ax, figsize=(5, 3.5))
+    lines = ax.plot(curve["grade"], curve["prediction"], "o-", label="predicted example size")
+    if "smoothed" in curve:
+        lines += ax.plot(curve["grade"], curve["smoothed"], "-", lw=2, alpha=0.6,
+                         label="monotone fit")
+    if true_size is not None:
+        lines.append(ax.axhline(true_size, color="k", ls="--", lw=1, label="true size"))
+    best = int(np.argmin(curve["abs_error"]))
+    lines += ax.plot([curve["grade"][best]], [curve.get("smoothed", curve["prediction"])[best]],
+                     "r*", ms=14,
+                     label="chosen grade")
+    ax.set_xlabel("DIN grade of the simulation")
+    ax.set_ylabel("predicted size y")
+    ax.legend(fontsize=8)
+    return lines
+
+
+def plot_feature_invariance(train, test, names, errors, *, axes=None):
+    """Fig. 11: each feature on the training (estimated TF) vs test (true TF) signals."""
+    import matplotlib.pyplot as plt
+
+    train, test = np.asarray(train), np.asarray(test)
+    if axes is None:
+        _, axes = plt.subplots(1, len(names), figsize=(3.2 * len(names), 3.2), squeeze=False)
+        axes = axes[0]
+    artists = []
+    for i, (ax, name) in enumerate(zip(axes, names)):
+        artists.append(ax.scatter(train[:, i], test[:, i], s=6, alpha=0.6))
+        lo = min(train[:, i].min(), test[:, i].min())
+        hi = max(train[:, i].max(), test[:, i].max())
+        ax.plot([lo, hi], [lo, hi], "k--", lw=0.8)
+        ax.set_title(f"{name}\nerror {100 * errors[name]:.1f} %", fontsize=9)
+        ax.set_xlabel("training (estimated TF)")
+        ax.set_ylabel("test (true TF)")
+    return artists
+
+
+def plot_predicted_vs_true(true, predicted, *, ax=None, low=None, high=None):
+    """Fig. 14a: predicted vs true size per test SA (with intervals when given)."""
+    ax = _ax(ax, figsize=(4.5, 4.5))
+    true, predicted = np.asarray(true), np.asarray(predicted)
+    rng = np.random.default_rng(0)
+    jitter = true + rng.uniform(-0.012, 0.012, true.size)
+    artists = []
+    if low is not None and high is not None:
+        artists.append(ax.vlines(jitter, low, high, color="0.8", lw=0.8,
+                                 label="90 % interval"))
+    artists.append(ax.scatter(jitter, predicted, s=10, label="test SA"))
+    artists += ax.plot([0, 1], [0, 1], "k--", lw=0.8)
+    ax.set_xlim(-0.05, 1.05)
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel("true size y")
+    ax.set_ylabel("predicted size y")
+    ax.set_title(f"MAE {100 * np.mean(np.abs(true - predicted)):.1f} %")
+    return artists
+
+
+def plot_ablation(mae_by_variant, *, ax=None):
+    """Fig. 14b: MAE (%) of each variant."""
+    ax = _ax(ax, figsize=(6, 3.5))
+    names = list(mae_by_variant)
+    values = [100 * mae_by_variant[n] for n in names]
+    bars = ax.bar([VARIANT_LABELS.get(n, n) for n in names], values)
+    ax.bar_label(bars, fmt="%.1f")
+    ax.set_ylabel("MAE [%]")
+    ax.tick_params(axis="x", labelrotation=20)
+    return bars
+
+
+def plot_error_vs(results, by, *, ax=None, variants=None):
+    """Fig. 13: MAE (%) against ``by`` (e.g. 'speed' or 'tf'), one line per variant."""
+    ax = _ax(ax, figsize=(7, 3.5))
+    variants = variants or list(dict.fromkeys(results["variant"]))
+    lines = []
+    for v in variants:
+        part = results[results["variant"] == v].groupby(by)["mae"].mean() * 100
+        x = np.arange(part.size) if part.index.dtype == object else part.index.to_numpy()
+        lines += ax.plot(x, part.to_numpy(), "o-", label=VARIANT_LABELS.get(v, v))
+        if part.index.dtype == object:
+            ax.set_xticks(x, part.index, rotation=45, ha="right", fontsize=7)
+    ax.set_xlabel(by)
+    ax.set_ylabel("MAE [%]")
+    ax.legend(fontsize=8)
+    return lines

@@ -1,0 +1,68 @@
+"""Fit from recording files and estimate the fault size of other recordings."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._errors import GearshotError
+
+__all__ = ["predict_from_files"]
+
+
+def _recording_files(path: Path):
+    from .rig import FORMATS
+
+    path = Path(path)
+    if path.is_file():
+        return [path]
+    if not path.is_dir():
+        raise GearshotError(f"--recordings {str(path)!r} does not exist")
+    suffixes = {s if s.startswith(".") else f".{s}" for s in FORMATS}
+    files = sorted(p for p in path.iterdir() if p.suffix.lower() in suffixes)
+    if not files:
+        raise GearshotError(f"{str(path)!r} holds no recording ({sorted(suffixes)})")
+    return files
+
+
+def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, speed, load,
+                       coverage=0.9, gear_teeth=38, pinion_teeth=17, seed=0,
+                       selection_tf=None):
+    """Fit the estimator from files and predict every SA segment of ``recordings``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``recording, segment, predicted, low, high``.
+    """
+    from .estimator import OneFaultShotEstimator
+    from .experiments import recording_segments
+    from .sim import load_database
+    from .transfer import TransferFunctionBank
+
+    for p in [*healthy, faulty]:
+        if not Path(p).is_file():
+            raise GearshotError(f"recording {str(p)!r} does not exist")
+    db = load_database(database, speed=speed, load=load)
+    kw = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
+    healthy_sa, long = [], None
+    for i, p in enumerate(healthy):
+        if i == 0:
+            sa, long = recording_segments(p, long=True, **kw)
+        else:
+            sa = recording_segments(p, **kw)
+        healthy_sa.append(sa)
+    example = recording_segments(faulty, **kw)[0]
+    if selection_tf is None:
+        selection_tf = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
+    est = OneFaultShotEstimator(random_state=seed)
+    est.fit(db, np.vstack(healthy_sa), example, faulty_size, long, selection_tf=selection_tf)
+    frames = []
+    for path in _recording_files(Path(recordings)):
+        sa = recording_segments(path, **kw)
+        low, high = est.predict_interval(sa, coverage=coverage)
+        frames.append(pd.DataFrame(dict(recording=str(path), segment=np.arange(len(sa)),
+                                        predicted=est.predict(sa), low=low, high=high)))
+    return pd.concat(frames, ignore_index=True)

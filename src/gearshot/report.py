@@ -1,0 +1,32 @@
+"""Markdown report gathering an experiment's tables and figures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = ["write_report"]
+
+
+def write_report(folder, summary: dict, figures: dict) -> Path:
+    """Write ``report.md`` in ``folder`` from a results summary and {caption: png path}."""
+    folder = Path(folder)
+    lines = ["# gearshot report", ""]
+    if "speed" in summary:
+        lines += [f"Condition: {summary['speed']:g} rps, {summary['load']:g} Nm; "
+                  f"seed {summary.get('seed')}.", ""]
+    if "mae" in summary:
+        lines += [f"**Full algorithm MAE: {summary['mae']:.1f} %**", ""]
+    if summary.get("ablations"):
+        lines += ["| variant | MAE [%] |", "|---|---|"]
+        lines += [f"| {k} | {v:.1f} |" for k, v in summary["ablations"].items()]
+        lines.append("")
+    for key in ("grade", "rig_grade", "selected_features", "n_neighbors", "feature_errors"):
+        if key in summary:
+            lines.append(f"* {key.replace('_', ' ')}: {summary[key]}")
+    lines.append("")
+    for caption, path in figures.items():
+        rel = Path(path).relative_to(folder) if Path(path).is_relative_to(folder) else path
+        lines += [f"## {caption}", "", f"![{caption}]({rel})", ""]
+    path = folder / "report.md"
+    path.write_text("\n".join(lines))
+    return path

@@ -1,0 +1,138 @@
+"""From a shaft tacho to gear-revolution cycles: angle domain and SA segments.
+
+The SA cycle is one revolution of the driven gear (``gear_teeth`` teeth). The tacho usually
+sits on the input (pinion) shaft, and one gear revolution is ``gear_teeth / pinion_teeth``
+pinion revolutions (38/17 for the paper's pair) -- not an integer. Re-sampling on the pinion
+angle with an integer number of samples per *gear* cycle is therefore impossible in general
+(2048 * 17 / 38 samples per pinion revolution is not an integer). Instead the signal is
+re-sampled directly on the gear angle:
+
+1. ``pulse_times`` gives the tacho pulse times t_k; pulse k sits at tacho-shaft angle
+   k / pulses_per_rev revolutions.
+2. The gear angle is the tacho-shaft angle times ``pinion_teeth / gear_teeth`` (input-shaft
+   tacho) or 1 (output-shaft tacho). Gear revolution m therefore starts at tacho-shaft angle
+   m * gear_teeth / pinion_teeth revolutions.
+3. The time of that angle comes from :func:`gearshot.signal.angle_to_time` (cubic spline of
+   the pulse times against angle) -- the same curve the angular re-sampler uses. These
+   "virtual gear pulses" (one per gear revolution) go to ``angular_resample`` with
+   ``pulses_per_rev=1`` and ``samples_per_rev = samples_per_cycle``.
+4. The angle-domain signal is cut into whole gear cycles; consecutive blocks of
+   ``cycles_per_segment`` cycles are synchronously averaged (the incomplete tail is dropped).
+
+Gear cycle 0 starts at the first tacho pulse. The absolute gear orientation at that pulse
+is not known from an input-shaft tacho, so SAs of *different* recordings may be circularly
+shifted against each other (by whole teeth and fractions); SAs of one recording are aligned.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from .._errors import GearshotError
+from .._validation import check_int
+from ..signal import angle_to_time
+
+__all__ = [
+    "check_pulse_train",
+    "gear_cycle_times",
+    "uniform_cycle_times",
+    "TACHO_SHAFTS",
+]
+
+TACHO_SHAFTS = ("input", "output")
+
+#: A pulse interval longer than this many median intervals counts as a dropout.
+DROPOUT_FACTOR = 1.5
+
+
+def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) -> np.ndarray:
+    """Validate tacho pulse times (s): enough pulses, increasing, no glitch, no long dropout.
+
+    A gap longer than ``DROPOUT_FACTOR`` median pulse intervals is a dropout (missing
+    pulses). A dropout that spans more than one revolution (more than ``pulses_per_rev``
+    intervals; with one pulse per revolution, *any* missing pulse) cannot be bridged
+    reliably and raises. Shorter dropouts (possible with several pulses per revolution)
+    are bridged by inserting the missing pulses evenly. An interval shorter than half the
+    median (an extra pulse: electrical glitch, double trigger) raises.
+
+    Returns
+    -------
+    ndarray
+        The pulse times, with bridged dropouts filled in.
+    """
+    pulses = np.asarray(pulses, dtype=np.float64).ravel()
+    if pulses.size < 2 * pulses_per_rev + 1:
+        raise GearshotError(f"{label}: the tacho shows {pulses.size} pulse(s); at least "
+                            f"{2 * pulses_per_rev + 1} are needed (empty or flat tacho?)")
+    gaps = np.diff(pulses)
+    if np.any(gaps <= 0):
+        raise GearshotError(f"{label}: tacho pulse times are not increasing")
+    med = float(np.median(gaps))
+    short = np.flatnonzero(gaps < 0.5 * med)
+    if short.size:
+        i = int(short[0])
+        raise GearshotError(
+            f"{label}: extra tacho pulse at t={pulses[i + 1]:.4g} s ({gaps[i] / med:.2f} "
+            f"median intervals after the previous one); {short.size} such glitch(es)")
+    long = np.flatnonzero(gaps > DROPOUT_FACTOR * med)
+    if long.size:
+        spans = np.rint(gaps[long] / med).astype(np.int64)  # intervals the gap covers
+        bad = np.flatnonzero(spans > pulses_per_rev)
+        if bad.size:
+            i = int(long[bad[0]])
+            raise GearshotError(
+                f"{label}: tacho dropout of {gaps[i]:.4g} s ({gaps[i] / med:.2f} pulse "
+                f"intervals, more than one revolution at tacho_pulses_per_rev="
+                f"{pulses_per_rev}) after the pulse at t={pulses[i]:.4g} s; {bad.size} such "
+                f"gap(s)")
+        pieces = [pulses[: long[0] + 1]]
+        for j, (i, k) in enumerate(zip(long, spans)):
+            a, b = pulses[i], pulses[i + 1]
+            pieces.append(a + (b - a) * np.arange(1, k) / k)
+            stop = long[j + 1] + 1 if j + 1 < long.size else pulses.size
+            pieces.append(pulses[i + 1: stop])
+        pulses = np.concatenate(pieces)
+    return pulses
+
+
+def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
+                     pulses_per_rev: int = 1, tacho_shaft: str = "input") -> np.ndarray:
+    """Times (s) at which the driven gear completes whole revolutions.
+
+    Parameters
+    ----------
+    pulses : ndarray, shape (n_pulses,)
+        Tacho pulse times in s, ``pulses_per_rev`` per revolution of the tacho shaft.
+    gear_teeth, pinion_teeth : int
+        Tooth counts of the driven gear and the pinion.
+    pulses_per_rev : int
+        Tacho pulses per revolution of its shaft.
+    tacho_shaft : {"input", "output"}
+        The shaft the tacho watches: the input (pinion) or output (gear) shaft.
+
+    Returns
+    -------
+    ndarray, shape (n_cycles + 1,)
+        Start time of gear revolution 0 (the first pulse), 1, ... up to the last revolution
+        that ends before the last pulse.
+    """
+    gear_teeth = check_int(gear_teeth, "gear_teeth", minimum=1)
+    pinion_teeth = check_int(pinion_teeth, "pinion_teeth", minimum=1)
+    pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    if tacho_shaft not in TACHO_SHAFTS:
+        raise GearshotError(f"tacho_shaft must be one of {TACHO_SHAFTS}; got {tacho_shaft!r}")
+    pulses = np.asarray(pulses, dtype=np.float64)
+    shaft_revs = np.arange(pulses.size) / pulses_per_rev
+    revs_per_cycle = gear_teeth / pinion_teeth if tacho_shaft == "input" else 1.0
+    n_cycles = int(np.floor(shaft_revs[-1] / revs_per_cycle + 1e-9))
+    targets = np.arange(n_cycles + 1) * revs_per_cycle
+    return angle_to_time(pulses, targets, pulses_per_rev=pulses_per_rev)
+
+
+def uniform_cycle_times(cycle_times: np.ndarray) -> np.ndarray:
+    """Equally spaced cycle times with the same first and last value (constant speed).
+
+    Used to show what skipping angular re-sampling costs: the signal is then cut at the
+    *mean* cycle period, as a plain time-domain synchronous average would do.
+    """
+    c = np.asarray(cycle_times, dtype=np.float64)
+    return np.linspace(c[0], c[-1], c.size)

@@ -1,0 +1,145 @@
+"""The virtual rig's physics engine on top of the gear-pair simulator
+(:func:`gearshot.sim.simulate`), which integrates the whole run with the time-varying
+speed and load.
+
+How the hidden reality reaches the simulator:
+
+* masses, inertias, bearing stiffness, shaft stiffness (shear modulus), mesh stiffness
+  (Young's modulus of the wheels) and modal damping of :meth:`GearPair.paper` are scaled by
+  the reality's factors;
+* the true DIN grade, with profile errors drawn from the reality's ``profile_seed`` on
+  every run (the rig always runs the same wheels);
+* the fault: the reality's centre and depth coefficient; its edge offsets widen/narrow and
+  shift the cut, so the physical fault differs from the nominal label ``y``.
+  ``simulate`` builds its own :class:`~gearshot.sim.FullToothFaceFault` (a circular arc)
+  from size/centre/depth and takes no fault object, so the reality's ``fault_roughness``
+  (depth varying along the profile) is not applied by this engine yet (it is by
+  :class:`~gearshot.rig.surrogate.SurrogateEngine`). :class:`IrregularFaceFault` is the
+  fault object to pass once ``simulate`` accepts one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._errors import GearshotError
+from .._validation import check_int
+from ..sim.faults import FullToothFaceFault
+from .reality import RigReality
+
+__all__ = ["SimulatorEngine", "IrregularFaceFault", "perturbed_pair", "physical_fault"]
+
+
+@dataclass(frozen=True)
+class IrregularFaceFault(FullToothFaceFault):
+    """A full tooth face fault whose depth varies along the profile: the arc-shaped cut of
+    :class:`~gearshot.sim.FullToothFaceFault` scaled by
+    ``1 + sum_k roughness[k] cos((k + 1) pi x)``, x = 0 ... 1 across the cut, in both the
+    section loss (stiffness) and the displacement excitation.
+
+    Parameters
+    ----------
+    roughness : tuple of float
+        Relative amplitudes; their absolute sum must stay below 1 (the cut stays a cut).
+    """
+
+    roughness: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        rough = tuple(float(r) for r in self.roughness)
+        if not all(np.isfinite(rough)) or sum(abs(r) for r in rough) >= 1.0:
+            raise GearshotError(f"roughness must be finite with absolute sum < 1; got "
+                                f"{self.roughness!r}")
+        object.__setattr__(self, "roughness", rough)
+
+    def depth_profile(self, s: np.ndarray) -> np.ndarray:
+        """Depth factor at roll fractions ``s`` (1 outside the cut)."""
+        s = np.asarray(s, dtype=float)
+        s0, s1 = self.window
+        if s1 <= s0:
+            return np.ones_like(s)
+        x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
+        return 1.0 + sum(r * np.cos((k + 1) * np.pi * x) for k, r in enumerate(self.roughness))
+
+    def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
+        base = super().section_loss(pair, x)
+        if self.is_healthy:
+            return base
+        (xa, _), (xb, _) = self._edges(pair)
+        s0, s1 = self.window
+        s = s0 + (np.asarray(x, dtype=float) - xa) / (xb - xa) * (s1 - s0)  # ~linear map
+        return base * self.depth_profile(s)
+
+    def displacement(self, pair, s: np.ndarray) -> np.ndarray:
+        return super().displacement(pair, s) * self.depth_profile(s)
+
+
+def perturbed_pair(pair, reality: RigReality | None):
+    """``pair`` with the reality's mass/inertia/stiffness/damping factors applied."""
+    if reality is None:
+        return pair
+    m1, m2 = pair.masses
+    j1, j2 = pair.inertias
+    g = (pair.shear_modulus_shaft if pair.shear_modulus_shaft is not None
+         else pair.youngs_modulus / (2 * (1 + pair.poisson)))
+    mp, mg = reality.mass_factor
+    ip, ig = reality.inertia_factor
+    return pair.replace(
+        mass_pinion=m1 * mp, mass_gear=m2 * mg,
+        inertia_pinion=j1 * ip, inertia_gear=j2 * ig,
+        bearing_stiffness=pair.bearing_stiffness * reality.bearing_stiffness_factor,
+        shear_modulus_shaft=g * reality.shaft_stiffness_factor,
+        youngs_modulus=pair.youngs_modulus * reality.mesh_stiffness_factor,
+        damping_ratio=min(pair.damping_ratio * reality.damping_factor, 0.5))
+
+
+def physical_fault(size: float, reality: RigReality | None) -> tuple[float, float, float]:
+    """(size, centre, depth) of the cut actually made for a fault labelled ``size``."""
+    if reality is None or size <= 0:
+        return float(size), 0.5, 0.5
+    e0, e1 = reality.fault_edges
+    lo = reality.fault_center - 0.5 * size * (1 + e0)
+    hi = reality.fault_center + 0.5 * size * (1 + e1)
+    lo, hi = max(lo, 0.0), min(hi, 1.0)
+    return hi - lo, 0.5 * (lo + hi), reality.fault_depth
+
+
+@dataclass(frozen=True)
+class SimulatorEngine:
+    """Physics engine for :class:`~gearshot.rig.VirtualRig` backed by the simulator.
+
+    Parameters
+    ----------
+    pair : GearPair, optional
+        Nominal gear pair (default :meth:`GearPair.paper`).
+    nominal_grade : int
+        DIN grade used when ``reality`` is None (the nominal model).
+    """
+
+    pair: object = field(default=None)
+    nominal_grade: int = 7
+
+    def __post_init__(self) -> None:
+        check_int(self.nominal_grade, "nominal_grade", minimum=1, maximum=12)
+
+    def __call__(self, *, motor_revs: np.ndarray, load_torque: np.ndarray, fs: float,
+                 fault_size: float, reality: RigReality | None,
+                 rng: np.random.Generator) -> np.ndarray:
+        from ..sim import GearPair, simulate
+
+        nominal = self.pair if self.pair is not None else GearPair.paper()
+        pair = perturbed_pair(nominal, reality)
+        revs = np.asarray(motor_revs, dtype=np.float64)
+        speed = np.gradient(revs) * fs
+        size, center, depth = physical_fault(fault_size, reality)
+        if reality is None:
+            grade, prng = self.nominal_grade, rng
+        else:
+            grade, prng = reality.grade, np.random.default_rng(reality.profile_seed)
+        res = simulate(pair, speed=speed, load=np.asarray(load_torque, dtype=np.float64),
+                       grade=grade, fault_sizes=[size], fs=fs, duration=revs.size / fs,
+                       rng=prng, fault_center=center, fault_depth=depth)
+        return res.acceleration[0]

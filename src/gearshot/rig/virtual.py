@@ -1,0 +1,360 @@
+"""`VirtualRig`: recordings from a hidden "reality", and Table-1 style campaigns.
+
+Signal chain of one recording (all at ``fs``, integrated over the whole run):
+
+1. input-shaft angle with slow speed drift (<= 1 %) and a once-per-revolution ripple,
+   starting at a random relative position of the wheels (:func:`motion.motor_angle`);
+   load torque with a once-per-output-revolution ripple (:func:`motion.load_torque`);
+2. the physics engine: gear vibration (g) for that angle and load history, with the
+   rig's true grade, perturbed masses/stiffnesses/damping and irregular fault;
+3. non-synchronous interference: motor electrical harmonics, an extra shaft at a
+   non-integer order, bearing-like impacts (:mod:`.interference`);
+4. the transfer path to the sensor: a TF from the bank, 10-30 dB attenuation
+   (:mod:`.path`);
+5. sensor noise at 20-30 dB SNR; a 1-pulse-per-revolution input-shaft tacho with jitter.
+
+A settling time (``settle`` s) is simulated before the recorded span and dropped, so
+neither the engine's nor the transfer path's start-up transient is recorded.
+
+The physics engine is pluggable: any callable
+``engine(*, motor_revs, load_torque, fs, fault_size, reality, rng) -> acceleration`` with
+``motor_revs``/``load_torque`` arrays of shape (n,) (rev, N m), ``reality`` a
+:class:`~gearshot.rig.reality.RigReality` (``None`` = the nominal model) and ``rng`` a
+``numpy.random.Generator``, returning the vibration in g, shape (n,). The default is
+:class:`~gearshot.rig.sim_engine.SimulatorEngine` (the gear-pair simulator, integrating the
+whole run); :class:`~gearshot.rig.surrogate.SurrogateEngine` is a fast stand-in.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import shutil
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .._errors import GearshotError
+from .._validation import check_in_range, check_int, check_positive
+from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics, rms
+from .motion import load_torque, motor_angle
+from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
+from .reality import RigReality, draw_reality
+from .recording import Recording
+from .sim_engine import SimulatorEngine
+from .surrogate import SurrogateEngine
+from .tacho import tacho_signal
+
+__all__ = ["VirtualRig", "read_campaign", "INDEX_NAME", "INDEX_COLUMNS"]
+
+INDEX_NAME = "index.csv"
+INDEX_COLUMNS = ["path", "speed", "load", "fault_size", "repetition"]
+
+
+def _key(value: float) -> int:
+    return int(round(float(value) * 1_000_000))
+
+
+class VirtualRig:
+    """A virtual gear test rig with seeded hidden "reality" parameters.
+
+    Parameters
+    ----------
+    seed : int
+        Seeds everything: the hidden reality (drawn once) and, together with the condition
+        and repetition, every recording -- the same call gives the same recording.
+    engine : {"sim", "surrogate"} or callable, optional
+        Physics engine (see the module docstring): ``"sim"`` (default,
+        :class:`~gearshot.rig.sim_engine.SimulatorEngine`, the gear-pair simulator),
+        ``"surrogate"`` (:class:`SurrogateEngine`, a fast stand-in) or any callable.
+    tf_bank : folder path or sequence of TFs, optional
+        Transfer-path bank (measured FRFs or TF-like objects with ``freqs``/``values``);
+        default: 8 synthetic modal TFs drawn from ``seed``. The reality picks one.
+    fs : float
+        Sampling rate, Hz (50 kHz).
+    gear_teeth, pinion_teeth : int
+        Tooth counts (38, 17: the paper's pair); the tacho is on the pinion shaft.
+    settle : float
+        Seconds simulated before each recording and dropped.
+    grade : int, optional
+        Force the rig's true DIN grade (default: drawn, hidden).
+    reality_overrides : mapping, optional
+        Fields of the hidden :class:`RigReality` to set instead of drawing them (see
+        :meth:`with_reality`).
+
+    Notes
+    -----
+    Arguments are stored as given; the reality, the TF and its FIR are built on first use.
+    """
+
+    def __init__(self, seed: int = 0, *, engine: str | Callable[..., np.ndarray] | None = None,
+                 tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = 38,
+                 pinion_teeth: int = 17, settle: float = 0.25, grade: int | None = None,
+                 reality_overrides: Mapping[str, Any] | None = None):
+        self.seed = seed
+        self.engine = engine
+        self.tf_bank = tf_bank
+        self.fs = fs
+        self.gear_teeth = gear_teeth
+        self.pinion_teeth = pinion_teeth
+        self.settle = settle
+        self.grade = grade
+        self.reality_overrides = reality_overrides
+        self._built: tuple[RigReality, np.ndarray, str] | None = None
+
+    def _params(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in ("seed", "engine", "tf_bank", "fs", "gear_teeth",
+                                              "pinion_teeth", "settle", "grade",
+                                              "reality_overrides")}
+
+    def with_reality(self, **changes: Any) -> VirtualRig:
+        """A copy of this rig whose hidden reality has some fields set (e.g.
+        ``attenuation_db=20``, ``grade=9``, ``snr_db=25``); everything else is unchanged.
+        For controlled experiments; see :class:`RigReality` for the fields."""
+        params = self._params()
+        params["reality_overrides"] = {**(self.reality_overrides or {}), **changes}
+        rig = VirtualRig(**params)
+        rig._build()  # validate now
+        return rig
+
+    # ------------------------------------------------------------------ hidden state
+    def _build(self) -> tuple[RigReality, np.ndarray, str]:
+        if self._built is None:
+            seed = check_int(self.seed, "seed", minimum=0)
+            fs = check_positive(self.fs, "fs")
+            check_int(self.gear_teeth, "gear_teeth", minimum=2)
+            check_int(self.pinion_teeth, "pinion_teeth", minimum=2)
+            check_positive(self.settle, "settle", allow_zero=True)
+            if self.tf_bank is None:
+                tfs = synthetic_path_tfs(8, rng=np.random.default_rng([seed, 3]), band=fs / 2)
+            else:
+                tfs = as_tf_list(self.tf_bank)
+            reality = draw_reality(np.random.default_rng([seed, 1]), n_tfs=len(tfs),
+                                   gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
+            overrides = dict(self.reality_overrides or {})
+            if self.grade is not None:
+                overrides["grade"] = self.grade
+            reality = _override(reality, overrides, n_tfs=len(tfs))
+            tf = tfs[reality.tf_index]
+            fir = path_fir(tf, fs, attenuation_db=reality.attenuation_db,
+                           n_taps=min(2 * (tf.freqs.size - 1), 16384))
+            self._built = (reality, fir, tf.name)
+        return self._built
+
+    def reveal(self) -> RigReality:
+        """The hidden reality -- for validating the rig only; an estimator must not use it."""
+        return self._build()[0]
+
+    def reveal_path(self) -> tuple[str, np.ndarray]:
+        """Name of the hidden transfer-path TF and its FIR (per sample) -- validation only."""
+        _, fir, name = self._build()
+        return name, fir.copy()
+
+    def _engine(self) -> Callable[..., np.ndarray]:
+        if self.engine is None or self.engine == "sim":
+            return SimulatorEngine()
+        if self.engine == "surrogate":
+            return SurrogateEngine(gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
+        if not callable(self.engine):
+            raise GearshotError(f"engine must be 'sim', 'surrogate' or a callable; got "
+                                f"{self.engine!r}")
+        return self.engine
+
+    # ------------------------------------------------------------------ one recording
+    def record(self, *, speed: float, load: float, fault_size: float = 0.0,
+               duration: float = 60.0, repetition: int = 0) -> Recording:
+        """Run the rig once and record it.
+
+        Parameters
+        ----------
+        speed : float
+            Nominal input-shaft speed, rev/s.
+        load : float
+            Nominal load torque, N m.
+        fault_size : float
+            Fault size y in [0, 1] (0 = healthy).
+        duration : float
+            Recorded length, s.
+        repetition : int
+            Repetition number (a different run of the same condition).
+
+        Returns
+        -------
+        Recording
+            Acceleration in g, the input-shaft tacho, metadata (no hidden parameters).
+        """
+        reality, fir, _ = self._build()
+        speed = check_positive(speed, "speed")
+        load = check_positive(load, "load")
+        fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
+        duration = check_positive(duration, "duration")
+        repetition = check_int(repetition, "repetition", minimum=0)
+        fs = float(self.fs)
+        rng = np.random.default_rng([int(self.seed), 2, _key(speed), _key(load),
+                                     _key(fault_size), repetition])
+        n_settle = int(round(self.settle * fs))
+        n = int(round(duration * fs))
+        t = np.arange(n_settle + n) / fs
+        # relative position of the wheels at the start: a whole number of pinion turns
+        # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
+        start = float(rng.integers(0, self.gear_teeth))
+        motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
+                            ripple=reality.speed_ripple, rng=rng, start=start)
+        torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
+                             ripple=reality.load_ripple, rng=rng)
+        vib = np.asarray(self._engine()(motor_revs=motor, load_torque=torque, fs=fs,
+                                        fault_size=fault_size, reality=reality, rng=rng),
+                         dtype=np.float64)
+        if vib.shape != motor.shape or not np.all(np.isfinite(vib)):
+            raise GearshotError(f"the physics engine returned shape {vib.shape} or non-finite "
+                                f"values; expected {motor.shape} finite")
+        level = rms(vib[n_settle:])
+        vib = vib + level * (
+            reality.motor_level * motor_harmonics(t, speed=speed,
+                                                  pole_pairs=reality.motor_pole_pairs,
+                                                  slip=reality.motor_slip, rng=rng)
+            + reality.extra_level * extra_shaft(motor, order=reality.extra_order, rng=rng)
+            + reality.impact_level * bearing_impacts(motor, fs, order=reality.impact_order,
+                                                     frequency=reality.impact_frequency,
+                                                     rng=rng))
+        acc = apply_path(vib, fir)[n_settle:]
+        acc = add_noise(acc, snr_db=reality.snr_db, rng=rng)
+        tach = tacho_signal(motor[n_settle:], jitter=reality.tacho_jitter, rng=rng)
+        return Recording(
+            acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
+            source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
+            extras={"repetition": repetition, "rig_seed": int(self.seed),
+                    "engine": type(self._engine()).__name__})
+
+    # ------------------------------------------------------------------ campaigns
+    @staticmethod
+    def file_name(speed: float, load: float, fault_size: float, repetition: int) -> str:
+        """File name of one campaign recording, e.g. ``s15_l10_y0.56_r3.h5``."""
+        return f"s{speed:g}_l{load:g}_y{fault_size:.2f}_r{repetition}.h5"
+
+    def campaign(self, folder: str | os.PathLike, *, speed: float, load: float,
+                 duration: float = 60.0, healthy: int = 6,
+                 sizes: Sequence[float] = (0.32, 0.56, 0.66), repetitions: int = 6,
+                 dtype: str = "float32", progress: bool = True) -> pd.DataFrame:
+        """Record one condition as in the paper's Table 1 and write it to ``folder``.
+
+        ``healthy`` healthy recordings and ``repetitions`` recordings per fault size, each
+        ``duration`` s, written as native HDF5 recordings (``dtype`` samples) plus an index
+        ``index.csv`` (rows of other conditions already in the folder are kept; rows of
+        this condition are replaced).
+
+        Everything is first written to a hidden staging folder inside ``folder``; only when
+        all recordings succeeded are they moved into place (``os.replace``) and the index
+        replaced. A failed campaign leaves no partial file behind and the old index intact.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``path`` (absolute), ``speed``, ``load``, ``fault_size``, ``repetition``;
+            one row per recording of this condition.
+        """
+        folder = Path(folder)
+        speed = check_positive(speed, "speed")
+        load = check_positive(load, "load")
+        healthy = check_int(healthy, "healthy", minimum=0)
+        repetitions = check_int(repetitions, "repetitions", minimum=0)
+        sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
+        check_positive(duration, "duration")
+        self._build()
+        jobs = [(0.0, r) for r in range(healthy)] + [(y, r) for y in sizes
+                                                     for r in range(repetitions)]
+        if not jobs:
+            raise GearshotError("the campaign holds no recording (healthy=0 and no sizes)")
+        folder.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=".campaign-", dir=folder))
+        try:
+            rows = []
+            from rich.progress import track
+
+            for y, r in track(jobs, description=f"rig {speed:g} rev/s {load:g} N m",
+                              disable=not progress):
+                rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
+                                  repetition=r)
+                name = self.file_name(speed, load, y, r)
+                rec.write(staging / name, dtype=dtype)
+                rows.append({"path": name, "speed": speed, "load": load, "fault_size": y,
+                             "repetition": r})
+            new = pd.DataFrame(rows, columns=INDEX_COLUMNS)
+            index_path = folder / INDEX_NAME
+            if index_path.exists():
+                old = pd.read_csv(index_path)
+                if list(old.columns) != INDEX_COLUMNS:
+                    raise GearshotError(f"{str(index_path)!r} is not a campaign index "
+                                        f"(columns {list(old.columns)})")
+                same = np.isclose(old["speed"], speed) & np.isclose(old["load"], load)
+                new_index = pd.concat([old[~same], new], ignore_index=True)
+            else:
+                new_index = new
+            new_index.to_csv(staging / INDEX_NAME, index=False)
+            for name in new["path"]:
+                os.replace(staging / name, folder / name)
+            os.replace(staging / INDEX_NAME, index_path)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+        out = new.copy()
+        out["path"] = [str((folder / p).resolve()) for p in out["path"]]
+        return out
+
+
+_RANGES = {  # field -> (low, high) accepted by with_reality / reality_overrides
+    "snr_db": (0.0, 200.0), "attenuation_db": (-60.0, 200.0), "speed_drift": (0.0, 0.05),
+    "speed_ripple": (0.0, 0.05), "load_ripple": (0.0, 0.5), "motor_level": (0.0, 10.0),
+    "extra_level": (0.0, 10.0), "impact_level": (0.0, 10.0), "tacho_jitter": (0.0, 0.01),
+    "fault_center": (0.0, 1.0), "fault_depth": (0.01, 1.0), "damping_factor": (0.1, 10.0),
+    "bearing_stiffness_factor": (0.1, 10.0), "shaft_stiffness_factor": (0.1, 10.0),
+    "mesh_stiffness_factor": (0.1, 10.0), "motor_slip": (0.0, 0.5),
+    "impact_frequency": (1.0, 1e6), "extra_order": (0.01, 1000.0),
+    "impact_order": (0.01, 1000.0),
+}
+
+
+def _override(reality: RigReality, changes: Mapping[str, Any], *, n_tfs: int) -> RigReality:
+    """``reality`` with validated field changes."""
+    fields = set(reality.as_dict())
+    out: dict[str, Any] = {}
+    for key, value in changes.items():
+        if key not in fields:
+            raise GearshotError(f"reality has no field {key!r}; fields: {sorted(fields)}")
+        if key == "grade":
+            out[key] = check_int(value, "grade", minimum=1, maximum=12)
+        elif key == "tf_index":
+            out[key] = check_int(value, "tf_index", minimum=0, maximum=n_tfs - 1)
+        elif key in ("profile_seed", "motor_pole_pairs"):
+            out[key] = check_int(value, key, minimum=0 if key == "profile_seed" else 1)
+        elif key in _RANGES:
+            out[key] = check_in_range(value, key, *_RANGES[key])
+        else:  # tuples: mass/inertia factors, fault edges/roughness
+            arr = tuple(float(v) for v in value)
+            if len(arr) != len(getattr(reality, key)):
+                raise GearshotError(f"{key} must hold {len(getattr(reality, key))} numbers; "
+                                    f"got {value!r}")
+            out[key] = arr
+    return dataclasses.replace(reality, **out)
+
+
+def read_campaign(folder: str | os.PathLike) -> pd.DataFrame:
+    """The index of a campaign folder, with absolute paths."""
+    folder = Path(folder)
+    index_path = folder / INDEX_NAME
+    if not index_path.is_file():
+        raise GearshotError(f"{str(folder)!r} holds no campaign index ({INDEX_NAME})")
+    try:
+        frame = pd.read_csv(index_path)
+    except Exception as exc:
+        raise GearshotError(f"cannot read {str(index_path)!r}: {exc}") from None
+    if list(frame.columns) != INDEX_COLUMNS:
+        raise GearshotError(f"{str(index_path)!r} has columns {list(frame.columns)}; "
+                            f"expected {INDEX_COLUMNS}")
+    frame["path"] = [str((folder / p).resolve()) for p in frame["path"]]
+    return frame
+
+

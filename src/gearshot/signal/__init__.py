@@ -1,0 +1,32 @@
+"""Pure signal-processing functions for gear vibration.
+
+Batching convention: every function takes signals along the **last axis**; any leading
+axes are batch axes and are preserved (``(n_signals, n_points)`` for a stack of
+synchronous averages). Options are keyword-only. Bad input raises
+:class:`gearshot.GearshotError` naming the parameter.
+"""
+
+from .alignment import fractional_shift, subtract_healthy
+from .angular import angle_to_time, angular_resample, pulse_times
+from .averaging import synchronous_average
+from .cepstrum import minimum_phase, real_cepstrum
+from .envelope import envelope
+from .orders import difference_signal, harmonic_signal, order_mask
+from .spectra import acs_background, amplitude_spectrum
+
+__all__ = [
+    "pulse_times",
+    "angle_to_time",
+    "angular_resample",
+    "synchronous_average",
+    "harmonic_signal",
+    "difference_signal",
+    "order_mask",
+    "envelope",
+    "amplitude_spectrum",
+    "acs_background",
+    "real_cepstrum",
+    "minimum_phase",
+    "fractional_shift",
+    "subtract_healthy",
+]

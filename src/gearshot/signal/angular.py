@@ -1,0 +1,172 @@
+"""Tacho pulses and resampling from time to shaft angle."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.ndimage
+import scipy.signal
+from scipy.interpolate import CubicSpline, PchipInterpolator
+
+from .._errors import GearshotError
+from .._validation import as_signal_array, check_in_range, check_int, check_positive
+
+__all__ = ["pulse_times", "angular_resample", "angle_to_time"]
+
+
+def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1):
+    """Times of the rising edges of a tacho signal, interpolated between samples.
+
+    An edge is where the signal crosses ``threshold`` upwards after having been below
+    ``threshold - hysteresis * (high - low)`` since the previous edge (a Schmitt trigger, so
+    noise on a slow edge yields one pulse). The crossing time is interpolated linearly
+    between the two samples around it.
+
+    Parameters
+    ----------
+    tacho : array_like, shape (n,)
+        TTL or analog once-(or more)-per-revolution signal.
+    fs : float
+        Sampling rate, Hz.
+    threshold : float, optional
+        Trigger level. Default: midway between the 1st and 99th percentiles.
+    hysteresis : float, default 0.1
+        Re-arm margin as a fraction of the percentile range.
+
+    Returns
+    -------
+    ndarray, shape (n_pulses,)
+        Pulse times in seconds from the first sample (strictly increasing).
+    """
+    tacho = as_signal_array(tacho, "tacho", max_ndim=1, min_length=2)
+    fs = check_positive(fs, "fs")
+    hysteresis = check_in_range(hysteresis, "hysteresis", 0.0, 1.0)
+    low, high = np.percentile(tacho, [1, 99])
+    if threshold is None:
+        if high <= low:
+            raise GearshotError("tacho is constant; it holds no pulses")
+        threshold = 0.5 * (low + high)
+    threshold = float(threshold)
+    if not np.isfinite(threshold):
+        raise GearshotError(f"threshold must be finite; got {threshold}")
+    rearm = threshold - hysteresis * max(high - low, 0.0)
+    above = tacho >= threshold
+    up = np.flatnonzero(~above[:-1] & above[1:]) + 1  # first sample at/above threshold
+    below = np.flatnonzero(tacho < rearm) if hysteresis > 0 else np.flatnonzero(~above)
+    if up.size and below.size:
+        last_below = np.searchsorted(below, up) - 1
+        valid = last_below >= 0
+        up, last_below = up[valid], last_below[valid]
+        # keep the first up-crossing after each re-arming
+        keep = np.r_[True, last_below[1:] != last_below[:-1]]
+        up = up[keep]
+    else:
+        up = up[:0]
+    x0, x1 = tacho[up - 1], tacho[up]
+    frac = (threshold - x0) / (x1 - x0)
+    return (up - 1 + frac) / fs
+
+
+def _check_pulses(pulse_times, name="pulse_times"):
+    pulses = as_signal_array(pulse_times, name, max_ndim=1)
+    if pulses.size < 2:
+        raise GearshotError(f"{name} must hold at least 2 pulses; got {pulses.size}")
+    steps = np.diff(pulses)
+    if np.any(steps <= 0):
+        i = int(np.flatnonzero(steps <= 0)[0])
+        raise GearshotError(
+            f"{name} must be strictly increasing; pulse {i + 1} at {pulses[i + 1]!r} s "
+            f"does not follow pulse {i} at {pulses[i]!r} s")
+    return pulses
+
+
+def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
+    """Time at which the shaft reaches given angles, from its tacho pulses.
+
+    The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
+    revolutions from the first) is a cubic spline, so speed varies smoothly rather than
+    piecewise-constantly; where a spline would not be monotone (extreme speed jumps) a
+    monotone PCHIP is used instead.
+
+    Parameters
+    ----------
+    pulse_times : array_like, shape (n_pulses,)
+        Strictly increasing pulse times, s.
+    angles : array_like
+        Shaft angles in revolutions from the first pulse, within the pulsed span.
+    pulses_per_rev : int, default 1
+
+    Returns
+    -------
+    ndarray
+        Times, s.
+    """
+    pulses = _check_pulses(pulse_times)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    revs = np.arange(pulses.size) / ppr
+    if pulses.size >= 4:
+        curve = CubicSpline(revs, pulses)
+        if np.any(curve(revs[:-1] + 0.5 / ppr, 1) <= 0) or np.any(curve(revs, 1) <= 0):
+            curve = PchipInterpolator(revs, pulses)
+    else:
+        curve = PchipInterpolator(revs, pulses)
+    return curve(np.asarray(angles, dtype=float))
+
+
+def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2):
+    """Resample a time signal at equal steps of shaft angle.
+
+    The signal is over-sampled ×``upsample`` (polyphase FIR interpolation) and then read at
+    the instants the shaft passes each angle step, by cubic-spline interpolation. The time
+    of each angle comes from :func:`angle_to_time` (smooth spline through the pulses).
+    Only whole revolutions from the first pulse are returned.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., n_samples)
+        Time signal(s), sampled at ``fs`` from t = 0.
+    fs : float
+        Sampling rate, Hz.
+    pulse_times : array_like, shape (n_pulses,)
+        Tacho pulse times, s (e.g. from :func:`pulse_times`), at least 2, increasing.
+    samples_per_rev : int
+        Output samples per shaft revolution.
+    pulses_per_rev : int, default 1
+        Tacho pulses per shaft revolution.
+    upsample : int, default 2
+        Over-sampling factor before interpolation.
+
+    Returns
+    -------
+    ndarray, shape (..., n_revs * samples_per_rev)
+        Angle-domain signal starting at the first pulse.
+    """
+    x = as_signal_array(x, "x", min_length=4)
+    fs = check_positive(fs, "fs")
+    pulses = _check_pulses(pulse_times)
+    spr = check_int(samples_per_rev, "samples_per_rev", minimum=1)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    upsample = check_int(upsample, "upsample", minimum=1)
+    duration = x.shape[-1] / fs
+    if pulses[0] < 0 or pulses[-1] > (x.shape[-1] - 1) / fs:
+        raise GearshotError(
+            f"pulse_times span [{pulses[0]:.6g}, {pulses[-1]:.6g}] s, outside the signal "
+            f"(0 … {duration:.6g} s at fs={fs:g} Hz); is fs right?")
+    n_revs = (pulses.size - 1) // ppr
+    if n_revs < 1:
+        raise GearshotError(
+            f"pulse_times hold {pulses.size} pulses, less than one revolution at "
+            f"pulses_per_rev={ppr}")
+    angles = np.arange(n_revs * spr) / spr
+    times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
+    if upsample > 1:
+        x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1)
+    else:
+        x_fine = x
+    position = times * fs * upsample  # fractional sample index in x_fine
+    flat = x_fine.reshape(-1, x_fine.shape[-1])
+    out = np.empty((flat.shape[0], position.size))
+    for i, row in enumerate(flat):
+        coeffs = scipy.ndimage.spline_filter1d(row, order=3, mode="mirror")
+        out[i] = scipy.ndimage.map_coordinates(coeffs, position[None, :], order=3,
+                                               mode="mirror", prefilter=False)
+    return out.reshape(*x.shape[:-1], position.size)

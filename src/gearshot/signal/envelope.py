@@ -1,0 +1,27 @@
+"""Envelope by the analytic signal."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.signal
+
+from .._validation import as_signal_array
+
+__all__ = ["envelope"]
+
+
+def envelope(x):
+    """Envelope ``|hilbert(x)|`` along the last axis.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., n)
+        Real signal(s).
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+        Magnitude of the analytic signal (mean not removed).
+    """
+    x = as_signal_array(x, "x", min_length=2)
+    return np.abs(scipy.signal.hilbert(x, axis=-1))

@@ -1,0 +1,90 @@
+"""Order-domain separation of a synchronous average into mesh and residual parts."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+
+from .._validation import as_signal_array, check_int
+from ._common import check_mesh_order, mesh_band_orders
+
+__all__ = ["harmonic_signal", "difference_signal", "order_mask"]
+
+
+def order_mask(n_points, mesh_order, *, n_sidebands=2):
+    """Boolean mask over one-sided orders ``0 … n_points//2``; True on mesh bands.
+
+    Parameters
+    ----------
+    n_points : int
+        Samples per cycle.
+    mesh_order : int
+        Mesh order in the cycle (teeth of the wheel whose revolution is the cycle).
+    n_sidebands : int
+        Sidebands on each side of every mesh harmonic.
+
+    Returns
+    -------
+    mask : ndarray of bool, shape (n_points // 2 + 1,)
+    """
+    n_points = check_int(n_points, "n_points", minimum=2)
+    mesh_order = check_mesh_order(mesh_order, n_points)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
+    mask = np.zeros(n_points // 2 + 1, dtype=bool)
+    mask[mesh_band_orders(n_points, mesh_order, n_sidebands)] = True
+    return mask
+
+
+def _split(sa, mesh_order, n_sidebands, keep_mesh: bool):
+    sa = as_signal_array(sa, "sa", min_length=4)
+    n = sa.shape[-1]
+    mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
+    spectrum = scipy.fft.rfft(sa, axis=-1)
+    spectrum *= mask if keep_mesh else ~mask
+    return scipy.fft.irfft(spectrum, n=n, axis=-1)
+
+
+def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
+    """The mesh harmonics of a synchronous average and their sidebands.
+
+    Keeps orders ``k * mesh_order + s`` (``k >= 1``, ``|s| <= n_sidebands``) in both halves of
+    the spectrum and zeroes every other order, DC included. ``harmonic_signal + difference_signal
+    == sa`` exactly.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+        Synchronous average(s), one cycle each.
+    mesh_order : int
+        Gear-mesh order in the cycle (38 for the paper's gear revolution).
+    n_sidebands : int, default 2
+        Sidebands kept on each side of every harmonic.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+    """
+    return _split(sa, mesh_order, n_sidebands, keep_mesh=True)
+
+
+def difference_signal(sa, mesh_order, *, n_sidebands=2):
+    """A synchronous average with its mesh harmonics and sidebands removed.
+
+    Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and
+    ``|s| <= n_sidebands`` in both halves of the spectrum, keeps every other order (DC
+    included) untouched — the reference implementation's difference signal.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+        Synchronous average(s).
+    mesh_order : int
+        Gear-mesh order in the cycle.
+    n_sidebands : int, default 2
+        Sidebands removed on each side of every harmonic.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+    """
+    return _split(sa, mesh_order, n_sidebands, keep_mesh=False)

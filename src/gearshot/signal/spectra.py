@@ -1,0 +1,98 @@
+"""Amplitude spectrum and its ACS background (the smooth floor under tones)."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy.interpolate import PchipInterpolator
+
+from .._errors import GearshotError
+from .._validation import as_signal_array, check_in_range, check_int
+
+__all__ = ["amplitude_spectrum", "acs_background"]
+
+
+def amplitude_spectrum(x, *, nfft=2**15):
+    """Averaged amplitude spectrum over non-overlapping rectangular segments.
+
+    ``sqrt(sum_s |FFT(x_s)|^2 / (n_segments * nfft))`` over the ``n_segments = len(x) // nfft``
+    consecutive segments ``x_s`` (a trailing partial segment is ignored).
+
+    Parameters
+    ----------
+    x : array_like, shape (..., n_samples)
+        Long signal(s), ``n_samples >= nfft``.
+    nfft : int, default 2**15
+        Segment (and FFT) length.
+
+    Returns
+    -------
+    ndarray, shape (..., nfft)
+        Two-sided amplitude spectrum (index k ↔ k/nfft of the sampling rate).
+    """
+    nfft = check_int(nfft, "nfft", minimum=2)
+    x = as_signal_array(x, "x")
+    n_seg = x.shape[-1] // nfft
+    if n_seg < 1:
+        raise GearshotError(
+            f"x has {x.shape[-1]} samples, fewer than one segment of nfft={nfft}")
+    segs = x[..., : n_seg * nfft].reshape(*x.shape[:-1], n_seg, nfft)
+    power = np.abs(scipy.fft.fft(segs, axis=-1)) ** 2
+    return np.sqrt(power.sum(axis=-2) / (n_seg * nfft))
+
+
+def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
+                   symmetric=True):
+    """Background of a spectrum by segment percentiles (the reference's ACS).
+
+    The spectrum is cut into segments of ``segment_size`` bins advancing by
+    ``round(segment_size * (1 - overlap))``; each segment's ``percentile`` (Hazen
+    definition, as MATLAB's ``prctile``) is placed at the segment centre and the centres are
+    joined by PCHIP interpolation. Bins before the first centre take the first segment's
+    value, bins after the last centre the last one's. With ``symmetric=True`` the first half
+    (bins ``0 … L/2``) is mirrored onto the second, so the result is the background of a
+    real signal's two-sided spectrum.
+
+    Parameters
+    ----------
+    spectrum : array_like, shape (..., L)
+        Amplitude spectrum (e.g. from :func:`amplitude_spectrum`).
+    segment_size : int, default 200
+        Bins per segment; at most ``L``.
+    overlap : float, default 0.75
+        Fraction of a segment shared with the next, in [0, 1).
+    percentile : float, default 50
+        Percentile taken in each segment, in [0, 100].
+    symmetric : bool, default True
+        Mirror the first half onto the second.
+
+    Returns
+    -------
+    ndarray, shape (..., L)
+    """
+    spectrum = as_signal_array(spectrum, "spectrum", min_length=2)
+    length = spectrum.shape[-1]
+    segment_size = check_int(segment_size, "segment_size", minimum=2)
+    if segment_size > length:
+        raise GearshotError(
+            f"segment_size={segment_size} is larger than the spectrum ({length} bins)")
+    overlap = check_in_range(overlap, "overlap", 0.0, 1.0, high_inclusive=False)
+    percentile = check_in_range(percentile, "percentile", 0.0, 100.0)
+    step = max(1, int(round(segment_size * (1.0 - overlap))))
+
+    windows = sliding_window_view(spectrum, segment_size, axis=-1)[..., ::step, :]
+    values = np.percentile(windows, percentile, axis=-1, method="hazen")
+    centres = (segment_size - 1) / 2.0 + step * np.arange(values.shape[-1])  # 0-based
+    grid = np.arange(length, dtype=float)
+    if values.shape[-1] == 1:
+        background = np.broadcast_to(values, spectrum.shape).copy()
+    else:
+        background = PchipInterpolator(centres, values, axis=-1, extrapolate=False)(grid)
+        before, after = grid < centres[0], grid > centres[-1]
+        background[..., before] = values[..., :1]
+        background[..., after] = values[..., -1:]
+    if symmetric and length > 2:
+        half = length // 2
+        background[..., half + 1:] = background[..., 1:length - half][..., ::-1]
+    return background

@@ -1,0 +1,141 @@
+"""Transfer-function estimate from one healthy signal, resampling and propagation."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+from scipy.interpolate import CubicSpline
+
+from .._errors import GearshotError
+from .._validation import as_signal_array, check_int
+from ..signal.cepstrum import minimum_phase
+from ..signal.spectra import acs_background, amplitude_spectrum
+
+__all__ = [
+    "estimate_transfer_function",
+    "resample_transfer_function",
+    "propagate",
+    "rms",
+    "rms_normalize",
+]
+
+
+def resample_transfer_function(tf_one_sided, n_out):
+    """Resample a one-sided frequency response to the DFT grid of an ``n_out``-point signal.
+
+    The reference implementation's normalized-axis resampling: the one-sided response
+    ``H[0] (DC) … H[L-1] (last line, taken as Nyquist)`` is extended by its conjugate mirror
+    to ``2L - 1`` points spread evenly over ``[0, 1]``; magnitude and unwrapped phase are
+    interpolated by not-a-knot cubic splines at ``n_out`` points spread evenly over
+    ``[0, 1]``; the first ``n_out // 2 + 1`` values are kept and completed with their
+    conjugates so that bins ``1 … n_out - 1`` are Hermitian.
+
+    Parameters
+    ----------
+    tf_one_sided : array_like of complex, shape (L,)
+        One-sided frequency response, ``L >= 2``.
+    n_out : int
+        Length of the signals it will multiply in the DFT domain.
+
+    Returns
+    -------
+    ndarray of complex, shape (n_out,)
+    """
+    tf = as_signal_array(tf_one_sided, "tf_one_sided", max_ndim=1, min_length=2,
+                         allow_complex=True).astype(complex)
+    n_out = check_int(n_out, "n_out", minimum=2)
+    full = np.concatenate([tf, np.conj(tf[:0:-1])])
+    axis_in = np.linspace(0.0, 1.0, full.size)
+    axis_out = np.linspace(0.0, 1.0, n_out)
+    magnitude = CubicSpline(axis_in, np.abs(full))(axis_out)
+    phase = CubicSpline(axis_in, np.unwrap(np.angle(full)))(axis_out)
+    half = (magnitude * np.exp(1j * phase))[: n_out // 2 + 1]
+    n_mirror = n_out - half.size
+    return np.concatenate([half, np.conj(half[1:n_mirror + 1][::-1])])
+
+
+def estimate_transfer_function(healthy_signal, n_out, *, nfft=2**15, segment_size=200,
+                               overlap=0.75, percentile=50):
+    """Estimate the transfer path from one long healthy signal (paper step 3).
+
+    Amplitude spectrum (rectangular segments of ``nfft``) → ACS background →
+    cepstral minimum phase → one-sided half resampled to ``n_out`` points with
+    :func:`resample_transfer_function`.
+
+    Parameters
+    ----------
+    healthy_signal : array_like, shape (n_samples,)
+        Long healthy signal in the cycle (angle) domain, ``n_samples >= nfft``.
+    n_out : int
+        Points per cycle of the signals to propagate (2048).
+    nfft : int, default 2**15
+    segment_size : int, default 200
+    overlap : float, default 0.75
+    percentile : float, default 50
+        ACS parameters (see :func:`gearshot.signal.acs_background`).
+
+    Returns
+    -------
+    ndarray of complex, shape (n_out,)
+        Minimum-phase transfer-function estimate on the ``n_out``-point DFT grid.
+    """
+    x = as_signal_array(healthy_signal, "healthy_signal", max_ndim=1)
+    spectrum = amplitude_spectrum(x, nfft=nfft)
+    background = acs_background(spectrum, segment_size=segment_size, overlap=overlap,
+                                percentile=percentile)
+    if not np.any(background > 0):
+        raise GearshotError(
+            "healthy_signal has no spectral background (a strictly periodic signal has "
+            "energy only at its orders); the TF estimate needs non-synchronous content "
+            "such as a real recording's noise")
+    tf_mp = minimum_phase(background)
+    return resample_transfer_function(tf_mp[: tf_mp.size // 2 + 1], n_out)
+
+
+def propagate(signals, tf):
+    """Pass one-cycle periodic signals through a transfer function: ``real(IDFT(tf · DFT(x)))``.
+
+    Parameters
+    ----------
+    signals : array_like, shape (..., n)
+    tf : array_like of complex, shape (n,)
+        Frequency response on the ``n``-point DFT grid (e.g. from
+        :func:`resample_transfer_function`).
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+    """
+    signals = as_signal_array(signals, "signals", min_length=2)
+    tf = as_signal_array(tf, "tf", max_ndim=1, allow_complex=True)
+    if tf.shape[-1] != signals.shape[-1]:
+        raise GearshotError(
+            f"tf has {tf.shape[-1]} points but signals have {signals.shape[-1]} per cycle")
+    return scipy.fft.ifft(scipy.fft.fft(signals, axis=-1) * tf, axis=-1).real
+
+
+def rms(x):
+    """Root mean square along the last axis."""
+    x = as_signal_array(x, "x")
+    return np.sqrt(np.mean(x * x, axis=-1))
+
+
+def rms_normalize(signals, reference):
+    """Divide signals by the mean RMS of reference signals (paper step 5).
+
+    Parameters
+    ----------
+    signals : array_like, shape (..., n)
+    reference : array_like, shape (..., m)
+        Healthy signals of the same domain (target healthy SAs for target signals,
+        healthy simulated SAs for simulated ones); the mean of their RMS values is the scale.
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+    """
+    signals = as_signal_array(signals, "signals")
+    scale = float(np.mean(rms(as_signal_array(reference, "reference"))))
+    if scale <= 0:
+        raise GearshotError("reference signals have zero RMS; cannot normalize by them")
+    return signals / scale

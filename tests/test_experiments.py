@@ -1,0 +1,118 @@
+"""Dataset builders of Sec. 4.1 / 4.2, the variant table, the runner and the figures."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from numpy.testing import assert_allclose
+
+from estimator_data import N, synthetic_sa
+from gearshot import GearshotError
+from gearshot.experiments import (RIG_VARIANTS, SIMULATED_VARIANTS, evaluate_variants,
+                                  rig_dataset, simulated_dataset, summarize, variant_params)
+
+
+@pytest.fixture(scope="module")
+def sim_data():
+    rng = np.random.default_rng(0)
+    y = np.r_[np.zeros(40), rng.uniform(0, 1, 160)]
+    return synthetic_sa(y, 4, rng), y
+
+
+def test_simulated_dataset_splits_like_the_paper(sim_data):
+    sa, y = sim_data
+    ds = simulated_dataset(sa, y, np.ones(N), attenuation_db=20, noise_fraction=0.0,
+                           random_state=0)
+    n_h_train = int((ds.database.fault_size == 0).sum())
+    assert n_h_train == 20  # healthy half/half
+    assert int((ds.database.fault_size > 0).sum()) == 112  # faulty 70 %
+    assert ds.target_healthy.shape == (5, N)  # 25 % of the 20 test healthy
+    # 15 healthy + 48 faulty - the example
+    assert ds.test_sa.shape == (62, N) and ds.test_size.shape == (62,)
+    assert 0 < ds.faulty_size <= 1
+    # no noise, flat path: test signals are the simulated ones × 10^(-20/20)
+    idx = [int(np.flatnonzero(np.all(np.isclose(sa, t / 0.1), axis=1))[0])
+           for t in ds.test_sa[:3]]
+    assert_allclose(ds.test_size[:3], y[idx])
+    train_rows = {tuple(r[:4]) for r in ds.database["sa"].values}
+    assert not any(tuple(t[:4] / 0.1) in train_rows for t in ds.test_sa)  # disjoint
+    assert ds.healthy_long.size == 128 * N
+    again = simulated_dataset(sa, y, np.ones(N), attenuation_db=20, noise_fraction=0.0,
+                              random_state=0)
+    assert_allclose(again.test_sa, ds.test_sa)
+
+
+def test_simulated_dataset_bad_input(sim_data):
+    sa, y = sim_data
+    with pytest.raises(GearshotError, match="attenuation_db"):
+        simulated_dataset(sa, y, np.ones(N), attenuation_db=-3)
+    with pytest.raises(GearshotError, match="healthy"):
+        simulated_dataset(sa[40:], y[40:], np.ones(N))
+
+
+def test_variants_table():
+    assert set(SIMULATED_VARIANTS) <= set(RIG_VARIANTS)
+    assert variant_params("full") == {}
+    assert variant_params("before_da")["rms_normalization"] is False
+    with pytest.raises(GearshotError, match="valid variants"):
+        variant_params("best")
+
+
+def test_evaluate_variants_and_summary(sim_data):
+    sa, y = sim_data
+    ds = simulated_dataset(sa, y, np.ones(N), random_state=1)
+    rows = evaluate_variants(ds.fit_args(), ds.test_sa, ds.test_size,
+                             variants=SIMULATED_VARIANTS, selection_tf=np.ones(N),
+                             random_state=0)
+    frame = pd.DataFrame(rows)
+    assert list(frame["variant"]) == list(SIMULATED_VARIANTS)
+    assert frame["mae"].between(0, 1).all()
+    table = summarize(frame)
+    assert_allclose(table.set_index("variant").loc["full", "mae_percent"],
+                    100 * frame.set_index("variant").loc["full", "mae"])
+
+
+@pytest.fixture(scope="module")
+def small_campaign(tmp_path_factory):
+    from gearshot.rig import VirtualRig
+
+    folder = tmp_path_factory.mktemp("campaign")
+    VirtualRig(seed=3).campaign(folder, speed=30.0, load=10.0, duration=4.0, healthy=3,
+                                sizes=(0.6,), repetitions=3)
+    return folder
+
+
+def test_rig_dataset_keeps_the_example_recording_out_of_the_test_set(small_campaign):
+    ds = rig_dataset(small_campaign, n_train_healthy=2, cycles_per_segment=10,
+                     random_state=0)
+    assert ds.target_healthy.shape[1] == 2048
+    assert ds.faulty_size == pytest.approx(0.6)
+    assert ds.example_recording not in set(ds.test_recording)
+    assert set(np.unique(ds.test_size)) == {0.0, 0.6}
+    assert ds.healthy_long.size % 2048 == 0 and ds.healthy_long.size >= 2 ** 15
+    with pytest.raises(GearshotError, match="n_train_healthy"):
+        rig_dataset(small_campaign, n_train_healthy=3, cycles_per_segment=10)
+    with pytest.raises(GearshotError, match="speed"):
+        rig_dataset(small_campaign, speed=15.0, cycles_per_segment=10)
+
+
+def test_figures_and_report(tmp_path, sim_data):
+    from gearshot.figures import report_from_json, simulated_figures
+
+    rows = pd.DataFrame([dict(speed=s, load=10.0, tf=t, attenuation_db=10.0, variant=v,
+                              mae=0.1 + 0.01 * s / 10 + (v == "before_da") * 0.1)
+                         for s in (10.0, 20.0) for t in ("a", "b")
+                         for v in SIMULATED_VARIANTS])
+    figs = simulated_figures(rows, tmp_path)
+    assert all(p.is_file() and p.stat().st_size > 1000 for p in figs.values())
+    assert all(p.with_suffix(".pdf").is_file() for p in figs.values())
+    report = (tmp_path / "report.md").read_text()
+    assert "before_da" in report and "fig13a_error_vs_speed.png" in report
+    import json
+
+    (tmp_path / "res.json").write_text(json.dumps({"experiment": "simulated",
+                                                   "rows": rows.to_dict("records")}))
+    out = report_from_json(tmp_path / "res.json", tmp_path / "again")
+    assert out.is_file()
+    (tmp_path / "bad.json").write_text("{not json")
+    with pytest.raises(GearshotError, match="bad.json"):
+        report_from_json(tmp_path / "bad.json", tmp_path / "x")
