@@ -7,18 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from gearshot.signal import difference_signal
 from gearshot.sim import GearPair, simulate, simulate_sa
 
 
-def diff(sa, mesh=38, side=2):
-    X = np.fft.fft(sa, axis=-1)
-    n = sa.shape[-1]
-    for k in range(0, n // 2 + 1, mesh):
-        for d in range(-side, side + 1):
-            if 0 <= k + d < n:
-                X[..., k + d] = 0
-                X[..., (-(k + d)) % n] = 0
-    return np.fft.ifft(X, axis=-1).real
+def diff(sa):
+    """Difference signal (mesh order 38, two sidebands), as in the reference."""
+    return difference_signal(sa, 38, n_sidebands=2)
 
 
 def rms(x):

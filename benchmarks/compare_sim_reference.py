@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from gearshot.signal import difference_signal  # noqa: E402
 from gearshot.sim import Fault, GearPair, mesh_stiffness, simulate_sa  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -22,15 +23,9 @@ REF = ROOT.parent / "shared" / "reference"
 N_GEARS = 8
 
 
-def diff(sa, mesh=38, side=2):
-    X = np.fft.fft(sa, axis=-1)
-    n = sa.shape[-1]
-    for k in range(0, n // 2 + 1, mesh):
-        for d in range(-side, side + 1):
-            if 0 <= k + d < n:
-                X[..., k + d] = 0
-                X[..., (-(k + d)) % n] = 0
-    return np.fft.ifft(X, axis=-1).real
+def diff(sa):
+    """Difference signal (mesh order 38, two sidebands), as in the reference."""
+    return difference_signal(sa, 38, n_sidebands=2)
 
 
 def rms(x):

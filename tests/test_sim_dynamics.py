@@ -6,22 +6,15 @@ import pytest
 from scipy.stats import spearmanr
 
 from gearshot import GearshotError
+from gearshot.signal import difference_signal
 from gearshot.sim import GearPair, simulate, simulate_sa
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
-def _diff(sa, mesh=38, side=2):
-    """Difference signal: mesh harmonics and +-side sidebands zeroed (private stand-in)."""
-    X = np.fft.fft(sa, axis=-1)
-    n = sa.shape[-1]
-    for k in range(0, n // 2 + 1, mesh):
-        for d in range(-side, side + 1):
-            i = k + d
-            if 0 <= i < n:
-                X[..., i] = 0
-                X[..., (-i) % n] = 0
-    return np.fft.ifft(X, axis=-1).real
+def _diff(sa):
+    """Difference signal (mesh order 38, two sidebands), as in the reference."""
+    return difference_signal(sa, 38, n_sidebands=2)
 
 
 def _rms(x):
