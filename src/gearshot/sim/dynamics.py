@@ -181,8 +181,9 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                     k = _interp_table(kf_tab[b], u)
                 else:
                     k = _interp_table(k_tab, u)
-                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt,
-                                  1.0 - u)
+                # both wheels' errors run along the path of contact (as in the lab's
+                # model): their slope terms add into a mesh-periodic sawtooth
+                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt, u)
                      + _tooth_error(p_slope[b], p_wav[b], p_phase[b], p_noise[b], p_nw, pt,
                                     u))
                 if faulty:
