@@ -166,14 +166,30 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
         xb = np.zeros(ndof)
         for n in range(n_steps):
             tm = mesh_pos[n]
+            # a pair's entry/exit is anti-aliased: its contribution is weighted by the
+            # fraction of a step-wide window around tm that lies inside its contact
+            if n > 0:
+                half = 0.5 * abs(tm - mesh_pos[n - 1])
+            else:
+                half = 0.5 * abs(mesh_pos[min(1, n_steps - 1)] - tm)
             base = math.floor(tm)
             kk = 0.0
             fex = 0.0
-            for j in range(n_pairs):
+            for j in range(-1, n_pairs):
                 nn = base - j
-                u = (tm - nn) / eps
-                if u < 0.0 or u >= 1.0:
+                lo = tm - half - nn
+                hi = tm + half - nn
+                if hi <= 0.0 or lo >= eps:
                     continue
+                if hi > lo:
+                    wgt = (min(hi, eps) - max(lo, 0.0)) / (hi - lo)
+                else:
+                    wgt = 1.0
+                u = (tm - nn) / eps
+                if u < 0.0:
+                    u = 0.0
+                elif u > 1.0:
+                    u = 1.0
                 gt = int(nn % z_gear)
                 pt = int(nn % z_pin)
                 faulty = gt == f_tooth[b]
@@ -188,8 +204,8 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                                     u))
                 if faulty:
                     e += _interp_table(ef_tab[b], u)
-                kk += k
-                fex += k * e
+                kk += wgt * k
+                fex += wgt * k * e
             ld = load[n]
             ma = motor_acc[n]
             for i in range(ndof):
