@@ -94,15 +94,6 @@ def test_fault_monotone_in_size():
     assert np.all(np.diff(changes) > 0)
 
 
-@pytest.mark.parametrize("kwargs, name", [
-    (dict(z_pinion=11), "z_pinion"), (dict(z_gear=8), "z_gear"),
-    (dict(module=-1.0), "module"), (dict(face_width=float("nan")), "face_width"),
-    (dict(poisson=0.7), "poisson")])
-def test_bad_pair(kwargs, name):
-    with pytest.raises(GearshotError, match=name):
-        GearPair.paper(**kwargs)
-
-
 @pytest.mark.parametrize("args, name", [((1.2,), "size"), ((-0.1,), "size"),
                                         ((float("nan"),), "size")])
 def test_bad_fault(args, name):
@@ -131,7 +122,3 @@ def test_faulty_table_matches_direct_evaluation():
         rel = np.abs(fast - exact) / exact
         assert np.sum(rel > 5e-3) <= 1          # only the one grid point on the jump
 
-
-def test_interference_is_refused():
-    with pytest.raises(GearshotError, match="interference"):
-        GearPair(z_pinion=12, z_gear=60)
