@@ -37,7 +37,7 @@ from .stiffness import _N_TABLE, _pair_table
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
            "DEFAULT_MIN_FS"]
 
-G0 = 9.80665
+_G0 = 9.80665  # m/s^2 per g
 #: internal integration rate floor, Hz (see benchmarks/RESULTS_sim.md: dt convergence)
 DEFAULT_MIN_FS = 100e3
 _BATCH_CHUNK = 64
@@ -45,13 +45,16 @@ _BATCH_CHUNK = 64
 
 # ----------------------------------------------------------------------------- model
 def system_matrices(pair: GearPair):
-    """Mass, constant stiffness, damping, line-of-action vector of the 7-DOF model.
+    """Mass, constant stiffness, damping and line-of-action vector of the 7-DOF model.
 
     Returns
     -------
     M, K0, C : ndarray (7, 7)
+        Mass (kg, kg m^2), stiffness without the mesh, modal damping.
     v : ndarray (7,)
-        Mesh deflection = v . q (m).
+        Mesh deflection along the line of action = v . q (m).
+    omega : ndarray (7,)
+        Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
     """
     m1, m2 = pair.masses
     j1, j2 = pair.inertias
@@ -225,7 +228,7 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                 x[i] = xn
             r = n - rec_start
             if r >= 0 and r < n_rec:
-                out[b, r] = (acc[1] + acc[4]) / 9.80665
+                out[b, r] = (acc[1] + acc[4]) / _G0
         X[b] = x
         V[b] = vel
         A[b] = acc
