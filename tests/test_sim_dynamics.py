@@ -173,3 +173,8 @@ def test_custom_fault_type_plugs_in():
         simulate_sa(PAIR, faults=[Dent()], fault_sizes=[0.2], **kw)
     with pytest.raises(GearshotError, match="fault_sizes"):
         simulate_sa(PAIR, fault_sizes=["a"], **kw)
+
+
+def test_pair_must_be_gearpair():
+    with pytest.raises(GearshotError, match="pair"):
+        simulate_sa("paper", speed=15, load=10, grade=7, fault_sizes=[0.0])

@@ -141,8 +141,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     n_points : int
         SA length.
     client : dask.distributed.Client, False or None
-        Run blocks on this client. ``None``: a LocalCluster for builds of more than 16
-        blocks, in-process otherwise; ``False``: always in-process.
+        Run blocks on this client (its workers write the blocks themselves, so the store
+        must be on a file system they share). ``None``: a LocalCluster (one
+        single-threaded worker process per core) for builds of more than 16 blocks,
+        in-process (numba threads over the batch) otherwise; ``False``: always in-process.
     progress : bool
         Show a rich progress bar.
 

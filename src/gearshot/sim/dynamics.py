@@ -235,6 +235,12 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
 
 
 # ----------------------------------------------------------------------------- inputs
+def _check_pair(pair):
+    if not isinstance(pair, GearPair):
+        raise GearshotError(f"pair must be a GearPair (e.g. GearPair.paper()); got "
+                            f"{describe(pair)}")
+
+
 def _check_grade(grade):
     return check_int(grade, "grade", minimum=1, maximum=12)
 
@@ -441,6 +447,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     ndarray (n_signals, n_points)
         Vertical acceleration SAs, g.
     """
+    _check_pair(pair)
     speed = check_positive(speed, "speed")
     load = check_positive(load, "load")
     grade = _check_grade(grade)
@@ -539,6 +546,7 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     """
     from scipy.signal import firwin, oaconvolve
 
+    _check_pair(pair)
     fs = check_positive(fs, "fs")
     grade = _check_grade(grade)
     faults = _resolve_faults(fault_sizes, faults, fault_center, fault_depth)
