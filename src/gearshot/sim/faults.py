@@ -8,8 +8,12 @@ A fault acts on the gear pair in two ways (DESIGN.md section 2):
 * it adds a displacement excitation along the line of action
   (:meth:`ToothFault.displacement`).
 
-New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault` and
-override these three hooks; the stiffness and dynamics code only calls the hooks.
+New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault`
+(a frozen dataclass, so faults are hashable and their tables can be cached) and override
+``is_healthy`` and these hooks, plus :meth:`ToothFault.affected_range` to tell where the
+stiffness changes and where it jumps; the stiffness and dynamics code only calls the
+hooks. Pass such faults to :func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate`
+with ``faults=[...]``.
 """
 
 from __future__ import annotations
@@ -52,9 +56,11 @@ class ToothFault:
         return np.zeros_like(np.asarray(x, dtype=float))
 
     def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
-        """(s_min, breakpoints): the pair stiffness differs from healthy only for gear
-        roll fractions s >= s_min and is smooth between the breakpoints."""
-        return 1.0, np.array([])
+        """(s_min, breakpoints): the pair stiffness may differ from healthy only for gear
+        roll fractions s >= s_min and is smooth between the breakpoints. The default (the
+        whole profile, no jumps) is safe; overriding it makes the tables exact at jumps
+        and cheaper."""
+        return 0.0, np.array([])
 
     def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
         """Roll fraction where the load actually acts when the nominal contact is at ``s``
