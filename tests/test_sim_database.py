@@ -27,12 +27,16 @@ def test_contract(tmp_path):
     assert one.sa.shape == (5, 2048) and np.all(one.grade.values == 7)
 
 
+KILL_KW = dict(speeds=[15, 20, 25], loads=[10], grades=[5, 7, 9], n_healthy=2, n_faulty=12,
+               seed=4)
+
+
 def test_kill9_resume_identical(tmp_path):
     ref = tmp_path / "ref"
-    build_database(ref, client=False, progress=False, **KW)
+    build_database(ref, client=False, progress=False, **KILL_KW)
     store = tmp_path / "killed"
     code = (f"from gearshot.sim import build_database; "
-            f"build_database({str(store)!r}, client=False, progress=False, **{KW!r})")
+            f"build_database({str(store)!r}, client=False, progress=False, **{KILL_KW!r})")
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
     proc = subprocess.Popen([sys.executable, "-c", code], env=env)
     deadline = time.time() + 120
@@ -43,12 +47,13 @@ def test_kill9_resume_identical(tmp_path):
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
-    assert len(list((store / "blocks").glob("*.zarr"))) < 6
-    build_database(store, client=False, progress=False, **KW)
-    for speed in (15, 20):
+    assert len(list((store / "blocks").glob("*.zarr"))) < 9, "build finished before the kill"
+    build_database(store, client=False, progress=False, **KILL_KW)
+    assert len(list((store / "blocks").glob("*.zarr"))) == 9
+    for speed in (15, 20, 25):
         a = load_database(ref, speed=speed, load=10)
         b = load_database(store, speed=speed, load=10)
-        assert a.sa.shape == b.sa.shape == (15, 2048)
+        assert a.sa.shape == b.sa.shape == (42, 2048)
         np.testing.assert_array_equal(a.sa.values, b.sa.values)
         np.testing.assert_array_equal(a.seed.values, b.seed.values)
     assert not list((store / "blocks").glob(".*tmp"))
@@ -78,3 +83,55 @@ def test_unwritable_store(tmp_path):
         assert not (locked / "db").exists()
     finally:
         locked.chmod(0o700)
+
+
+def test_store_below_a_file_is_refused(tmp_path):
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("x")
+    with pytest.raises(GearshotError, match="store"):
+        build_database(blocker / "db", client=False, progress=False, **KW)
+    assert blocker.read_text() == "x"
+    with pytest.raises(GearshotError, match="store"):
+        build_database(blocker, client=False, progress=False, **KW)
+
+
+def test_other_build_in_store_is_refused(tmp_path):
+    small = dict(KW, speeds=[15], grades=[7])
+    build_database(tmp_path / "db", client=False, progress=False, **small)
+    with pytest.raises(GearshotError, match="seed"):
+        build_database(tmp_path / "db", client=False, progress=False, **dict(small, seed=5))
+
+
+def test_missing_condition_and_store(tmp_path):
+    build_database(tmp_path / "db", client=False, progress=False,
+                   **dict(KW, speeds=[15], grades=[7]))
+    with pytest.raises(GearshotError, match="speed"):
+        load_database(tmp_path / "db", speed=25, load=10)
+    with pytest.raises(GearshotError, match="grade"):
+        load_database(tmp_path / "db", speed=15, load=10, grade=3)
+    with pytest.raises(GearshotError, match="manifest"):
+        load_database(tmp_path / "nothing", speed=15, load=10)
+
+
+def test_dask_client_gives_same_content(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    small = dict(KW, speeds=[15], grades=[5, 7])
+    build_database(tmp_path / "a", client=False, progress=False, **small)
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=":0") as client:
+        build_database(tmp_path / "b", client=client, progress=False, **small)
+    a = load_database(tmp_path / "a", speed=15, load=10)
+    b = load_database(tmp_path / "b", speed=15, load=10)
+    np.testing.assert_array_equal(a.sa.values, b.sa.values)
+
+
+def test_signal_reproducible_from_its_seed(tmp_path):
+    from gearshot.sim import GearPair, simulate_sa
+
+    build_database(tmp_path / "db", client=False, progress=False,
+                   **dict(KW, speeds=[15], grades=[7]))
+    ds = load_database(tmp_path / "db", speed=15, load=10, grade=7)
+    i = 3
+    sa = simulate_sa(GearPair.paper(), speed=15, load=10, grade=7,
+                     fault_sizes=[float(ds.fault_size[i])], rng=[int(ds.seed[i])])
+    np.testing.assert_allclose(sa[0], ds.sa.values[i], rtol=0, atol=1e-9)

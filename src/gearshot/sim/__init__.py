@@ -1,12 +1,49 @@
-"""The spur-gear dynamic simulator and simulated databases."""
+"""The spur-gear dynamic simulator and simulated SA databases.
+
+Pieces (SI units; angles in rad; accelerations in g):
+
+* :class:`GearPair` — frozen parameter set (``GearPair.paper()`` is the paper's pair).
+* :func:`mesh_stiffness`, :func:`pair_stiffness` — potential-energy mesh stiffness
+  (Hertz, bending, shear, axial, Sainsot fillet foundation).
+* :class:`ToothFault` (extensible base), :class:`FullToothFaceFault` via ``Fault.ftff``.
+* :func:`draw_profile_errors` — DIN 3962 profile errors per tooth.
+* :func:`simulate` — time signals with constant or time-varying speed and load;
+  :func:`simulate_sa` — batched steady-state synchronous averages.
+* :func:`build_database` / :func:`load_database` — resumable Zarr databases.
+
+Example
+-------
+>>> from gearshot.sim import GearPair, simulate_sa
+>>> sa = simulate_sa(GearPair.paper(), speed=15, load=10, grade=7,
+...                  fault_sizes=[0.0, 0.5], rng=0)
+>>> sa.shape
+(2, 2048)
+"""
+
 from .database import build_database, default_database_path, load_database
-from .dynamics import SimulationResult, simulate, simulate_sa, system_matrices
+from .dynamics import DEFAULT_MIN_FS, SimulationResult, simulate, simulate_sa, system_matrices
 from .faults import Fault, FullToothFaceFault, ToothFault
 from .geometry import GearPair
 from .profile_errors import DIN_PROFILE_TOLERANCES, ToothProfileErrors, draw_profile_errors
 from .stiffness import contact_ratio, mesh_stiffness, pair_stiffness
 
-__all__ = ["GearPair", "Fault", "FullToothFaceFault", "ToothFault", "contact_ratio",
-           "mesh_stiffness", "pair_stiffness", "DIN_PROFILE_TOLERANCES", "ToothProfileErrors",
-           "draw_profile_errors", "SimulationResult", "simulate", "simulate_sa",
-           "system_matrices", "build_database", "load_database", "default_database_path"]
+__all__ = [
+    "GearPair",
+    "Fault",
+    "FullToothFaceFault",
+    "ToothFault",
+    "contact_ratio",
+    "mesh_stiffness",
+    "pair_stiffness",
+    "DIN_PROFILE_TOLERANCES",
+    "ToothProfileErrors",
+    "draw_profile_errors",
+    "DEFAULT_MIN_FS",
+    "SimulationResult",
+    "simulate",
+    "simulate_sa",
+    "system_matrices",
+    "build_database",
+    "load_database",
+    "default_database_path",
+]

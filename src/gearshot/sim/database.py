@@ -141,8 +141,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     n_points : int
         SA length.
     client : dask.distributed.Client, False or None
-        Run blocks on this client. ``None``: a LocalCluster for builds of more than 16
-        blocks, in-process otherwise; ``False``: always in-process.
+        Run blocks on this client (its workers write the blocks themselves, so the store
+        must be on a file system they share). ``None``: a LocalCluster (one
+        single-threaded worker process per core) for builds of more than 16 blocks,
+        in-process (numba threads over the batch) otherwise; ``False``: always in-process.
     progress : bool
         Show a rich progress bar.
 
@@ -176,7 +178,7 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     if client is None and len(todo) > _SMALL_BUILD:
         from dask.distributed import Client, LocalCluster
         own_cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
-                                   processes=True)
+                                   processes=True, dashboard_address=":0")
         client = Client(own_cluster)
     try:
         _run_tasks(store, pair, todo, len(tasks), n_healthy, n_faulty, seed, n_points,

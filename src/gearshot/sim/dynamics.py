@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
 
-import numpy as np
 import numba as nb
+import numpy as np
+import scipy.fft as sp_fft
 
 from .._errors import GearshotError
 from .._validation import check_finite, check_int, check_positive, describe
@@ -37,7 +37,7 @@ from .stiffness import _N_TABLE, _pair_table
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
            "DEFAULT_MIN_FS"]
 
-G0 = 9.80665
+_G0 = 9.80665  # m/s^2 per g
 #: internal integration rate floor, Hz (see benchmarks/RESULTS_sim.md: dt convergence)
 DEFAULT_MIN_FS = 100e3
 _BATCH_CHUNK = 64
@@ -45,13 +45,16 @@ _BATCH_CHUNK = 64
 
 # ----------------------------------------------------------------------------- model
 def system_matrices(pair: GearPair):
-    """Mass, constant stiffness, damping, line-of-action vector of the 7-DOF model.
+    """Mass, constant stiffness, damping and line-of-action vector of the 7-DOF model.
 
     Returns
     -------
     M, K0, C : ndarray (7, 7)
+        Mass (kg, kg m^2), stiffness without the mesh, modal damping.
     v : ndarray (7,)
-        Mesh deflection = v . q (m).
+        Mesh deflection along the line of action = v . q (m).
+    omega : ndarray (7,)
+        Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
     """
     m1, m2 = pair.masses
     j1, j2 = pair.inertias
@@ -146,34 +149,50 @@ def _tooth_error(slope, wav, phase, noise, nwaves, t, s):
             + noise[t, i] * (1.0 - f) + noise[t, i + 1] * f)
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, parallel=True, fastmath=True)
 def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                    g_slope, g_wav, g_phase, g_noise, g_nw,
                    p_slope, p_wav, p_phase, p_noise, p_nw,
-                   eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, x0, coef,
+                   eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, X, V, A, coef,
                    rec_start, out):
     n_batch = out.shape[0]
     n_steps = mesh_pos.shape[0]
     n_rec = out.shape[1]
-    ndof = x0.shape[0]
+    ndof = X.shape[1]
     a0, a2, a3, a6, a7 = coef[0], coef[1], coef[2], coef[3], coef[4]
     n_pairs = int(math.ceil(eps)) + 1
     z_pin = p_slope.shape[1]
     for b in nb.prange(n_batch):
-        x = x0.copy()
-        vel = np.zeros(ndof)
-        acc = np.zeros(ndof)
+        x = X[b].copy()
+        vel = V[b].copy()
+        acc = A[b].copy()
         xb = np.zeros(ndof)
         for n in range(n_steps):
             tm = mesh_pos[n]
+            # a pair's entry/exit is anti-aliased: its contribution is weighted by the
+            # fraction of a step-wide window around tm that lies inside its contact
+            if n > 0:
+                half = 0.5 * abs(tm - mesh_pos[n - 1])
+            else:
+                half = 0.5 * abs(mesh_pos[min(1, n_steps - 1)] - tm)
             base = math.floor(tm)
             kk = 0.0
             fex = 0.0
-            for j in range(n_pairs):
+            for j in range(-1, n_pairs):
                 nn = base - j
-                u = (tm - nn) / eps
-                if u < 0.0 or u >= 1.0:
+                lo = tm - half - nn
+                hi = tm + half - nn
+                if hi <= 0.0 or lo >= eps:
                     continue
+                if hi > lo:
+                    wgt = (min(hi, eps) - max(lo, 0.0)) / (hi - lo)
+                else:
+                    wgt = 1.0
+                u = (tm - nn) / eps
+                if u < 0.0:
+                    u = 0.0
+                elif u > 1.0:
+                    u = 1.0
                 gt = int(nn % z_gear)
                 pt = int(nn % z_pin)
                 faulty = gt == f_tooth[b]
@@ -181,14 +200,15 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                     k = _interp_table(kf_tab[b], u)
                 else:
                     k = _interp_table(k_tab, u)
-                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt,
-                                  1.0 - u)
+                # both wheels' errors run along the path of contact (as in the lab's
+                # model): their slope terms add into a mesh-periodic sawtooth
+                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt, u)
                      + _tooth_error(p_slope[b], p_wav[b], p_phase[b], p_noise[b], p_nw, pt,
                                     u))
                 if faulty:
                     e += _interp_table(ef_tab[b], u)
-                kk += k
-                fex += k * e
+                kk += wgt * k
+                fex += wgt * k * e
             ld = load[n]
             ma = motor_acc[n]
             for i in range(ndof):
@@ -208,17 +228,29 @@ def _newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
                 x[i] = xn
             r = n - rec_start
             if r >= 0 and r < n_rec:
-                out[b, r] = (acc[1] + acc[4]) / 9.80665
+                out[b, r] = (acc[1] + acc[4]) / _G0
+        X[b] = x
+        V[b] = vel
+        A[b] = acc
 
 
 # ----------------------------------------------------------------------------- inputs
+def _check_pair(pair):
+    if not isinstance(pair, GearPair):
+        raise GearshotError(f"pair must be a GearPair (e.g. GearPair.paper()); got "
+                            f"{describe(pair)}")
+
+
 def _check_grade(grade):
     return check_int(grade, "grade", minimum=1, maximum=12)
 
 
 def _check_sizes(fault_sizes):
-    arr = np.atleast_1d(np.asarray(fault_sizes, dtype=float)) if not isinstance(
-        fault_sizes, str) else None
+    try:
+        arr = (None if isinstance(fault_sizes, str)
+               else np.atleast_1d(np.asarray(fault_sizes, dtype=float)))
+    except (TypeError, ValueError):
+        arr = None
     if arr is None or arr.ndim != 1 or arr.size == 0:
         raise GearshotError(f"fault_sizes must be a non-empty 1-D sequence; got "
                             f"{describe(fault_sizes)}")
@@ -265,7 +297,22 @@ def _profile(value, name, times):
     return arr
 
 
-def _fault_list(pair, sizes, center, depth):
+def _resolve_faults(fault_sizes, faults, center, depth) -> list[ToothFault]:
+    """One fault object per signal, from FTFF sizes or from given fault objects."""
+    if faults is not None:
+        if fault_sizes is not None:
+            raise GearshotError("give fault_sizes or faults, not both")
+        faults = list(faults) if not isinstance(faults, ToothFault) else [faults]
+        if not faults:
+            raise GearshotError("faults must not be empty")
+        for i, f in enumerate(faults):
+            if f is not None and not isinstance(f, ToothFault):
+                raise GearshotError(f"faults[{i}] must be a ToothFault (e.g. Fault.ftff(0.3))"
+                                    f" or None; got {describe(f)}")
+        return [f if f is not None else ToothFault() for f in faults]
+    if fault_sizes is None:
+        raise GearshotError("give fault_sizes (FTFF sizes) or faults (fault objects)")
+    sizes = _check_sizes(fault_sizes)
     return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
 
 
@@ -294,17 +341,37 @@ def _stack_errors(errs: list[ToothProfileErrors]):
             float(errs[0].n_waves))
 
 
+class _Batch:
+    """Prepared per-signal tables and the integration state of a batch of signals."""
+
+    def __init__(self, pair, integ, faults, gear_errs, pin_errs):
+        self.pair, self.integ = pair, integ
+        self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
+        self.g = _stack_errors(gear_errs)
+        self.p = _stack_errors(pin_errs)
+        n = len(faults)
+        self.X = np.tile(integ.x_static, (n, 1))
+        self.V = np.zeros((n, integ.x_static.size))
+        self.A = np.zeros((n, integ.x_static.size))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+        """Advance over the given steps; return the vertical acceleration (g) of steps
+        ``rec_start ... rec_start + n_rec - 1``."""
+        pair, integ = self.pair, self.integ
+        out = np.empty((self.X.shape[0], n_rec))
+        _newmark_batch(np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
+                       np.ascontiguousarray(load), _pair_table(pair, None), self.kf,
+                       self.ef, self.tooth, *self.g, *self.p, pair.contact_ratio,
+                       pair.z_gear, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
+                       integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
+                       rec_start, out)
+        return out
+
+
 def _run(pair, integ, mesh_pos, motor_acc, load, faults, gear_errs, pin_errs, rec_start,
          n_rec):
-    kf, ef, tooth = _fault_arrays(pair, faults)
-    g = _stack_errors(gear_errs)
-    p = _stack_errors(pin_errs)
-    out = np.empty((len(faults), n_rec))
-    _newmark_batch(mesh_pos, motor_acc, load, _pair_table(pair, None), kf, ef, tooth,
-                   *g, *p, pair.contact_ratio, pair.z_gear, integ.B1, integ.B2, integ.B3,
-                   integ.w, integ.s, integ.v, integ.c_load, integ.c_motor, integ.x_static,
-                   integ.coef, rec_start, out)
-    return out
+    return _Batch(pair, integ, faults, gear_errs, pin_errs).run(mesh_pos, motor_acc, load,
+                                                              rec_start, n_rec)
 
 
 def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
@@ -328,14 +395,16 @@ def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
 
 
 def _warmup_time(pair: GearPair, integ: _Integrator) -> float:
-    # transients of the slowest mode decay to < 1e-4 of their start
-    return 9.2 / (pair.damping_ratio * integ.omega_min)
+    # the start transient (from the static state under the mean mesh stiffness; small)
+    # of the slowest mode decays to 1 % of its start: SA error ~2e-5 relative for the
+    # paper pair (benchmarks/RESULTS_sim.md)
+    return 4.6 / (pair.damping_ratio * integ.omega_min)
 
 
 # ----------------------------------------------------------------------------- public API
-def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes,
+def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes=None,
                 n_points: int = 2048, same_gear: bool = False, rng=None,
-                fault_center: float = 0.5, fault_depth: float = 0.5,
+                fault_center: float = 0.5, fault_depth: float = 0.5, faults=None,
                 min_fs: float = DEFAULT_MIN_FS) -> np.ndarray:
     """Synchronous averages over one revolution of the driven gear, steady state.
 
@@ -343,7 +412,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     tooth-to-tooth errors to its mean tooth; the model is linear with gear-periodic
     stiffness, so the SA equals the steady-state response of one gear revolution to
     the gear's own errors plus the pinion's mean-tooth errors. That response is what is
-    integrated here (after a warm-up that damps the start transient below 1e-4), then
+    integrated here (after a warm-up that damps the start transient to 1 %), then
     resampled to ``n_points`` by ideal FFT resampling (orders >= n_points/2 dropped).
 
     Parameters
@@ -367,24 +436,28 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
         is then reproducible alone from its seed).
     fault_center, fault_depth : float
         FTFF placement and depth coefficient.
+    faults : sequence of ToothFault, optional
+        Instead of ``fault_sizes``: one fault object per signal (any fault type; None =
+        healthy).
     min_fs : float
         Lowest internal integration rate, Hz.
 
     Returns
     -------
-    ndarray (len(fault_sizes), n_points)
+    ndarray (n_signals, n_points)
         Vertical acceleration SAs, g.
     """
+    _check_pair(pair)
     speed = check_positive(speed, "speed")
     load = check_positive(load, "load")
     grade = _check_grade(grade)
-    sizes = _check_sizes(fault_sizes)
+    faults = _resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    n_sig = len(faults)
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = _as_rng(rng, sizes.size)
-    faults = _fault_list(pair, sizes, fault_center, fault_depth)
+    rng = _as_rng(rng, n_sig)
     t_rev = pair.z_gear / (pair.z_pinion * speed)
-    n_rev = max(2 * n_points, int(math.ceil(t_rev * min_fs)))
+    n_rev = sp_fft.next_fast_len(max(2 * n_points, int(math.ceil(t_rev * min_fs))), real=True)
     dt = t_rev / n_rev
     integ = _integrator(pair, dt, load)
     n_warm = int(math.ceil(_warmup_time(pair, integ) / dt))
@@ -393,9 +466,9 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     mesh_pos = tau * speed * pair.z_pinion
     zeros = np.zeros(n_steps)
     loads = np.full(n_steps, load)
-    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=True)
-    out = np.empty((sizes.size, n_points))
-    for start in range(0, sizes.size, _BATCH_CHUNK):
+    ge, pe = _draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=True)
+    out = np.empty((n_sig, n_points))
+    for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
         acc = _run(pair, integ, mesh_pos, zeros, loads, faults[sl], ge[sl], pe[sl],
                    n_warm - 1, n_rev)
@@ -405,13 +478,13 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
 
 def _fft_resample(x: np.ndarray, n_out: int) -> np.ndarray:
     n = x.shape[-1]
-    X = np.fft.rfft(x, axis=-1)
+    X = sp_fft.rfft(x, axis=-1, workers=-1)
     Y = np.zeros(x.shape[:-1] + (n_out // 2 + 1,), dtype=complex)
     keep = min(n_out // 2, X.shape[-1] - 1)
     Y[..., :keep] = X[..., :keep]
     if n_out % 2 == 0 and keep == n_out // 2:
         Y[..., keep] = X[..., keep].real
-    return np.fft.irfft(Y, n=n_out, axis=-1) * (n_out / n)
+    return sp_fft.irfft(Y, n=n_out, axis=-1, workers=-1) * (n_out / n)
 
 
 @dataclass(frozen=True)
@@ -436,11 +509,16 @@ class SimulationResult:
     fs: float
 
 
-def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
+def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: float,
              duration: float | None = None, n_revs: float | None = None, rng=None,
              same_gear: bool = False, fault_center: float = 0.5, fault_depth: float = 0.5,
-             min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
+             faults=None, min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
     """Vertical-acceleration time signals, steady state from the first sample.
+
+    The run is integrated in chunks (memory stays bounded for long recordings) at an
+    integer multiple of ``fs`` that is >= ``min_fs``, after a warm-up at the initial speed
+    and load, and decimated by a Kaiser-windowed FIR (as :func:`scipy.signal.resample_poly`)
+    fed with real samples on both sides, so there are no edge effects.
 
     Parameters
     ----------
@@ -459,68 +537,113 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes, fs: float,
         and is decimated with an anti-aliasing filter.
     duration, n_revs : float
         Signal length in seconds, or in input-shaft revolutions (one of the two).
-    rng, same_gear, fault_center, fault_depth, min_fs
+    rng, same_gear, fault_center, fault_depth, faults, min_fs
         As in :func:`simulate_sa`.
 
     Returns
     -------
     SimulationResult
     """
-    from scipy.signal import resample_poly
+    from scipy.signal import firwin, oaconvolve
 
+    _check_pair(pair)
     fs = check_positive(fs, "fs")
     grade = _check_grade(grade)
-    sizes = _check_sizes(fault_sizes)
+    faults = _resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    n_sig = len(faults)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = _as_rng(rng)
+    rng = _as_rng(rng, n_sig)
     if (duration is None) == (n_revs is None):
         raise GearshotError("give exactly one of duration and n_revs; got "
                             f"duration={duration!r}, n_revs={n_revs!r}")
     up = max(1, int(math.ceil(min_fs / fs)))
     dt = 1.0 / (fs * up)
-    probe = np.array([0.0])
-    speed0 = float(_profile(speed, "speed", probe)[0])
+    speed_fn = _profile_fn(speed, "speed", fs)
+    load_fn = _profile_fn(load, "load", fs)
     if duration is None:
         n_revs = check_positive(n_revs, "n_revs")
         if callable(speed) or np.ndim(speed):
             raise GearshotError("n_revs needs a constant speed; give duration instead")
-        duration = n_revs / speed0
+        duration = n_revs / float(speed)
     duration = check_positive(duration, "duration")
     n_out = int(round(duration * fs))
     if n_out < 2:
         raise GearshotError(f"duration must span >= 2 samples at fs; got {duration!r} s")
+    if not callable(speed) and np.ndim(speed) and np.size(speed) < n_out:
+        raise GearshotError(f"speed holds {np.size(speed)} samples; the duration needs "
+                            f"{n_out} at fs")
+    if not callable(load) and np.ndim(load) and np.size(load) < n_out:
+        raise GearshotError(f"load holds {np.size(load)} samples; the duration needs "
+                            f"{n_out} at fs")
     n_fine = n_out * up
-    t_fine = np.arange(n_fine) * dt
-    if np.ndim(speed) and not callable(speed):
-        sp_src = _profile(speed, "speed", probe)
-        t_src = np.arange(sp_src.size) / fs
-        sp = np.interp(t_fine, t_src, sp_src)
-    else:
-        sp = _profile(speed, "speed", t_fine)
-    if np.ndim(load) and not callable(load):
-        ld_src = _profile(load, "load", probe)
-        ld = np.interp(t_fine, np.arange(ld_src.size) / fs, ld_src)
-    else:
-        ld = _profile(load, "load", t_fine)
-    integ = _integrator(pair, dt, float(ld[0]))
-    n_warm = int(math.ceil(_warmup_time(pair, integ) / dt))
-    # warm-up at the initial speed and load (tau < 0), then the requested profile
-    tau_warm = (np.arange(n_warm - 1) - (n_warm - 1)) * dt
-    theta_fine = 2 * np.pi * np.concatenate(
-        [[0.0], np.cumsum(0.5 * (sp[1:] + sp[:-1]) * dt)])
-    theta = np.concatenate([2 * np.pi * sp[0] * tau_warm, theta_fine])
-    omega = 2 * np.pi * np.concatenate([np.full(n_warm - 1, sp[0]), sp])
-    motor_acc = np.gradient(omega, dt)
-    loads = np.concatenate([np.full(n_warm - 1, ld[0]), ld])
-    mesh_pos = theta * pair.z_pinion / (2 * np.pi)
-    faults = _fault_list(pair, sizes, fault_center, fault_depth)
-    ge, pe = _draw_errors(pair, grade, sizes.size, rng, same_gear, average_pinion=False)
-    acc = np.empty((sizes.size, n_out))
-    for start in range(0, sizes.size, _BATCH_CHUNK):
+    sp0 = float(speed_fn(np.zeros(1))[0])
+    ld0 = float(load_fn(np.zeros(1))[0])
+    integ = _integrator(pair, dt, ld0)
+    # anti-aliasing FIR (Kaiser, like scipy's resample_poly), centred: half length D
+    half = 10 * up if up > 1 else 0
+    h = firwin(2 * half + 1, 1.0 / up, window=("kaiser", 5.0)) if up > 1 else np.ones(1)
+    n_warm = max(int(math.ceil(_warmup_time(pair, integ) / dt)), half + 1)
+    ge, pe = _draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=False)
+    acc = np.empty((n_sig, n_out))
+    angle = np.zeros(n_out)
+    z1 = pair.z_pinion
+    chunk = 1 << 16
+    for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        fine = _run(pair, integ, mesh_pos, motor_acc, loads,
-                    faults[sl], ge[sl], pe[sl], n_warm - 1, n_fine)
-        acc[sl] = resample_poly(fine, 1, up, axis=-1) if up > 1 else fine
-    angle = theta_fine[::up]
+        batch = _Batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        # warm-up at the initial speed and load, t = -(n_warm - 1) dt ... 0; keep the
+        # samples from t = -half dt to 0 (the filter's history and the first sample)
+        tau = (np.arange(n_warm) - (n_warm - 1)) * dt
+        zero = np.zeros(n_warm)
+        tail = batch.run(sp0 * z1 * tau, zero, np.full(n_warm, ld0), n_warm - 1 - half,
+                         half + 1)
+        theta = 0.0
+        k_next = 0
+        g0 = -half              # fine time index of tail[:, 0]
+        n_total = n_fine + half
+        for c0 in range(1, n_total, chunk):
+            c1 = min(c0 + chunk, n_total)
+            t = np.arange(c0 - 1, c1 + 1) * dt          # one step of margin each side
+            sp = speed_fn(t)
+            omega = 2 * np.pi * sp
+            inc = np.pi * (sp[1:-1] + sp[:-2]) * dt      # trapezoid, steps c0 ... c1-1
+            th = theta + np.cumsum(inc)
+            theta = th[-1]
+            if start == 0:                               # the motor angle at output times
+                fidx = np.arange(c0, c1)
+                sel = (fidx % up == 0) & (fidx // up < n_out)
+                angle[fidx[sel] // up] = th[sel]
+            motor_acc = (omega[2:] - omega[:-2]) / (2 * dt)
+            fine = batch.run(th * z1 / (2 * np.pi), motor_acc, load_fn(t[1:-1]), 0,
+                             c1 - c0)
+            zz = np.concatenate([tail, fine], axis=1)
+            if up == 1:
+                idx = np.arange(zz.shape[1]) + g0
+                keep = (idx >= 0) & (idx < n_out)
+                acc[sl, idx[keep]] = zz[:, keep]
+                tail = zz[:, :0]
+                g0 += zz.shape[1]
+                continue
+            conv = oaconvolve(zz, h[None, :], mode="valid", axes=-1)
+            centre = g0 + half + np.arange(conv.shape[1])  # fine index of each output
+            pick = (centre % up == 0) & (centre // up >= k_next) & (centre // up < n_out)
+            ks = centre[pick] // up
+            acc[sl, ks] = conv[:, pick]
+            if ks.size:
+                k_next = int(ks[-1]) + 1
+            tail = zz[:, -(2 * half):]
+            g0 += zz.shape[1] - 2 * half
     return SimulationResult(acceleration=acc, pinion_angle=angle,
                             time=np.arange(n_out) / fs, fs=fs)
+
+
+def _profile_fn(value, name, fs):
+    """A vectorised f(t) for a constant, a callable or samples at ``fs``."""
+    if callable(value):
+        return lambda t: _profile(value, name, t)
+    if np.ndim(value) == 0:
+        v = check_positive(value, name)
+        return lambda t: np.full(np.shape(t), v)
+    src = _profile(value, name, np.zeros(1))
+    t_src = np.arange(src.size) / fs
+    return lambda t: np.interp(t, t_src, src)

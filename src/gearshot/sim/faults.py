@@ -8,12 +8,17 @@ A fault acts on the gear pair in two ways (DESIGN.md section 2):
 * it adds a displacement excitation along the line of action
   (:meth:`ToothFault.displacement`).
 
-New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault` and
-override these three hooks; the stiffness and dynamics code only calls the hooks.
+New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault`
+(a frozen dataclass, so faults are hashable and their tables can be cached) and override
+``is_healthy`` and these hooks, plus :meth:`ToothFault.affected_range` to tell where the
+stiffness changes and where it jumps; the stiffness and dynamics code only calls the
+hooks. Pass such faults to :func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate`
+with ``faults=[...]``.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -51,9 +56,11 @@ class ToothFault:
         return np.zeros_like(np.asarray(x, dtype=float))
 
     def affected_range(self, pair: GearPair) -> tuple[float, np.ndarray]:
-        """(s_min, breakpoints): the pair stiffness differs from healthy only for gear
-        roll fractions s >= s_min and is smooth between the breakpoints."""
-        return 1.0, np.array([])
+        """(s_min, breakpoints): the pair stiffness may differ from healthy only for gear
+        roll fractions s >= s_min and is smooth between the breakpoints. The default (the
+        whole profile, no jumps) is safe; overriding it makes the tables exact at jumps
+        and cheaper."""
+        return 0.0, np.array([])
 
     def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
         """Roll fraction where the load actually acts when the nominal contact is at ``s``
@@ -150,7 +157,7 @@ class FullToothFaceFault(ToothFault):
         z = pair.z_gear
         rb = pair.base_radius(z)
         # healthy flank half-thickness at x (invert x(r) on a fine table)
-        r_tab = np.linspace(rb, pair.tip_radius(z), 2001)
+        r_tab = np.linspace(rb, pair.tip_radius(z), 601)
         psi = involute_half_angle(z, pair.pressure_angle, r_tab, rb)
         x_tab, h_tab = r_tab * np.cos(psi), r_tab * np.sin(psi)
         inside = (x > xa) & (x < xb)
@@ -165,30 +172,45 @@ class FullToothFaceFault(ToothFault):
         s0, s1 = self.window
         if self.is_healthy:
             return 1.0, np.array([])
-        return s0, np.array([s0, 0.5 * (s0 + s1), s1])
+        return s0, np.array([s0, self._switch(pair), s1])
+
+    def _switch(self, pair: GearPair) -> float:
+        """Nominal roll fraction where the load jumps from one edge of the cut to the
+        other (largest jump of the touched point)."""
+        knots, _, contact = self.bridge(pair)
+        i = int(np.argmax(np.abs(np.diff(contact))))
+        return 0.5 * (knots[i] + knots[i + 1])
 
     def contact_roll(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
-        """While the nominal contact lies in the tip-side half of the cut, the mating flank
-        bridges the hollow and pivots on the cut's tip-side edge, so the load stays there;
-        in the root-side half it follows the cut again (only the thinning acts)."""
+        """Where the load acts: inside the cut, the gear point the bridging mating flank
+        touches (:meth:`bridge`): the tip-side edge first, then the root-side edge."""
         s = np.asarray(s, dtype=float)
         if self.is_healthy:
             return s
         s0, s1 = self.window
-        mid = 0.5 * (s0 + s1)
+        knots, _, contact = self.bridge(pair)
+        sw = self._switch(pair)
         out = s.copy()
-        out[(s > mid) & (s < s1)] = s1
+        hi = (s > sw) & (s < s1)
+        lo = (s > s0) & (s <= sw)
+        k_hi, k_lo = knots > sw, knots <= sw      # interpolate within each side only
+        if hi.any():
+            out[hi] = np.interp(s[hi], knots[k_hi], contact[k_hi])
+        if lo.any():
+            out[lo] = np.interp(s[lo], knots[k_lo], contact[k_lo])
         return out
 
-    def _flank_points(self, pair: GearPair, margin: float = 0.25, n: int = 160):
+    def _flank_points(self, pair: GearPair, margin: float = 0.04, n: int = 80):
         """Polar (radius, angle from the tooth centre line) of the cut flank near the cut:
-        the arc, plus the involute up to ``margin`` of the active profile beyond it."""
+        ``n`` points on the arc, plus a few on the involute up to ``margin`` of the active
+        profile beyond its edges (on conjugate flanks the gap grows away from the nominal
+        contact, so the edges bound the healthy part)."""
         z = pair.z_gear
         rb = pair.base_radius(z)
         _, (l_lo, l_hi) = pair.roll_limits
         s0, s1 = self.window
-        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, n // 2),
-                    np.linspace(s1, min(s1 + margin, 1.0), n // 2)]
+        pieces_s = [np.linspace(max(s0 - margin, -0.02), s0, 5),
+                    np.linspace(s1, min(s1 + margin, 1.0), 5)]
         ls = l_lo + np.concatenate(pieces_s) * (l_hi - l_lo)
         r = np.hypot(rb, np.maximum(ls, 0.0))
         psi = involute_half_angle(z, pair.pressure_angle, r, rb)
@@ -198,11 +220,12 @@ class FullToothFaceFault(ToothFault):
         return (np.concatenate([r, np.hypot(xx, hh)]),
                 np.concatenate([psi, np.arctan2(hh, xx)]))
 
-    def _retreat(self, pair: GearPair, u: np.ndarray) -> np.ndarray:
+    def _retreat(self, pair: GearPair, u: np.ndarray):
         """Rigid-body retreat (m, >= 0) of the mating pinion flank when the nominal
         contact is at line-of-action fraction ``u``: the smallest normal gap between the
         pinion involute (through the nominal contact point) and the remaining gear flank
-        (cut arc and the involute beyond its edges), points within the pinion's flank."""
+        (cut arc and the involute beyond its edges), points within the pinion's flank;
+        and the gear radius (m) of the point where the pinion then touches."""
         z1, z2 = pair.z_pinion, pair.z_gear
         a0 = pair.pressure_angle
         rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
@@ -230,7 +253,8 @@ class FullToothFaceFault(ToothFault):
         gap = rb1 * (np.arctan2(py, px) + inv_r(np.maximum(rp, rb1), rb1) - phi_p[:, None])
         gap = (gap + math.pi * rb1) % (2 * math.pi * rb1) - math.pi * rb1
         gap = np.where((rp >= rb1) & (rp <= ra1), gap, np.inf)
-        return np.clip(gap.min(axis=1), 0.0, None)
+        best = np.argmin(gap, axis=1)
+        return np.clip(gap[np.arange(gap.shape[0]), best], 0.0, None), r[best]
 
     def deviation_depth(self, pair: GearPair) -> float:
         """Peak displacement excitation (m) over the cut (see :meth:`displacement`)."""
@@ -240,11 +264,26 @@ class FullToothFaceFault(ToothFault):
         s = np.linspace(s0, s1, 257)
         return float(-self.displacement(pair, s).min())
 
+    def bridge(self, pair: GearPair):
+        """The cut bridged by the mating flank, sampled across the cut (cached).
+
+        Returns
+        -------
+        s : ndarray (129,)
+            Nominal contact positions (gear roll fractions), cut start to end.
+        retreat : ndarray (129,)
+            Rigid retreat of the mating flank, m (:meth:`_retreat`).
+        contact : ndarray (129,)
+            Roll fraction of the gear point actually touched (an edge of the cut, or its
+            floor for shallow cuts).
+        """
+        return _bridge(self, pair)
+
     def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
         """Loss of approach along the line of action while the nominal contact lies in
         the cut: the mating flank bridges the hollow and bears on the cut's edges (or its
         floor, for shallow cuts), so the pair's transmission error drops by the rigid
-        gap computed from the exact involute geometry (:meth:`_retreat`)."""
+        gap computed from the exact involute geometry (:meth:`bridge`)."""
         s = np.asarray(s, dtype=float)
         out = np.zeros_like(s)
         if self.is_healthy:
@@ -252,11 +291,22 @@ class FullToothFaceFault(ToothFault):
         s0, s1 = self.window
         inside = (s > s0) & (s < s1)
         if inside.any():
-            # the retreat is smooth but for one kink: sample it on 193 points, interpolate
-            knots = np.linspace(s0, s1, 193)
-            ret = self._retreat(pair, 1.0 - knots)
+            knots, ret, _ = self.bridge(pair)
             out[inside] = -self.transmission * np.interp(s[inside], knots, ret)
         return out
+
+
+@functools.lru_cache(maxsize=1024)
+def _bridge(fault: FullToothFaceFault, pair: GearPair):
+    s0, s1 = fault.window
+    knots = np.linspace(s0, s1, 129)   # smooth but for the edge switch: interpolate
+    ret, radius = fault._retreat(pair, 1.0 - knots)
+    rb = pair.base_radius(pair.z_gear)
+    _, (l_lo, l_hi) = pair.roll_limits
+    contact = (np.sqrt(np.maximum(radius ** 2 - rb ** 2, 0.0)) - l_lo) / (l_hi - l_lo)
+    for arr in (knots, ret, contact):
+        arr.setflags(write=False)
+    return knots, ret, contact
 
 
 class Fault:

@@ -99,6 +99,12 @@ class GearPair:
             raise GearshotError(
                 f"bore_radius must be well below the pinion root radius "
                 f"({self.root_radius(self.z_pinion):.4g} m); got {self.bore_radius!r}")
+        (p_lo, _), (g_lo, _) = self.roll_limits
+        if p_lo <= 0 or g_lo <= 0:
+            raise GearshotError(
+                f"z_pinion={self.z_pinion}, z_gear={self.z_gear}: the path of contact starts "
+                f"below a base circle (involute interference); use more pinion teeth or a "
+                f"smaller addendum (addendum={self.addendum!r})")
         if not self.contact_ratio > 1.0:
             raise GearshotError(f"the pair's contact ratio must exceed 1; got "
                                 f"{self.contact_ratio:.4g} (z={self.z_pinion}/{self.z_gear})")

@@ -4,6 +4,12 @@ Along the roll length of the active profile (s in [0, 1]) tooth i deviates by
 ``e_i(s) = fHa_i s + 0.5 ffa_i sin(2 pi n s + phi_i) + noise_i(s)`` with fHa_i, ffa_i drawn
 within +-10 % of the grade's values, n = 2.5 waves (z < 20) or 3.5, phi_i ~ U(-pi, pi) and
 noise_i piecewise linear between knots drawn from U(-c, c) (DESIGN.md section 2).
+
+In the dynamics, s is the position along the path of contact (0 at the start of the
+pair's contact, 1 at its end) for both wheels, as in the lab's model; the two wheels'
+slope terms then add into a mesh-periodic sawtooth (measuring each wheel's s from its own
+root instead would let equal slopes cancel and lowers the mesh harmonics about 4-fold,
+far below the reference SAs).
 """
 
 from __future__ import annotations

@@ -117,7 +117,7 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 
 _N_TABLE = 1025
-_N_SEGMENT = 48  # exact evaluations per smooth segment of a faulty tooth's compliance
+_N_SEGMENT = 24  # exact evaluations per smooth segment of a faulty tooth's compliance
 
 
 @functools.lru_cache(maxsize=32)
@@ -200,7 +200,7 @@ def mesh_stiffness(pair: GearPair, pinion_angle, *, fault: ToothFault | None = N
         inside = (u >= 0) & (u < 1)
         k = np.interp(u, u_grid, k_healthy)
         if k_fault is not None:
-            faulty = np.mod(n, pair.z_gear) == fault.tooth
+            faulty = np.mod(n, pair.z_gear) == fault.tooth % pair.z_gear
             k = np.where(faulty, np.interp(u, u_grid, k_fault), k)
         total += np.where(inside, k, 0.0)
     return total
