@@ -47,9 +47,20 @@ def resample_transfer_function(tf_one_sided, n_out):
     full = np.concatenate([tf, np.conj(tf[:0:-1])])
     axis_in = np.linspace(0.0, 1.0, full.size)
     axis_out = np.linspace(0.0, 1.0, n_out)
-    magnitude = CubicSpline(axis_in, np.abs(full))(axis_out)
+    with np.errstate(over="ignore"):
+        modulus = np.abs(full)
+    peak = float(np.max(modulus))
+    if not np.isfinite(peak):
+        raise GearshotError("tf_one_sided has magnitudes beyond the float range")
+    # splines are linear in the data: scaling by a power of two is exact and keeps
+    # slopes of huge values finite
+    scale = 2.0 ** np.round(np.log2(peak)) if peak > 0 else 1.0
+    magnitude = CubicSpline(axis_in, modulus / scale)(axis_out)
     phase = CubicSpline(axis_in, np.unwrap(np.angle(full)))(axis_out)
-    half = (magnitude * np.exp(1j * phase))[: n_out // 2 + 1]
+    with np.errstate(over="ignore", invalid="ignore"):
+        half = (scale * magnitude * np.exp(1j * phase))[: n_out // 2 + 1]
+    if not np.all(np.isfinite(half)):
+        raise GearshotError("tf_one_sided is too large: its resampled values overflow")
     n_mirror = n_out - half.size
     return np.concatenate([half, np.conj(half[1:n_mirror + 1][::-1])])
 
