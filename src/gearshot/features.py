@@ -42,7 +42,7 @@ __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
 _TINY_RMS = 1e-10
 _SHAFT_ORDERS = (1, 2)
-_WORKERS = -1  # scipy.fft threads: all cores
+_WORKERS = None  # scipy.fft threads: one (Dask workers parallelize across processes)
 
 
 class _Parts:

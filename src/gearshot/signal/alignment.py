@@ -105,7 +105,7 @@ def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=Fals
             fine[:, half] = cross[:, half] / 4.0  # split Nyquist bins multiply to a quarter
         else:
             fine[:, : half + 1] = cross[:, : half + 1]
-        cc = scipy.fft.irfft(fine, n=n_fine, axis=-1, workers=-1)
+        cc = scipy.fft.irfft(fine, n=n_fine, axis=-1)
         tau = np.argmax(cc, axis=-1) / upsample  # delay of each reference, samples
         advance = _shift_factors(n, tau)
         res_spec = sx[None, :] * advance - spec_r

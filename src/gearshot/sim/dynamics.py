@@ -38,7 +38,7 @@ __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
            "DEFAULT_MIN_FS"]
 
 _G0 = 9.80665  # m/s^2 per g
-#: internal integration rate floor, Hz (see benchmarks/RESULTS_sim.md: dt convergence)
+#: internal integration rate floor, Hz (see benchmarks/RESULTS.md, gearshot.sim section: dt convergence)
 DEFAULT_MIN_FS = 100e3
 _BATCH_CHUNK = 64
 
@@ -397,7 +397,7 @@ def _draw_errors(pair, grade, n, rng, same_gear, average_pinion):
 def _warmup_time(pair: GearPair, integ: _Integrator) -> float:
     # the start transient (from the static state under the mean mesh stiffness; small)
     # of the slowest mode decays to 1 % of its start: SA error ~2e-5 relative for the
-    # paper pair (benchmarks/RESULTS_sim.md)
+    # paper pair (benchmarks/RESULTS.md, gearshot.sim section)
     return 4.6 / (pair.damping_ratio * integ.omega_min)
 
 
