@@ -15,6 +15,7 @@ __all__ = [
     "check_positive",
     "check_int",
     "check_in_range",
+    "check_increasing",
     "describe",
 ]
 
@@ -135,3 +136,14 @@ def check_in_range(value: Any, name: str, low: float, high: float, *,
         hb = "]" if high_inclusive else ")"
         raise GearshotError(f"{name} must lie in {lb}{low}, {high}{hb}; got {value}")
     return value
+
+
+def check_increasing(x: np.ndarray, name: str, *, unit: str = "") -> np.ndarray:
+    """Raise unless the 1-D array ``x`` is strictly increasing; names the first offender."""
+    steps = np.diff(x)
+    if np.any(steps <= 0):
+        i = int(np.flatnonzero(steps <= 0)[0])
+        raise GearshotError(
+            f"{name} must be strictly increasing; {name}[{i + 1}]={float(x[i + 1])!r}{unit} "
+            f"does not follow {name}[{i}]={float(x[i])!r}{unit}")
+    return x

@@ -28,16 +28,12 @@ import scipy.signal
 from .._validation import check_in_range, check_int
 from .reality import RigReality
 
+from ..sim.profile_errors import DIN_PROFILE_TOLERANCES
+
 __all__ = ["SurrogateEngine", "DIN_PROFILE_TOLERANCES_UM"]
 
-#: grade -> (fHa, ffa, c) in micrometres (DIN 3962, DESIGN.md section 2).
-DIN_PROFILE_TOLERANCES_UM = {
-    g: (fh, ff, c) for g, fh, ff, c in zip(
-        range(1, 13),
-        (1, 1.5, 2, 3, 4.5, 6, 9, 12, 18, 28, 45, 71),
-        (1.5, 2, 3, 4, 6, 8, 11, 16, 22, 36, 56, 90),
-        (0.02, 0.04, 0.06, 0.08, 0.1, 0.2, 0.3, 0.4, 0.6, 1.0, 1.5, 2.3))
-}
+#: grade -> (fHa, ffa, c) in micrometres (DIN 3962): the simulator's table.
+DIN_PROFILE_TOLERANCES_UM = DIN_PROFILE_TOLERANCES
 
 _G = 9.80665
 

@@ -8,7 +8,8 @@ import scipy.signal
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range, check_int, check_positive
+from .._validation import (as_signal_array, check_in_range, check_increasing, check_int,
+                           check_positive)
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 
@@ -70,13 +71,7 @@ def _check_pulses(pulse_times, name="pulse_times"):
     pulses = as_signal_array(pulse_times, name, max_ndim=1)
     if pulses.size < 2:
         raise GearshotError(f"{name} must hold at least 2 pulses; got {pulses.size}")
-    steps = np.diff(pulses)
-    if np.any(steps <= 0):
-        i = int(np.flatnonzero(steps <= 0)[0])
-        raise GearshotError(
-            f"{name} must be strictly increasing; pulse {i + 1} at {pulses[i + 1]!r} s "
-            f"does not follow pulse {i} at {pulses[i]!r} s")
-    return pulses
+    return check_increasing(pulses, name, unit=" s")
 
 
 def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):

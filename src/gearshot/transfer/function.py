@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int, describe
+from .._validation import as_signal_array, check_increasing, check_int, describe
 
 __all__ = ["TransferFunction"]
 
@@ -76,12 +76,7 @@ class TransferFunction:
                                 f"got {values.shape}")
         if freqs[0] < 0:
             raise GearshotError(f"freqs must be >= 0 Hz; got first line {float(freqs[0])!r}")
-        steps = np.diff(freqs)
-        if np.any(steps <= 0):
-            i = int(np.flatnonzero(steps <= 0)[0])
-            raise GearshotError(
-                f"freqs must be strictly increasing; freqs[{i}]={float(freqs[i])!r} is followed by "
-                f"freqs[{i + 1}]={float(freqs[i + 1])!r}")
+        check_increasing(freqs, "freqs", unit=" Hz")
         for key in ("response_node", "response_direction", "reference_node",
                     "reference_direction"):
             object.__setattr__(self, key, check_int(getattr(self, key), key))
