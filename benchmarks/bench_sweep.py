@@ -30,7 +30,7 @@ def main():
     speeds, loads = [10.0, 15.0, 20.0, 25.0], [10.0]
     store = Path(args.data) / "db-sweep-grade7"
     t0 = time.perf_counter()
-    with Client(LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None)) as c:
+    with Client(LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0")) as c:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=[7],
                        n_healthy=100, n_faulty=700, seed=0, client=c)
     t_db = time.perf_counter() - t0
@@ -40,7 +40,7 @@ def main():
         results = Path(args.data) / f"sweep-results-{workers}"
         shutil.rmtree(results, ignore_errors=True)
         with Client(LocalCluster(n_workers=workers, threads_per_worker=1,
-                                 dashboard_address=None)) as client:
+                                 dashboard_address=":0")) as client:
             t0 = time.perf_counter()
             frame = simulated_experiment(store, speeds=speeds, loads=loads, grade=7,
                                          frf_folder=args.frf_folder, results_dir=results,

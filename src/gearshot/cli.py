@@ -55,7 +55,7 @@ def _client(scheduler: Optional[str], workers: int, *, needed: bool):
         from dask.distributed import Client, LocalCluster
 
         return Client(LocalCluster(n_workers=workers, threads_per_worker=1,
-                                   dashboard_address=None))
+                                   dashboard_address=":0"))
     return None
 
 
