@@ -139,7 +139,11 @@ class SimulatorEngine:
             grade, prng = self.nominal_grade, rng
         else:
             grade, prng = reality.grade, np.random.default_rng(reality.profile_seed)
+        if reality is not None and size > 0 and any(reality.fault_roughness):
+            fault = dict(faults=[IrregularFaceFault(size=size, center=center, depth=depth,
+                                                    roughness=reality.fault_roughness)])
+        else:
+            fault = dict(fault_sizes=[size], fault_center=center, fault_depth=depth)
         res = simulate(pair, speed=speed, load=np.asarray(load_torque, dtype=np.float64),
-                       grade=grade, fault_sizes=[size], fs=fs, duration=revs.size / fs,
-                       rng=prng, fault_center=center, fault_depth=depth)
+                       grade=grade, fs=fs, duration=revs.size / fs, rng=prng, **fault)
         return res.acceleration[0]
