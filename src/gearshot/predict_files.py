@@ -13,7 +13,7 @@ __all__ = ["predict_from_files"]
 
 
 def _recording_files(path: Path):
-    from .rig import FORMATS
+    from .rig import FORMATS, INDEX_NAME
 
     path = Path(path)
     if path.is_file():
@@ -21,7 +21,8 @@ def _recording_files(path: Path):
     if not path.is_dir():
         raise GearshotError(f"--recordings {str(path)!r} does not exist")
     suffixes = {s if s.startswith(".") else f".{s}" for s in FORMATS}
-    files = sorted(p for p in path.iterdir() if p.suffix.lower() in suffixes)
+    files = sorted(p for p in path.iterdir()
+                   if p.suffix.lower() in suffixes and p.name != INDEX_NAME)
     if not files:
         raise GearshotError(f"{str(path)!r} holds no recording ({sorted(suffixes)})")
     return files
