@@ -80,23 +80,23 @@ class _LagSearch:
         self.offsets = offsets
 
     def best(self, cross: np.ndarray) -> np.ndarray:
-        """Fine-grid index (0 … n·upsample−1) of the maximum for each row of ``cross``."""
+        """Fine-grid index (0 … n·upsample−1) of the first maximum for each row of ``cross``."""
         n, n_fine = self.n, self.n * self.upsample
         half = cross[:, : n // 2 + 1] * self.weights
         padded = np.zeros((cross.shape[0], n * self.coarse // 2 + 1), dtype=complex)
         padded[:, : half.shape[1]] = half
         padded[:, 1:] *= 0.5  # irfft doubles these bins itself
         coarse = scipy.fft.irfft(padded, n=n * self.coarse, axis=-1)
-        out = np.empty(cross.shape[0], dtype=int)
-        for r in range(cross.shape[0]):
-            cand = np.argpartition(coarse[r], -self.n_candidates)[-self.n_candidates:]
-            centres = np.sort(cand) * self.step
-            base = np.exp(2j * np.pi * np.outer(centres, self.k) / n_fine) * half[r]
-            values = np.hstack([base.real, -base.imag]) @ self.offset_phase
-            fine = (centres[:, None] + self.offsets[None, :]) % n_fine
-            order = np.lexsort((fine.ravel(), -values.ravel()))
-            out[r] = fine.ravel()[order[0]]
-        return out
+        cand = np.sort(np.argpartition(coarse, -self.n_candidates, axis=-1)
+                       [:, -self.n_candidates:], axis=-1)
+        centres = cand * self.step  # (rows, n_candidates) on the fine grid
+        base = np.exp(2j * np.pi * centres[:, :, None] * self.k / n_fine) * half[:, None, :]
+        values = np.concatenate([base.real, -base.imag], axis=-1) @ self.offset_phase
+        fine = (centres[:, :, None] + self.offsets) % n_fine
+        values = values.reshape(len(values), -1)
+        fine = fine.reshape(len(fine), -1)
+        top = values == values.max(axis=-1, keepdims=True)
+        return np.where(top, fine, n_fine).min(axis=-1)  # first maximum, as argmax
 
 
 def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=False):
@@ -141,20 +141,25 @@ def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=Fals
     spec_x = scipy.fft.fft(flat, axis=-1)
     spec_r = scipy.fft.fft(refs, axis=-1)
     search = _LagSearch(n, upsample)
+    n_refs = refs.shape[0]
 
     residual = np.empty_like(flat)
     ref_index = np.empty(flat.shape[0], dtype=int)
     delays = np.empty(flat.shape[0])
-    for i, sx in enumerate(spec_x):
-        cross = sx[None, :] * np.conj(spec_r)
-        tau = search.best(cross) / upsample  # delay of each reference, samples
-        advance = _shift_factors(n, tau)
-        res_spec = sx[None, :] * advance - spec_r
-        energy = np.sum(np.abs(res_spec) ** 2, axis=-1)
-        best = int(np.argmin(energy))
-        residual[i] = scipy.fft.ifft(res_spec[best] * np.conj(advance[best])).real
-        ref_index[i] = best
-        delays[i] = tau[best]
+    chunk = max(1, 256 // n_refs)
+    for start in range(0, flat.shape[0], chunk):
+        sx = spec_x[start:start + chunk]  # (c, n)
+        cross = (sx[:, None, :] * np.conj(spec_r)[None]).reshape(-1, n)
+        tau = (search.best(cross) / upsample).reshape(-1, n_refs)  # delays, samples
+        advance = _shift_factors(n, tau)  # (c, n_refs, n)
+        res_spec = sx[:, None, :] * advance - spec_r[None]
+        energy = np.sum(res_spec.real ** 2 + res_spec.imag ** 2, axis=-1)
+        best = np.argmin(energy, axis=-1)
+        rows = np.arange(len(sx))
+        back = res_spec[rows, best] * np.conj(advance[rows, best])
+        residual[start:start + chunk] = scipy.fft.ifft(back, axis=-1).real
+        ref_index[start:start + chunk] = best
+        delays[start:start + chunk] = tau[rows, best]
     residual = residual.reshape(signals.shape)
     if return_details:
         return residual, ref_index.reshape(batch_shape), delays.reshape(batch_shape)
