@@ -29,6 +29,7 @@ def main():
 
     speeds, loads = [10.0, 15.0, 20.0, 25.0], [10.0]
     store = Path(args.data) / "db-sweep-grade7"
+    shutil.rmtree(store, ignore_errors=True)  # time a fresh build
     t0 = time.perf_counter()
     with Client(LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0")) as c:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=[7],
