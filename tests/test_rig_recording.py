@@ -248,3 +248,17 @@ def test_round_trip_property(tmp_path, values, fs, speed, text, extra, fmt):
     np.testing.assert_array_equal(back.acceleration, rec.acceleration)
     np.testing.assert_array_equal(back.tacho, rec.tacho)
     assert back.fs == rec.fs and back.metadata == rec.metadata
+
+
+def test_jittered_tacho_has_one_clean_pulse_per_revolution():
+    """An early pulse must not be split at the integer angle (a double pulse)."""
+    from gearshot.rig.tacho import tacho_signal
+    from gearshot.signal import pulse_times
+
+    fs = 50_000.0
+    revs = 15.0 * np.arange(int(30 * fs)) / fs
+    for seed in range(4):
+        x = tacho_signal(revs, jitter=5e-3, rng=np.random.default_rng(seed))
+        steps = np.diff(pulse_times(x, fs)) * 15.0  # revolutions between pulses
+        assert steps.size in (448, 449, 450)
+        assert steps.min() > 0.95 and steps.max() < 1.05

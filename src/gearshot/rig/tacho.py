@@ -49,14 +49,19 @@ def tacho_signal(shaft_revs: np.ndarray, *, pulses_per_rev: int = 1, duty: float
         raise GearshotError(f"duty + 2*edge*pulses_per_rev must be < 1; got duty={duty}, "
                             f"edge={edge}")
     a = revs * ppr
-    k = np.floor(a).astype(np.int64)
     if jitter > 0:
         if rng is None:
             raise GearshotError("rng (a numpy.random.Generator) is needed when jitter > 0")
-        k0 = int(k.min())
-        delta = rng.normal(0.0, jitter * ppr, size=int(k.max()) - k0 + 2)
-        a = a - delta[k - k0]
-    p = np.mod(a, 1.0)
+        # pulse k rises at a = k + delta_k; each sample belongs to the last pulse that has
+        # risen before it (indexing delta by floor(a) instead would cut an early pulse's
+        # edge in two at the integer angle, a double pulse)
+        k0, k1 = int(np.floor(a.min())) - 1, int(np.floor(a.max())) + 2
+        starts = np.arange(k0, k1) + rng.normal(0.0, jitter * ppr, size=k1 - k0)
+        starts = np.maximum.accumulate(starts)
+        j = np.clip(np.searchsorted(starts, a, side="right") - 1, 0, starts.size - 1)
+        p = a - starts[j]
+    else:
+        p = np.mod(a, 1.0)
     rise = np.clip(p / (edge * ppr), 0.0, 1.0)
     fall = np.clip((duty - p) / (edge * ppr), 0.0, 1.0)
     return amplitude * np.minimum(rise, fall)
