@@ -144,8 +144,7 @@ def _figures(out, est, results, full_pred, campaign, rig):
     plotting.plot_spectrum_background(spec, acs_background(spec), ax=ax)
     figs["Spectrum of a long healthy signal and its ACS background"] = \
         plotting.save_figure(fig, out / "spectrum_acs")[0]
-    true_tf = rig.true_transfer_function(est.n_points_) \
-        if hasattr(rig, "true_transfer_function") else None
+    true_tf = _hidden_path_on_sa_grid(rig, SPEED, est.n_points_)
     if true_tf is not None:
         fig, ax = plt.subplots(figsize=(8, 3.5))
         plotting.plot_tf_estimate(true_tf, est.transfer_function_, ax=ax)
@@ -157,3 +156,16 @@ def _figures(out, est, results, full_pred, campaign, rig):
     figs["A faulty SA and its difference signal"] = \
         plotting.save_figure(fig, out / "sa_difference")[0]
     return figs
+
+
+def _hidden_path_on_sa_grid(rig, speed, n_points):
+    """The rig's hidden path (its FIR) at the SA grid's orders, for the demo's figure only."""
+    import scipy.signal
+
+    if not hasattr(rig, "reveal_path"):
+        return None
+    _, fir = rig.reveal_path()
+    gear_rate = speed * rig.pinion_teeth / rig.gear_teeth  # gear revolutions per second
+    orders = np.arange(n_points // 2 + 1)
+    _, h = scipy.signal.freqz(fir, worN=orders * gear_rate, fs=rig.fs)
+    return np.concatenate([h, np.conj(h[1:n_points - h.size + 1][::-1])])
