@@ -129,8 +129,6 @@ def rig(
                                             "surface grade (default: hidden, drawn)."),
 ) -> None:
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
-    from .rig import VirtualRig
-
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     rig_obj = _make_rig(seed, frf_folder, rig_grade)
@@ -149,10 +147,7 @@ def _make_rig(seed, frf_folder, rig_grade):
         if not 1 <= rig_grade <= 12:
             raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
         kwargs["grade"] = rig_grade
-    try:
-        return VirtualRig(seed=seed, **kwargs)
-    except TypeError:
-        raise GearshotError("this VirtualRig does not accept --rig-grade") from None
+    return VirtualRig(seed=seed, **kwargs)
 
 
 @experiment_app.command("simulated")
@@ -259,7 +254,7 @@ def experiment_rig(
     if not (campaign / "index.csv").is_file():
         rig_obj = _make_rig(seed, frf_folder, rig_grade)
         if attenuation_db is not None:
-            rig_obj = _with_attenuation(rig_obj, attenuation_db)
+            rig_obj = rig_obj.with_reality(attenuation_db=attenuation_db)
         rig_obj.campaign(campaign, speed=speed, load=load, duration=duration)
     selection = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
@@ -276,12 +271,6 @@ def experiment_rig(
         from .figures import rig_figures
 
         rig_figures(results, predictions, out)
-
-
-def _with_attenuation(rig_obj, attenuation_db):
-    if hasattr(rig_obj, "with_reality"):
-        return rig_obj.with_reality(attenuation_db=attenuation_db)
-    raise GearshotError("this VirtualRig does not accept --attenuation-db")
 
 
 @app.command()

@@ -145,11 +145,10 @@ def _figures(out, est, results, full_pred, campaign, rig):
     figs["Spectrum of a long healthy signal and its ACS background"] = \
         plotting.save_figure(fig, out / "spectrum_acs")[0]
     true_tf = _hidden_path_on_sa_grid(rig, SPEED, est.n_points_)
-    if true_tf is not None:
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        plotting.plot_tf_estimate(true_tf, est.transfer_function_, ax=ax)
-        figs["Transfer-function estimate vs the rig's hidden path"] = \
-            plotting.save_figure(fig, out / "tf_estimate")[0]
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    plotting.plot_tf_estimate(true_tf, est.transfer_function_, ax=ax)
+    figs["Transfer-function estimate vs the rig's hidden path"] = \
+        plotting.save_figure(fig, out / "tf_estimate")[0]
     sa = recording_segments(faulty_path)[0]
     fig, ax = plt.subplots(figsize=(8, 3.5))
     plotting.plot_sa_and_difference(sa, est.mesh_order, ax=ax)
@@ -162,8 +161,6 @@ def _hidden_path_on_sa_grid(rig, speed, n_points):
     """The rig's hidden path (its FIR) at the SA grid's orders, for the demo's figure only."""
     import scipy.signal
 
-    if not hasattr(rig, "reveal_path"):
-        return None
     _, fir = rig.reveal_path()
     gear_rate = speed * rig.pinion_teeth / rig.gear_teeth  # gear revolutions per second
     orders = np.arange(n_points // 2 + 1)

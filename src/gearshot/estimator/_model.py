@@ -13,7 +13,7 @@ from sklearn.utils.validation import check_is_fitted
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int
 from ..features import PAPER_FEATURES, available_features
-from ..transfer import resample_transfer_function
+from ..transfer import mean_rms, resample_transfer_function
 from . import steps
 from .zero_shot import healthy_signature, match_grade
 
@@ -240,7 +240,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.transfer_function_ = self._target_tf(healthy_long, n_points)
 
         # target side (steps 5–7), independent of the grade
-        self.target_scale_ = float(np.mean(np.sqrt(np.mean(target_healthy ** 2, axis=1))))
+        self.target_scale_ = mean_rms(target_healthy)
         if self.rms_normalization and self.target_scale_ <= 0:
             raise GearshotError("target_healthy has zero RMS")
         scaled = target_healthy / self.target_scale_ if self.rms_normalization \

@@ -25,7 +25,7 @@ from sklearn.utils import check_random_state
 from .._errors import GearshotError
 from ..features import extract_features
 from ..signal import subtract_healthy
-from ..transfer import estimate_transfer_function, propagate, rms_normalize
+from ..transfer import estimate_transfer_function, mean_rms, propagate, rms_normalize
 
 __all__ = [
     "select_features",
@@ -253,7 +253,7 @@ def select_features(sim_sa, fault_size, selection_tf, *, mesh_order, names,
     sim_sa = np.asarray(sim_sa, float)
     healthy = np.asarray(fault_size) == 0
     n_points = sim_sa.shape[1]
-    noise_rms = noise_fraction * float(np.mean(np.sqrt(np.mean(sim_sa[healthy] ** 2, 1))))
+    noise_rms = noise_fraction * mean_rms(sim_sa[healthy])
     noisy = sim_sa + noise_rms * rng.standard_normal(sim_sa.shape)
     test = propagate(noisy, selection_tf)
     long_cycles = propagate(_long_healthy_signal(sim_sa[healthy], n_long_cycles, noise_rms,

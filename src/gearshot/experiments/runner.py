@@ -71,7 +71,6 @@ def _write_parquet_atomic(frame: pd.DataFrame, path: Path) -> None:
 def _simulated_task(spec: dict) -> pd.DataFrame:
     """One (speed, load, attenuation): every test TF × variant. Runs on a Dask worker."""
     from ..sim import load_database
-    from ..transfer import TransferFunctionBank
     from .simulated import simulated_dataset
 
     db = load_database(spec["store"], speed=spec["speed"], load=spec["load"],

@@ -9,7 +9,7 @@ import xarray as xr
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..transfer import propagate
+from ..transfer import mean_rms, propagate
 
 __all__ = ["SimulatedDataset", "simulated_dataset"]
 
@@ -101,7 +101,7 @@ def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
     h_target, h_test = h_test[:n_target], h_test[n_target:]
 
     alpha = 10 ** (-attenuation_db / 20)
-    noise_rms = noise_fraction * float(np.mean(np.sqrt(np.mean(sa[healthy] ** 2, 1))))
+    noise_rms = noise_fraction * mean_rms(sa[healthy])
 
     def to_target(x, n_avg):
         noisy = x + noise_rms / np.sqrt(n_avg) * rng.standard_normal(x.shape)

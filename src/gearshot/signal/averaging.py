@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_int

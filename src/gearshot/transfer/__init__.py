@@ -7,6 +7,7 @@ container, UFF58/CSV I/O, hammer-test estimation, modal synthesis, physical-time
 from .bank import TransferFunctionBank
 from .estimation import (
     estimate_transfer_function,
+    mean_rms,
     propagate,
     resample_transfer_function,
     rms,
@@ -24,6 +25,7 @@ __all__ = [
     "resample_transfer_function",
     "propagate",
     "rms",
+    "mean_rms",
     "rms_normalize",
     "TransferFunction", "TransferFunctionBank", "UffRecord", "read_frf", "write_frf",
     "read_uff_records", "FRF_SUFFIXES", "ImpactFRF", "frf_from_impacts", "impact_arrays",

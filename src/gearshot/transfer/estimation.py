@@ -16,6 +16,7 @@ __all__ = [
     "resample_transfer_function",
     "propagate",
     "rms",
+    "mean_rms",
     "rms_normalize",
 ]
 
@@ -131,6 +132,11 @@ def rms(x):
     return np.sqrt(np.mean(x * x, axis=-1))
 
 
+def mean_rms(signals):
+    """Mean over signals of the RMS along the last axis: the RMS-normalization scale."""
+    return float(np.mean(rms(signals)))
+
+
 def rms_normalize(signals, reference):
     """Divide signals by the mean RMS of reference signals (paper step 5).
 
@@ -146,7 +152,7 @@ def rms_normalize(signals, reference):
     ndarray, shape (..., n)
     """
     signals = as_signal_array(signals, "signals")
-    scale = float(np.mean(rms(as_signal_array(reference, "reference"))))
+    scale = mean_rms(as_signal_array(reference, "reference"))
     if scale <= 0:
         raise GearshotError("reference signals have zero RMS; cannot normalize by them")
     return signals / scale
