@@ -2,8 +2,18 @@
 
 from pathlib import Path
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# Property tests draw the same examples on every run (the project's determinism rule);
+# GEARSHOT_HYPOTHESIS=explore draws fresh ones, for hunting new counter-examples locally.
+settings.register_profile("deterministic", derandomize=True, database=None)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile("explore" if os.environ.get("GEARSHOT_HYPOTHESIS") == "explore"
+                      else "deterministic")
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 

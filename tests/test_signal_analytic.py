@@ -177,3 +177,17 @@ def test_lag_search_equals_the_full_interpolated_correlation():
     fine[:, n // 2] = cross[:, n // 2] / 4
     brute = np.argmax(np.fft.irfft(fine, n=n * up), axis=-1)
     np.testing.assert_array_equal(_LagSearch(n, up).best(cross), brute)
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_lag_search_on_signals_shorter_than_its_candidate_count(n):
+    """Regression (found by Hypothesis): 2- and 3-sample signals align to themselves."""
+    x = np.arange(1.0, n + 1)
+    residual = signal.subtract_healthy(x, x, upsample=1)
+    np.testing.assert_allclose(residual, 0.0, atol=1e-12)
+
+
+def test_pulse_times_with_no_rearmed_crossing_is_empty():
+    """Regression (found by Hypothesis): an up-crossing never preceded by a re-arm is no pulse."""
+    x = np.array([0.0] + [1.7e16] * 8 + [-1.3e16])
+    assert signal.pulse_times(x, 1000.0).size == 0

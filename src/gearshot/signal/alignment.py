@@ -87,8 +87,8 @@ class _LagSearch:
         padded[:, : half.shape[1]] = half
         padded[:, 1:] *= 0.5  # irfft doubles these bins itself
         coarse = scipy.fft.irfft(padded, n=n * self.coarse, axis=-1)
-        cand = np.sort(np.argpartition(coarse, -self.n_candidates, axis=-1)
-                       [:, -self.n_candidates:], axis=-1)
+        n_cand = min(self.n_candidates, coarse.shape[-1])
+        cand = np.sort(np.argpartition(coarse, -n_cand, axis=-1)[:, -n_cand:], axis=-1)
         centres = cand * self.step  # (rows, n_candidates) on the fine grid
         base = np.exp(2j * np.pi * centres[:, :, None] * self.k / n_fine) * half[:, None, :]
         values = np.concatenate([base.real, -base.imag], axis=-1) @ self.offset_phase

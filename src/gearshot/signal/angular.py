@@ -58,7 +58,7 @@ def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1):
         valid = last_below >= 0
         up, last_below = up[valid], last_below[valid]
         # keep the first up-crossing after each re-arming
-        keep = np.r_[True, last_below[1:] != last_below[:-1]]
+        keep = np.r_[True, last_below[1:] != last_below[:-1]][:up.size]
         up = up[keep]
     else:
         up = up[:0]
