@@ -252,3 +252,52 @@ def test_isotonic_tuning_ignores_a_lucky_outlier():
     assert np.all(np.diff(curve["smoothed"]) >= 0)
     with pytest.raises(GearshotError, match="smoothing"):
         steps.tune_grade(preds.get, [1, 2], 0.3, smoothing="spline")
+
+
+# ------------------------------------------------------------------- soft grade weighting
+def test_grade_weights_follow_a_gaussian_likelihood_of_the_example():
+    residuals = np.full(99, 0.1)  # 90 % quantile 0.1 → sigma 0.05
+    w = steps.grade_weights([0.30, 0.35, 0.40, 0.90], [1, 2, 3, 4], 0.35, residuals)
+    assert list(w) == [2, 1, 3]  # largest first; grade 4 (10 sigma away) is dropped
+    assert_allclose(sum(w.values()), 1.0)
+    assert_allclose(w[1], w[3])
+    assert_allclose(w[1] / w[2], np.exp(-0.5))
+
+
+def test_conformal_quantile_is_the_finite_sample_rank():
+    res = np.arange(1, 11) / 10  # 0.1 … 1.0
+    assert steps.conformal_quantile(res, 0.5) == 0.6  # ceil(11 * 0.5) = 6th
+    assert steps.conformal_quantile(res, 0.9) == 1.0
+    assert steps.conformal_quantile(-res, 0.5) == 0.6  # signs do not matter
+
+
+def test_mixture_interval_of_one_model_and_of_two_separated_models():
+    res = np.linspace(0, 0.1, 1001)  # uniform |r| on [0, 0.1]
+    pred = np.array([0.5])
+    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
+    assert_allclose([lo[0], hi[0]], [0.41, 0.59], atol=2e-3)
+    # two equally weighted models 0.4 apart: the 90 % range reaches into both
+    lo, hi = steps.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.5, 2: 0.5},
+                                    {1: res, 2: res}, 0.9)
+    assert lo[0] < 0.3 and hi[0] > 0.7
+    # a lopsided mix sits mostly on the heavy model
+    lo, hi = steps.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.97, 2: 0.03},
+                                    {1: res, 2: res}, 0.9)
+    assert hi[0] < 0.4
+
+
+def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):
+    db, healthy, long, faulty, y = data
+    args = (db, healthy, faulty[20], y[20], long)
+    soft = OneFaultShotEstimator(random_state=0).fit(*args, selection_tf=tf_pair[1])
+    best = OneFaultShotEstimator(random_state=0, grade_weighting="best").fit(
+        *args, selection_tf=tf_pair[1])
+    assert best.grade_weights_ == {best.grade_: 1.0}
+    assert soft.grade_ == best.grade_ and soft.grade_ in soft.grade_weights_
+    assert_allclose(sum(soft.grade_weights_.values()), 1.0)
+    X = soft.features_of(faulty)
+    mix = sum(w * soft.grade_models_[g].predict(X) for g, w in soft.grade_weights_.items())
+    assert_allclose(soft.predict(faulty), mix)
+    assert_allclose(best.predict(faulty), best.model_.predict(X))
+    with pytest.raises(GearshotError, match="grade_weighting"):
+        OneFaultShotEstimator(grade_weighting="mean").fit(*args, selection_tf=tf_pair[1])

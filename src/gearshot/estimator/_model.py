@@ -81,6 +81,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     tuning_smoothing : {"isotonic", "none"}, default "isotonic"
         Fit the example's predicted size over the grades by a monotone curve before
         choosing (robust to KNN scatter); "none" is the paper's literal nearest rule.
+    grade_weighting : {"soft", "best"}, default "soft"
+        "best" predicts with the one tuned grade (the paper). "soft" averages the models of
+        every grade, weighted by how well each predicts the faulty example (a Gaussian
+        likelihood whose width is half the 90 % validation-residual quantile of the best
+        grade): one example cannot pin the grade down, and averaging over the grades it
+        leaves plausible is steadier (see :func:`steps.grade_weights`).
     random_state : int, numpy Generator/RandomState or None
 
     Attributes
@@ -88,6 +94,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     selected_features_ : tuple of str
     feature_errors_ : dict
     grade_ : int
+        The best grade (the paper's choice).
+    grade_weights_ : dict grade → weight
+        Weights of the grade models that predict (``{grade_: 1.0}`` unless soft).
     tuning_curve_ : dict of arrays (grade, prediction, abs_error) or None
     transfer_function_ : ndarray of complex or None
     n_neighbors_ : int
@@ -98,7 +107,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  rms_normalization=True, transfer_function="estimate",
                  n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
                  zero_shot=False, upsample=100, tuning_smoothing="isotonic",
-                 random_state=None):
+                 grade_weighting="soft", random_state=None):
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -113,6 +122,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.zero_shot = zero_shot
         self.upsample = upsample
         self.tuning_smoothing = tuning_smoothing
+        self.grade_weighting = grade_weighting
         self.random_state = random_state
 
     # ------------------------------------------------------------------ validation
@@ -128,6 +138,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                        low_inclusive=False, high_inclusive=False)
         check_int(self.mesh_order, "mesh_order", minimum=1)
         check_int(self.upsample, "upsample", minimum=1)
+        if self.grade_weighting not in ("soft", "best"):
+            raise GearshotError(f"grade_weighting must be 'soft' or 'best'; got "
+                                f"{self.grade_weighting!r}")
         grades = [check_int(g, "grades", minimum=1, maximum=12) for g in self.grades]
         if not grades:
             raise GearshotError("grades must list at least one DIN grade")
@@ -274,6 +287,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         # step 2: simulation tuning (or zero-shot grade matching, or the nominal grade)
         seed = int(rng.randint(np.iinfo(np.int32).max))
         self.tuning_curve_ = None
+        self.grade_weights_ = None
         if self.zero_shot:
             target_sig = healthy_signature(scaled, self.mesh_order)
             sims = {g: healthy_signature(
@@ -292,9 +306,17 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             self.grade_, self.tuning_curve_ = steps.tune_grade(
                 predict_example, grades, faulty_size, smoothing=self.tuning_smoothing)
             self.model_ = models[self.grade_]
+            if self.grade_weighting == "soft":
+                self.grade_weights_ = steps.grade_weights(
+                    self.tuning_curve_["prediction"], grades, faulty_size,
+                    self.model_.validation_residuals)
+                self.grade_models_ = {g: models[g] for g in self.grade_weights_}
         else:
             self.grade_ = nominal if not self.tune_simulation else grades[0]
             self.model_ = self._model_for_grade(self.grade_, cols, seed)
+        if self.grade_weights_ is None:
+            self.grade_weights_ = {int(self.grade_): 1.0}
+            self.grade_models_ = {int(self.grade_): self.model_}
         self.n_neighbors_ = self.model_.n_neighbors
         self.faulty_size_ = faulty_size
         del self.database_  # do not keep (or pickle) the whole database
@@ -320,10 +342,17 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         -------
         ndarray (n_signals,)
         """
-        return self.model_.predict(self.features_of(sa))
+        X = self.features_of(sa)
+        return sum(w * self.grade_models_[g].predict(X) for g, w in self.grade_weights_.items())
 
     def predict_interval(self, sa, coverage=0.9):
-        """Split-conformal prediction intervals from the validation split.
+        """Split-conformal prediction intervals from the validation splits.
+
+        Each grade model's interval is its prediction ± the conformal quantile of its
+        validation residuals; with soft grade weighting the interval is the central
+        ``coverage`` range of the weighted mixture of the grade models' residual
+        distributions around their predictions (one model: the plain split-conformal
+        interval).
 
         Returns
         -------
@@ -332,12 +361,17 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         """
         coverage = check_in_range(coverage, "coverage", 0, 1, low_inclusive=False,
                                   high_inclusive=False)
-        pred = self.predict(sa)
-        res = np.sort(self.model_.validation_residuals)
-        n = res.size
-        rank = min(n - 1, int(np.ceil((n + 1) * coverage)) - 1)
-        q = res[max(rank, 0)]
-        return np.clip(pred - q, 0, 1), np.clip(pred + q, 0, 1)
+        X = self.features_of(sa)
+        if len(self.grade_weights_) == 1:
+            pred = self.model_.predict(X)
+            q = steps.conformal_quantile(self.model_.validation_residuals, coverage)
+            return np.clip(pred - q, 0, 1), np.clip(pred + q, 0, 1)
+        preds = {g: self.grade_models_[g].predict(X) for g in self.grade_weights_}
+        low, high = steps.mixture_interval(
+            preds, self.grade_weights_,
+            {g: self.grade_models_[g].validation_residuals for g in self.grade_weights_},
+            coverage)
+        return np.clip(low, 0, 1), np.clip(high, 0, 1)
 
     def score(self, X, y, sample_weight=None):
         """Negative mean absolute error (higher is better)."""

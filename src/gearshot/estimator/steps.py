@@ -31,6 +31,9 @@ __all__ = [
     "select_features",
     "feature_invariance_errors",
     "tune_grade",
+    "grade_weights",
+    "conformal_quantile",
+    "mixture_interval",
     "estimate_tf",
     "propagate_simulated",
     "normalize_rms",
@@ -326,3 +329,82 @@ def tune_grade(predict_example: Callable[[int], float], grades: Sequence[int],
     best = grades[int(candidates[np.argmin(raw_error[candidates])])]
     return best, {"grade": np.array(grades), "prediction": preds, "smoothed": smoothed,
                   "abs_error": errors}
+
+
+def grade_weights(predictions, grades, faulty_size, validation_residuals, *,
+                  coverage=0.9, min_weight=1e-3):
+    """Step 2, soft form: weight each grade by how well it predicts the faulty example.
+
+    ``w_g ∝ exp(-½ ((ŷ_g - y) / σ)²)`` with ``σ`` half the ``coverage`` quantile of the
+    best grade's validation residuals (the scatter a correct model shows on one signal).
+    Grades below ``min_weight`` of the total are dropped and the rest renormalized.
+
+    Parameters
+    ----------
+    predictions : array_like (n_grades,)
+        Each grade model's prediction of the example.
+    grades : sequence of int
+    faulty_size : float
+    validation_residuals : array_like
+        ``|y - ŷ|`` of the best grade's model on its validation split.
+
+    Returns
+    -------
+    dict grade → weight (sums to 1, largest first)
+    """
+    preds = np.asarray(predictions, float)
+    sigma = max(0.5 * conformal_quantile(validation_residuals, coverage), 1e-3)
+    logw = -0.5 * ((preds - faulty_size) / sigma) ** 2
+    w = np.exp(logw - logw.max())
+    w /= w.sum()
+    keep = w >= min_weight
+    w = w[keep] / w[keep].sum()
+    kept = np.asarray(grades)[keep]
+    order = np.argsort(-w, kind="stable")
+    return {int(kept[i]): float(w[i]) for i in order}
+
+
+def conformal_quantile(residuals, coverage):
+    """Split-conformal quantile: the ⌈(n+1)·coverage⌉-th smallest absolute residual."""
+    res = np.sort(np.abs(np.asarray(residuals, float)))
+    if res.size == 0:
+        raise GearshotError("conformal_quantile needs at least one residual")
+    rank = min(res.size - 1, int(np.ceil((res.size + 1) * coverage)) - 1)
+    return float(res[max(rank, 0)])
+
+
+def mixture_interval(predictions, weights, residuals, coverage, *, n_levels=200):
+    """Central ``coverage`` interval of a weighted mixture of symmetric residual laws.
+
+    Model ``g`` says ``y = ŷ_g ± r`` with ``r`` drawn from its absolute validation
+    residuals and either sign equally likely; the mixture weights the models by
+    ``weights``. Each residual law is summarized by ``n_levels`` quantiles.
+
+    Parameters
+    ----------
+    predictions : dict grade → ndarray (n,)
+    weights : dict grade → float
+    residuals : dict grade → ndarray
+    coverage : float in (0, 1)
+
+    Returns
+    -------
+    low, high : ndarray (n,)
+    """
+    levels = (np.arange(n_levels) + 0.5) / n_levels
+    values, mass = [], []
+    for g, w in weights.items():
+        r = np.quantile(np.abs(np.asarray(residuals[g], float)), levels)
+        pred = np.asarray(predictions[g], float)[:, None]
+        values += [pred - r, pred + r]
+        mass.append(np.full(2 * n_levels, w / (2 * n_levels)))
+    values = np.concatenate(values, axis=1)
+    mass = np.concatenate(mass)
+    order = np.argsort(values, axis=1)
+    sorted_values = np.take_along_axis(values, order, axis=1)
+    cdf = np.cumsum(mass[order], axis=1)
+    tail = (1 - coverage) / 2
+    lo_idx = np.minimum((cdf < tail).sum(axis=1), values.shape[1] - 1)
+    hi_idx = np.minimum((cdf < 1 - tail).sum(axis=1), values.shape[1] - 1)
+    rows = np.arange(values.shape[0])
+    return sorted_values[rows, lo_idx], sorted_values[rows, hi_idx]
