@@ -116,3 +116,27 @@ def test_figures_and_report(tmp_path, sim_data):
     (tmp_path / "bad.json").write_text("{not json")
     with pytest.raises(GearshotError, match="bad.json"):
         report_from_json(tmp_path / "bad.json", tmp_path / "x")
+
+
+def test_rig_figures_include_fig11_and_the_tuning_curve(tmp_path, sim_data):
+    from gearshot.estimator import OneFaultShotEstimator
+    from gearshot.figures import rig_figures
+
+    sa, y = sim_data
+    tf = np.ones(N, complex)
+    ds = simulated_dataset(sa, y, tf, random_state=1)
+    db = ds.database.assign_coords(grade=("signal", np.where(np.arange(ds.database.sizes[
+        "signal"]) % 2 == 0, 3, 6)))
+    est = OneFaultShotEstimator(random_state=0, grades=[3, 6]).fit(
+        db, ds.target_healthy, ds.faulty_example, ds.faulty_size, ds.healthy_long,
+        selection_tf=tf)
+    train, test = est.selection_features_
+    assert train.shape == test.shape == (train.shape[0], 4)
+    pred = est.predict(ds.test_sa)
+    predictions = pd.DataFrame(dict(variant="full", true=ds.test_size, predicted=pred))
+    results = pd.DataFrame([dict(variant="full", mae=float(np.mean(np.abs(pred - ds.test_size))))])
+    figs = rig_figures(results, predictions, tmp_path, estimator=est)
+    names = {p.name for p in figs.values()}
+    assert {"fig11_feature_invariance.png", "tuning_curve.png", "fig14a.png"} <= names
+    assert all(p.stat().st_size > 1000 for p in figs.values())
+    assert "fig11_feature_invariance.png" in (tmp_path / "report.md").read_text()

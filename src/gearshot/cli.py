@@ -259,7 +259,12 @@ def experiment_rig(
     selection = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
-                                          n_repeats=repeats, seed=seed)
+                                          n_repeats=repeats, seed=seed,
+                                          keep_estimators=out is not None)
+    estimator = None
+    if "estimator" in results:
+        estimator = results.loc[results["variant"] == "full", "estimator"].iloc[0]
+        results = results.drop(columns="estimator")
     table = summarize(results)
     typer.echo(table.to_string(index=False))
     by_variant = dict(zip(table["variant"], table["mae_percent"]))
@@ -270,7 +275,7 @@ def experiment_rig(
     if out is not None:
         from .figures import rig_figures
 
-        rig_figures(results, predictions, out)
+        rig_figures(results, predictions, out, estimator=estimator)
 
 
 @app.command()

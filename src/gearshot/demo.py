@@ -130,6 +130,11 @@ def _figures(out, est, results, full_pred, campaign, rig):
     fig, ax = plt.subplots(figsize=(6.5, 3.5))
     plotting.plot_ablation(dict(zip(results["variant"], results["mae"])), ax=ax)
     figs["MAE of the ablations, Fig. 14b"] = plotting.save_figure(fig, out / "fig14b_ablation")[0]
+    if est.selection_features_ is not None:
+        plotting.plot_feature_invariance(*est.selection_features_, est.candidate_features_,
+                                         est.feature_errors_)
+        figs["Feature invariance (step 1): estimated vs held-out TF, Fig. 11"] = \
+            plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
     if est.tuning_curve_ is not None:
         fig, ax = plt.subplots(figsize=(5, 3.5))
         plotting.plot_tuning_curve(est.tuning_curve_, est.faulty_size_, ax=ax)

@@ -45,8 +45,13 @@ def simulated_figures(results: pd.DataFrame, out) -> dict:
     return figs
 
 
-def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out) -> dict:
-    """Fig. 14 a–b: predicted vs true (full algorithm) and the ablation errors."""
+def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out, *,
+                estimator=None) -> dict:
+    """Fig. 14 a–b: predicted vs true (full algorithm) and the ablation errors.
+
+    With a fitted full-algorithm ``estimator`` (the first repeat's), also Fig. 11 (its
+    feature-selection scatter) and its DIN tuning curve.
+    """
     from . import plotting
 
     plt = _plt()
@@ -60,6 +65,16 @@ def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out) -> dict:
     mae = results.groupby("variant", sort=False)["mae"].mean()
     plotting.plot_ablation(mae.to_dict(), ax=ax)
     figs["Ablations (Fig. 14b)"] = plotting.save_figure(fig, out / "fig14b")[0]
+    if estimator is not None and getattr(estimator, "selection_features_", None) is not None:
+        plotting.plot_feature_invariance(*estimator.selection_features_,
+                                         estimator.candidate_features_,
+                                         estimator.feature_errors_)
+        figs["Feature invariance, step 1 (Fig. 11)"] = \
+            plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
+    if estimator is not None and estimator.tuning_curve_ is not None:
+        fig, ax = plt.subplots(figsize=(5, 3.5))
+        plotting.plot_tuning_curve(estimator.tuning_curve_, estimator.faulty_size_, ax=ax)
+        figs["DIN tuning curve"] = plotting.save_figure(fig, out / "tuning_curve")[0]
     from .report import write_report
 
     write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,

@@ -93,6 +93,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     ----------
     selected_features_ : tuple of str
     feature_errors_ : dict
+    selection_features_ : (train, test) tuple of ndarray or None
+        Step 1's paired candidate features through the estimated and the held-out TF
+        (the paper's Fig. 11; see :func:`gearshot.plotting.plot_feature_invariance`).
     grade_ : int
         The best grade (the paper's choice).
     grade_weights_ : dict grade → weight
@@ -274,11 +277,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                                     "(the held-out TF of step 1)")
             sel_tf = _on_grid(selection_tf, n_points, "selection_tf")
             sa_n, y_n = self.database_[nominal]
-            selected, errors = steps.select_features(
+            selected, errors, self.selection_features_ = steps.select_features(
                 sa_n, y_n, sel_tf, mesh_order=self.mesh_order, names=names,
-                threshold=self.selection_threshold, random_state=rng)
+                threshold=self.selection_threshold, random_state=rng, return_features=True)
         else:
-            selected, errors = names, {}
+            selected, errors, self.selection_features_ = names, {}, None
         self.selected_features_ = tuple(selected)
         self.feature_errors_ = errors
         cols = [names.index(n) for n in self.selected_features_]

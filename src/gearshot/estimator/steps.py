@@ -220,7 +220,7 @@ def _long_healthy_signal(healthy_sa, n_cycles, noise_rms, rng):
 
 def select_features(sim_sa, fault_size, selection_tf, *, mesh_order, names,
                     threshold=0.10, noise_fraction=0.10, n_long_cycles=128,
-                    random_state=None):
+                    random_state=None, return_features=False):
     """Step 1: keep features that the TF estimate makes invariant to the transfer path.
 
     A "test" set is the simulated SAs plus white noise (``noise_fraction`` of the healthy
@@ -245,12 +245,16 @@ def select_features(sim_sa, fault_size, selection_tf, *, mesh_order, names,
     n_long_cycles : int
         Cycles in the long healthy test signal used for the TF estimate.
     random_state : int, Generator or None
+    return_features : bool, default False
+        Also return the paired feature arrays (what the paper's Fig. 11 plots).
 
     Returns
     -------
     selected : tuple of str
         At least one name: when no feature passes, the one with the smallest error.
     errors : dict name → error
+    (train, test) : tuple of ndarray (n_signals - 1, n_features)
+        Only with ``return_features``: the features through the estimated and the true TF.
     """
     rng = np.random.default_rng(check_random_state(random_state).randint(2**31 - 1))
     sim_sa = np.asarray(sim_sa, float)
@@ -280,6 +284,8 @@ def select_features(sim_sa, fault_size, selection_tf, *, mesh_order, names,
     selected = tuple(n for n, e in errors.items() if e < threshold)
     if not selected:
         selected = (min(errors, key=errors.get),)
+    if return_features:
+        return selected, errors, (f_train[keep], f_test[keep])
     return selected, errors
 
 
