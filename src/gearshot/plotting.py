@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 __all__ = [
     "save_figure",
@@ -177,6 +178,10 @@ def plot_ablation(mae_by_variant, *, ax=None):
     return bars
 
 
+AXIS_LABELS = {"speed": "speed [rps]", "load": "load [N m]", "tf": "transfer function",
+               "attenuation_db": "attenuation [dB]"}
+
+
 def plot_error_vs(results, by, *, ax=None, variants=None):
     """Fig. 13: MAE (%) against ``by`` (e.g. 'speed' or 'tf'), one line per variant."""
     ax = _ax(ax, figsize=(7, 3.5))
@@ -184,11 +189,13 @@ def plot_error_vs(results, by, *, ax=None, variants=None):
     lines = []
     for v in variants:
         part = results[results["variant"] == v].groupby(by)["mae"].mean() * 100
-        x = np.arange(part.size) if part.index.dtype == object else part.index.to_numpy()
+        numeric = pd.api.types.is_numeric_dtype(part.index)
+        x = part.index.to_numpy() if numeric else np.arange(part.size)
         lines += ax.plot(x, part.to_numpy(), "o-", label=VARIANT_LABELS.get(v, v))
-        if part.index.dtype == object:
-            ax.set_xticks(x, part.index, rotation=45, ha="right", fontsize=7)
-    ax.set_xlabel(by)
+        if not numeric:  # names (e.g. TFs, stored as object or pyarrow strings)
+            ax.set_xticks(x, [str(n) for n in part.index], rotation=45, ha="right",
+                          fontsize=7)
+    ax.set_xlabel(AXIS_LABELS.get(by, by))
     ax.set_ylabel("MAE [%]")
     ax.legend(fontsize=8)
     return lines
