@@ -143,6 +143,7 @@ def plot_feature_invariance(train, test, names, errors, *, axes=None):
         ax.set_title(f"{name}\nerror {100 * errors[name]:.1f} %", fontsize=9)
         ax.set_xlabel("training (estimated TF)")
         ax.set_ylabel("test (true TF)")
+    axes[0].figure.tight_layout()
     return artists
 
 
