@@ -119,6 +119,7 @@ def _figures(out, est, results, full_pred, campaign, rig):
 
     from . import plotting
     from .experiments import recording_segments
+    from .figures import estimator_figures
     from .rig import read_campaign
     from .signal import acs_background, amplitude_spectrum
 
@@ -130,16 +131,7 @@ def _figures(out, est, results, full_pred, campaign, rig):
     fig, ax = plt.subplots(figsize=(6.5, 3.5))
     plotting.plot_ablation(dict(zip(results["variant"], results["mae"])), ax=ax)
     figs["MAE of the ablations, Fig. 14b"] = plotting.save_figure(fig, out / "fig14b_ablation")[0]
-    if est.selection_features_ is not None:
-        plotting.plot_feature_invariance(*est.selection_features_, est.candidate_features_,
-                                         est.feature_errors_)
-        figs["Feature invariance (step 1): estimated vs held-out TF, Fig. 11"] = \
-            plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
-    if est.tuning_curve_ is not None:
-        fig, ax = plt.subplots(figsize=(5, 3.5))
-        plotting.plot_tuning_curve(est.tuning_curve_, est.faulty_size_, ax=ax)
-        figs["Simulation tuning: example prediction per DIN grade"] = \
-            plotting.save_figure(fig, out / "tuning_curve")[0]
+    figs.update(estimator_figures(est, out))
     index = read_campaign(campaign)
     healthy_path = index[index["fault_size"] == 0]["path"].iloc[0]
     faulty_path = index[index["fault_size"] == index["fault_size"].max()]["path"].iloc[0]

@@ -10,7 +10,7 @@ import pandas as pd
 
 from ._errors import GearshotError
 
-__all__ = ["simulated_figures", "rig_figures", "report_from_json"]
+__all__ = ["simulated_figures", "rig_figures", "estimator_figures", "report_from_json"]
 
 
 def _plt():
@@ -65,20 +65,37 @@ def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out, *,
     mae = results.groupby("variant", sort=False)["mae"].mean()
     plotting.plot_ablation(mae.to_dict(), ax=ax)
     figs["Ablations (Fig. 14b)"] = plotting.save_figure(fig, out / "fig14b")[0]
-    if estimator is not None and getattr(estimator, "selection_features_", None) is not None:
-        plotting.plot_feature_invariance(*estimator.selection_features_,
-                                         estimator.candidate_features_,
-                                         estimator.feature_errors_)
-        figs["Feature invariance, step 1 (Fig. 11)"] = \
-            plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
-    if estimator is not None and estimator.tuning_curve_ is not None:
-        fig, ax = plt.subplots(figsize=(5, 3.5))
-        plotting.plot_tuning_curve(estimator.tuning_curve_, estimator.faulty_size_, ax=ax)
-        figs["DIN tuning curve"] = plotting.save_figure(fig, out / "tuning_curve")[0]
+    if estimator is not None:
+        figs.update(estimator_figures(estimator, out))
     from .report import write_report
 
     write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,
                        "ablations": (mae * 100).to_dict()}, figs)
+    return figs
+
+
+def estimator_figures(estimator, out) -> dict:
+    """Figures of one fitted estimator: Fig. 11 (step 1's feature scatter, when features
+    were selected) and the DIN tuning curve (when the grade was tuned).
+
+    Returns {caption: png path}.
+    """
+    from . import plotting
+
+    plt = _plt()
+    out = Path(out)
+    figs = {}
+    if getattr(estimator, "selection_features_", None) is not None:
+        plotting.plot_feature_invariance(*estimator.selection_features_,
+                                         estimator.candidate_features_,
+                                         estimator.feature_errors_)
+        figs["Feature invariance (step 1): estimated vs held-out TF, Fig. 11"] = \
+            plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
+    if estimator.tuning_curve_ is not None:
+        fig, ax = plt.subplots(figsize=(5, 3.5))
+        plotting.plot_tuning_curve(estimator.tuning_curve_, estimator.faulty_size_, ax=ax)
+        figs["Simulation tuning: example prediction per DIN grade"] = \
+            plotting.save_figure(fig, out / "tuning_curve")[0]
     return figs
 
 
