@@ -1,7 +1,5 @@
 """Transfer functions: estimation from healthy signals, resampling and propagation; FRF
 container, UFF58/CSV I/O, hammer-test estimation, modal synthesis, physical-time filtering.
-
-(Merged package init on the ``transfer`` branch: the lead's exports plus this branch's.)
 """
 
 from .bank import TransferFunctionBank
