@@ -11,7 +11,7 @@ from sklearn.preprocessing import StandardScaler
 
 from estimator_data import N, synthetic_database, synthetic_sa, synthetic_target
 from gearshot import GearshotError
-from gearshot.estimator import OneFaultShotEstimator, steps
+from gearshot.estimator import OneFaultShotEstimator, signature_weights, steps
 from gearshot.transfer import resample_transfer_function
 
 
@@ -189,6 +189,32 @@ def test_zero_shot_needs_no_example(data):
     assert est.predict(faulty).shape == y.shape
 
 
+def test_signature_weights_trust_a_matching_grade_and_fall_back_to_uniform():
+    rng = np.random.default_rng(0)
+    sims = {g: g * 0.5 + 0.1 * rng.standard_normal(200) for g in (1, 2, 3, 4)}
+    w, consistent = signature_weights(2.0 + 0.01 * rng.standard_normal(50), sims)
+    assert consistent and max(w, key=w.get) == 4 and w[4] > 0.99
+    # between grades 2 and 3 (0.15 and 0.35 away, spread 0.1): both kept, the nearer heavier
+    w, consistent = signature_weights(1.15 + 0.01 * rng.standard_normal(50), sims)
+    assert consistent and set(w) == {2, 3} and w[2] > w[3] > 0.001
+    # far outside every grade's range: the signature is not trusted
+    w, consistent = signature_weights(np.full(50, 9.0), sims)
+    assert not consistent
+    assert_allclose([w[g] for g in (1, 2, 3, 4)], 0.25)
+
+
+def test_zero_shot_soft_weights_are_a_distribution_over_grades(data):
+    db, healthy, long, faulty, y = data
+    est = OneFaultShotEstimator(zero_shot=True, select_features=False, random_state=0)
+    est.fit(db, healthy, healthy_long=long)
+    assert_allclose(sum(est.grade_weights_.values()), 1.0)
+    assert set(est.grade_weights_) <= {3, 6, 9}
+    assert isinstance(est.tuning_curve_["consistent"], bool)
+    X = est.features_of(faulty)
+    mix = sum(w * est.grade_models_[g].predict(X) for g, w in est.grade_weights_.items())
+    assert_allclose(est.predict(faulty), mix)
+
+
 def test_save_and_load_round_trip(fitted, data, tmp_path):
     path = tmp_path / "model.joblib"
     fitted.save(path)
@@ -284,6 +310,45 @@ def test_mixture_interval_of_one_model_and_of_two_separated_models():
     lo, hi = steps.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.97, 2: 0.03},
                                     {1: res, 2: res}, 0.9)
     assert hi[0] < 0.4
+
+
+def test_mixture_interval_discrepancy_is_a_gaussian_widening():
+    pred = np.array([0.5, 0.2])
+    # zero simulated residuals: the interval is the Gaussian's central 90 % (±1.645 σ)
+    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: np.zeros(50)}, 0.9,
+                                    discrepancy=0.1, n_levels=2000)
+    assert_allclose(hi - pred, 0.1645, atol=2e-3)
+    assert_allclose(pred - lo, 0.1645, atol=2e-3)
+    # Gaussian residuals (σ 0.06) and discrepancy (σ 0.08) add in quadrature: σ 0.1
+    res = np.abs(np.random.default_rng(0).normal(0, 0.06, 200_000))
+    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.08,
+                                    n_levels=2000)
+    assert_allclose(hi - pred, 0.1645, atol=3e-3)
+    res = np.linspace(0, 0.1, 1001)
+    narrow = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
+    wide = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.05)
+    assert np.all(wide[1] - wide[0] > narrow[1] - narrow[0] + 0.02)
+    with pytest.raises(GearshotError, match="discrepancy"):
+        steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=-0.1)
+
+
+def test_model_discrepancy_widens_intervals_and_zero_is_split_conformal(fitted, data,
+                                                                         tf_pair):
+    db, healthy, long, faulty, y = data
+    args = (db, healthy, faulty[20], y[20], long)
+    pure = clone(fitted).set_params(grade_weighting="best", model_discrepancy=0.0).fit(
+        *args, selection_tf=tf_pair[1])
+    lo0, hi0 = pure.predict_interval(faulty)
+    q = steps.conformal_quantile(pure.model_.validation_residuals, 0.9)
+    assert_allclose(hi0, np.clip(pure.predict(faulty) + q, 0, 1))
+    widened = clone(pure).set_params(model_discrepancy=0.1).fit(
+        *args, selection_tf=tf_pair[1])
+    lo1, hi1 = widened.predict_interval(faulty)
+    assert_allclose(widened.predict(faulty), pure.predict(faulty))
+    assert np.all(hi1 - lo1 >= hi0 - lo0 - 1e-12)
+    assert np.mean(hi1 - lo1) > np.mean(hi0 - lo0) + 0.05
+    with pytest.raises(GearshotError, match="model_discrepancy"):
+        clone(pure).set_params(model_discrepancy=-1).fit(*args, selection_tf=tf_pair[1])
 
 
 def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):

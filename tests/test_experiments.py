@@ -8,7 +8,8 @@ from numpy.testing import assert_allclose
 from estimator_data import N, synthetic_sa
 from gearshot import GearshotError
 from gearshot.experiments import (RIG_VARIANTS, SIMULATED_VARIANTS, evaluate_variants,
-                                  rig_dataset, simulated_dataset, summarize, variant_params)
+                                  rig_dataset, rig_experiment, simulated_dataset, summarize,
+                                  variant_params)
 
 
 @pytest.fixture(scope="module")
@@ -93,6 +94,12 @@ def test_rig_dataset_keeps_the_example_recording_out_of_the_test_set(small_campa
         rig_dataset(small_campaign, n_train_healthy=3, cycles_per_segment=10)
     with pytest.raises(GearshotError, match="speed"):
         rig_dataset(small_campaign, speed=15.0, cycles_per_segment=10)
+
+
+def test_rig_experiment_rejects_an_unknown_keep_estimators(small_campaign):
+    with pytest.raises(GearshotError, match="keep_estimators.*'last'"):
+        rig_experiment(small_campaign, None, speed=10, load=5, selection_tf=None,
+                       keep_estimators="last")
 
 
 def test_figures_and_report(tmp_path, sim_data):

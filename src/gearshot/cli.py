@@ -260,10 +260,10 @@ def experiment_rig(
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
                                           n_repeats=repeats, seed=seed,
-                                          keep_estimators=out is not None)
+                                          keep_estimators="first" if out else False)
     estimator = None
     if "estimator" in results:
-        estimator = results.loc[results["variant"] == "full", "estimator"].iloc[0]
+        estimator = results.loc[results["variant"] == "full", "estimator"].dropna().iloc[0]
         results = results.drop(columns="estimator")
     table = summarize(results)
     typer.echo(table.to_string(index=False))

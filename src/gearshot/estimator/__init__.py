@@ -14,7 +14,7 @@ from .steps import (
     suppress_harmonics_target,
     tune_grade,
 )
-from .zero_shot import healthy_signature, match_grade
+from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = [
     "OneFaultShotEstimator",
@@ -30,6 +30,7 @@ __all__ = [
     "fit_knn",
     "healthy_signature",
     "match_grade",
+    "signature_weights",
     "save_estimator",
     "load_estimator",
 ]

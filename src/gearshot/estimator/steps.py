@@ -129,6 +129,8 @@ class KnnModel:
         ``|y - ŷ|`` on the validation split at the chosen K (for conformal intervals).
     validation_y : ndarray
         Labels of the validation split.
+    validation_prediction : ndarray
+        Predictions of the validation split at the chosen K.
     """
 
     pipeline: Pipeline
@@ -136,6 +138,7 @@ class KnnModel:
     validation_mae: np.ndarray
     validation_residuals: np.ndarray
     validation_y: np.ndarray
+    validation_prediction: np.ndarray
 
     def predict(self, X):
         return self.pipeline.predict(X)
@@ -193,9 +196,9 @@ def fit_knn(X, y, *, n_neighbors=range(1, 101), validation_fraction=0.3, random_
     mae_all = np.mean(np.abs(running_mean - y[val][:, None]), axis=0)
     mae = mae_all[candidates - 1]
     best = int(candidates[int(np.argmin(mae))])
-    residuals = np.abs(running_mean[:, best - 1] - y[val])
+    val_pred = running_mean[:, best - 1]
     final = _knn_pipeline(best).fit(X, y)
-    return KnnModel(final, best, mae_all, residuals, y[val])
+    return KnnModel(final, best, mae_all, np.abs(val_pred - y[val]), y[val], val_pred)
 
 
 # ---------------------------------------------------------------- step 1
@@ -379,12 +382,28 @@ def conformal_quantile(residuals, coverage):
     return float(res[max(rank, 0)])
 
 
-def mixture_interval(predictions, weights, residuals, coverage, *, n_levels=200):
+def _conformal_levels(residuals, levels):
+    res = np.sort(np.abs(np.asarray(residuals, float)))
+    if res.size == 0:
+        raise GearshotError("mixture_interval needs at least one residual per model")
+    rank = np.ceil((res.size + 1) * np.asarray(levels)).astype(int) - 1
+    return res[np.clip(rank, 0, res.size - 1)]
+
+
+def mixture_interval(predictions, weights, residuals, coverage, *, discrepancy=0.0,
+                     n_levels=200):
     """Central ``coverage`` interval of a weighted mixture of symmetric residual laws.
 
-    Model ``g`` says ``y = ŷ_g ± r`` with ``r`` drawn from its absolute validation
-    residuals and either sign equally likely; the mixture weights the models by
-    ``weights``. Each residual law is summarized by ``n_levels`` quantiles.
+    Model ``g`` says ``y = ŷ_g ± e``. The error ``e`` combines the model's absolute
+    validation residuals ``r`` with ``δ ~ N(0, discrepancy²)``, an error the simulation
+    cannot show (the simulation-to-reality gap left after tuning): at each level ``p`` the
+    two quantiles add in quadrature, ``e_p = sqrt(r_p² + (discrepancy · z_p)²)`` with
+    ``z_p`` the level-``p`` quantile of ``|N(0, 1)|``. That sum is exact when ``r`` is
+    Gaussian too, never narrower than ``r_p`` and pure Gaussian when the residuals are 0.
+    ``r_p`` is the split-conformal quantile (the ⌈(n+1)p⌉-th smallest residual), so one
+    model without discrepancy gives the split-conformal interval. Each law is summarized
+    by ``n_levels`` levels, either sign equally likely; the mixture weights the models by
+    ``weights``.
 
     Parameters
     ----------
@@ -392,15 +411,22 @@ def mixture_interval(predictions, weights, residuals, coverage, *, n_levels=200)
     weights : dict grade → float
     residuals : dict grade → ndarray
     coverage : float in (0, 1)
+    discrepancy : float >= 0
+        Standard deviation of ``δ`` (fault-size units).
 
     Returns
     -------
     low, high : ndarray (n,)
     """
+    from scipy.stats import halfnorm
+
+    if not discrepancy >= 0:
+        raise GearshotError(f"discrepancy must be >= 0; got {discrepancy!r}")
     levels = (np.arange(n_levels) + 0.5) / n_levels
+    gauss = discrepancy * halfnorm.ppf(levels)
     values, mass = [], []
     for g, w in weights.items():
-        r = np.quantile(np.abs(np.asarray(residuals[g], float)), levels)
+        r = np.hypot(_conformal_levels(residuals[g], levels), gauss)
         pred = np.asarray(predictions[g], float)[:, None]
         values += [pred - r, pred + r]
         mass.append(np.full(2 * n_levels, w / (2 * n_levels)))
@@ -408,7 +434,7 @@ def mixture_interval(predictions, weights, residuals, coverage, *, n_levels=200)
     mass = np.concatenate(mass)
     order = np.argsort(values, axis=1)
     sorted_values = np.take_along_axis(values, order, axis=1)
-    cdf = np.cumsum(mass[order], axis=1)
+    cdf = np.cumsum(mass[order], axis=1) / mass.sum()
     tail = (1 - coverage) / 2
     lo_idx = np.minimum((cdf < tail).sum(axis=1), values.shape[1] - 1)
     hi_idx = np.minimum((cdf < 1 - tail).sum(axis=1), values.shape[1] - 1)

@@ -5,6 +5,13 @@ tooth-profile errors a grade implies set how much of a healthy SA's energy lies 
 mesh harmonics. The signature of a set of healthy SAs is the distribution of
 ``log(RMS(difference signal) / RMS(harmonic signal))``; the grade whose simulated healthy SAs
 (through the same TF estimate) have the nearest median signature is chosen.
+
+The signature only means something if some grade's simulation resembles the target. When
+the target's median lies further from every grade's median than ``consistency`` times the
+simulated within-grade spread, the healthy data carry content the simulator does not
+produce (other machine parts, a structure of its own), and :func:`signature_weights`
+falls back to the uniform prior over grades: the prediction is then the average of the
+grade models, not a guess driven by that foreign content.
 """
 
 from __future__ import annotations
@@ -13,7 +20,7 @@ import numpy as np
 
 from ..signal import difference_signal, harmonic_signal
 
-__all__ = ["healthy_signature", "match_grade"]
+__all__ = ["healthy_signature", "match_grade", "signature_weights"]
 
 
 def healthy_signature(sa, mesh_order, *, n_sidebands=2):
@@ -45,3 +52,46 @@ def match_grade(target_signature, simulated_signatures):
     dist = np.abs(medians - target)
     return int(grades[int(np.argmin(dist))]), {"grade": grades, "prediction": medians,
                                                 "abs_error": dist}
+
+
+def signature_weights(target_signature, simulated_signatures, *, consistency=2.0,
+                      min_weight=1e-3):
+    """Weights of the grades from healthy data alone.
+
+    ``w_g ∝ exp(-½ ((m_g - t) / s)²)`` with ``m_g`` each grade's median simulated signature,
+    ``t`` the target's median and ``s`` the median within-grade standard deviation of the
+    simulated signatures. If no grade lies within ``consistency · s`` of the target, the
+    signature is not trusted and every grade gets the same weight.
+
+    Parameters
+    ----------
+    target_signature : ndarray
+    simulated_signatures : dict grade → ndarray
+    consistency : float > 0
+    min_weight : float
+        Grades below this share are dropped and the rest renormalized.
+
+    Returns
+    -------
+    weights : dict grade → weight (sums to 1, largest first)
+    consistent : bool
+        Whether some grade matched (False: the uniform fallback was used).
+    """
+    target = float(np.median(target_signature))
+    grades = np.array(sorted(simulated_signatures))
+    medians = np.array([float(np.median(simulated_signatures[g])) for g in grades])
+    spread = float(np.median([np.std(simulated_signatures[g]) for g in grades]))
+    spread = max(spread, 1e-12)
+    dist = np.abs(medians - target)
+    consistent = bool(dist.min() <= consistency * spread)
+    if consistent:
+        logw = -0.5 * (dist / spread) ** 2
+        w = np.exp(logw - logw.max())
+    else:
+        w = np.ones(grades.size)
+    w /= w.sum()
+    keep = w >= min_weight
+    w = w[keep] / w[keep].sum()
+    kept = grades[keep]
+    order = np.lexsort((kept, -w))
+    return {int(kept[i]): float(w[i]) for i in order}, consistent

@@ -179,6 +179,12 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
                    n_repeats=1, seed=0, keep_estimators=False):
     """The paper's Sec. 4.2 experiment on one condition's campaign.
 
+    Parameters
+    ----------
+    keep_estimators : bool or "first"
+        Keep the fitted estimators in an ``estimator`` column: of every repeat (True) or of
+        the first repeat only (``"first"``, enough to draw one run's figures).
+
     Returns
     -------
     results : pandas.DataFrame
@@ -188,6 +194,9 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
     """
     from .rig import rig_dataset
 
+    if keep_estimators not in (True, False, "first"):
+        raise GearshotError(f"keep_estimators must be True, False or 'first'; got "
+                            f"{keep_estimators!r}")
     cache: dict = {}
     rows, preds = [], []
     for r in range(int(n_repeats)):
@@ -195,7 +204,9 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
                          segments=cache)
         for row in evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=variants, selection_tf=selection_tf,
-                                     random_state=seed + r, keep_estimators=keep_estimators):
+                                     random_state=seed + r,
+                                     keep_estimators=keep_estimators is True
+                                     or (keep_estimators == "first" and r == 0)):
             pred = row.pop("prediction")
             preds.append(pd.DataFrame(dict(repeat=r, variant=row["variant"],
                                            true=ds.test_size, predicted=pred,
