@@ -32,6 +32,7 @@ __all__ = [
     "feature_invariance_errors",
     "tune_grade",
     "grade_weights",
+    "prune_weights",
     "conformal_quantile",
     "mixture_interval",
     "estimate_tf",
@@ -129,8 +130,6 @@ class KnnModel:
         ``|y - ŷ|`` on the validation split at the chosen K (for conformal intervals).
     validation_y : ndarray
         Labels of the validation split.
-    validation_prediction : ndarray
-        Predictions of the validation split at the chosen K.
     """
 
     pipeline: Pipeline
@@ -138,7 +137,6 @@ class KnnModel:
     validation_mae: np.ndarray
     validation_residuals: np.ndarray
     validation_y: np.ndarray
-    validation_prediction: np.ndarray
 
     def predict(self, X):
         return self.pipeline.predict(X)
@@ -196,9 +194,9 @@ def fit_knn(X, y, *, n_neighbors=range(1, 101), validation_fraction=0.3, random_
     mae_all = np.mean(np.abs(running_mean - y[val][:, None]), axis=0)
     mae = mae_all[candidates - 1]
     best = int(candidates[int(np.argmin(mae))])
-    val_pred = running_mean[:, best - 1]
+    residuals = np.abs(running_mean[:, best - 1] - y[val])
     final = _knn_pipeline(best).fit(X, y)
-    return KnnModel(final, best, mae_all, np.abs(val_pred - y[val]), y[val], val_pred)
+    return KnnModel(final, best, mae_all, residuals, y[val])
 
 
 # ---------------------------------------------------------------- step 1
@@ -364,8 +362,18 @@ def grade_weights(predictions, grades, faulty_size, validation_residuals, *,
     preds = np.asarray(predictions, float)
     sigma = max(0.5 * conformal_quantile(validation_residuals, coverage), 1e-3)
     logw = -0.5 * ((preds - faulty_size) / sigma) ** 2
-    w = np.exp(logw - logw.max())
-    w /= w.sum()
+    return prune_weights(grades, np.exp(logw - logw.max()), min_weight)
+
+
+def prune_weights(grades, weights, min_weight=1e-3):
+    """Normalize grade weights, drop those below ``min_weight`` and renormalize.
+
+    Returns
+    -------
+    dict grade → weight (sums to 1, largest first; ties in the given grade order)
+    """
+    w = np.asarray(weights, float)
+    w = w / w.sum()
     keep = w >= min_weight
     w = w[keep] / w[keep].sum()
     kept = np.asarray(grades)[keep]
@@ -374,20 +382,16 @@ def grade_weights(predictions, grades, faulty_size, validation_residuals, *,
 
 
 def conformal_quantile(residuals, coverage):
-    """Split-conformal quantile: the ⌈(n+1)·coverage⌉-th smallest absolute residual."""
+    """Split-conformal quantile: the ⌈(n+1)·coverage⌉-th smallest absolute residual.
+
+    ``coverage`` may be an array of levels (then an array of quantiles is returned).
+    """
     res = np.sort(np.abs(np.asarray(residuals, float)))
     if res.size == 0:
         raise GearshotError("conformal_quantile needs at least one residual")
-    rank = min(res.size - 1, int(np.ceil((res.size + 1) * coverage)) - 1)
-    return float(res[max(rank, 0)])
-
-
-def _conformal_levels(residuals, levels):
-    res = np.sort(np.abs(np.asarray(residuals, float)))
-    if res.size == 0:
-        raise GearshotError("mixture_interval needs at least one residual per model")
-    rank = np.ceil((res.size + 1) * np.asarray(levels)).astype(int) - 1
-    return res[np.clip(rank, 0, res.size - 1)]
+    rank = np.ceil((res.size + 1) * np.asarray(coverage, float)).astype(int) - 1
+    q = res[np.clip(rank, 0, res.size - 1)]
+    return float(q) if q.ndim == 0 else q
 
 
 def mixture_interval(predictions, weights, residuals, coverage, *, discrepancy=0.0,
@@ -426,7 +430,7 @@ def mixture_interval(predictions, weights, residuals, coverage, *, discrepancy=0
     gauss = discrepancy * halfnorm.ppf(levels)
     values, mass = [], []
     for g, w in weights.items():
-        r = np.hypot(_conformal_levels(residuals[g], levels), gauss)
+        r = np.hypot(conformal_quantile(residuals[g], levels), gauss)
         pred = np.asarray(predictions[g], float)[:, None]
         values += [pred - r, pred + r]
         mass.append(np.full(2 * n_levels, w / (2 * n_levels)))

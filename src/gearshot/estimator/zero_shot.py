@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..signal import difference_signal, harmonic_signal
+from .steps import prune_weights
 
 __all__ = ["healthy_signature", "match_grade", "signature_weights"]
 
@@ -89,9 +90,4 @@ def signature_weights(target_signature, simulated_signatures, *, consistency=2.0
         w = np.exp(logw - logw.max())
     else:
         w = np.ones(grades.size)
-    w /= w.sum()
-    keep = w >= min_weight
-    w = w[keep] / w[keep].sum()
-    kept = grades[keep]
-    order = np.lexsort((kept, -w))
-    return {int(kept[i]): float(w[i]) for i in order}, consistent
+    return prune_weights(grades, w, min_weight), consistent
