@@ -18,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gearshot.rig import Recording, VirtualRig
+from gearshot.io import Recording
+from gearshot.rig import VirtualRig
 
 
 def main() -> None:

@@ -134,7 +134,7 @@ def figure(bank):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from gearshot.transfer import plot_transfer_function
+    from gearshot.plotting import plot_transfer_function
 
     fig, axes = plt.subplots(2, 2, sharex="col", figsize=(13, 7),
                              gridspec_kw={"height_ratios": [2, 1]})

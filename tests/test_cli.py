@@ -10,7 +10,7 @@ SUBCOMMANDS = [[], ["demo"], ["simulate"], ["rig"], ["experiment"], ["experiment
 
 
 def run(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "gearshot.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "gearshot.app.cli", *args], capture_output=True,
                           text=True, timeout=120, env=env)
 
 

@@ -103,7 +103,7 @@ def test_rig_experiment_rejects_an_unknown_keep_estimators(small_campaign):
 
 
 def test_figures_and_report(tmp_path, sim_data):
-    from gearshot.figures import report_from_json, simulated_figures
+    from gearshot.app.figures import report_from_json, simulated_figures
 
     rows = pd.DataFrame([dict(speed=s, load=10.0, tf=t, attenuation_db=10.0, variant=v,
                               mae=0.1 + 0.01 * s / 10 + (v == "before_da") * 0.1)
@@ -127,7 +127,7 @@ def test_figures_and_report(tmp_path, sim_data):
 
 def test_rig_figures_include_fig11_and_the_tuning_curve(tmp_path, sim_data):
     from gearshot.estimator import OneFaultShotEstimator
-    from gearshot.figures import rig_figures
+    from gearshot.app.figures import rig_figures
 
     sa, y = sim_data
     tf = np.ones(N, complex)

@@ -10,12 +10,12 @@ import pytest
 from scipy.signal import hilbert
 
 from gearshot import GearshotError
-from gearshot.rig import (INDEX_COLUMNS, PathTF, Recording, SimulatorEngine, SurrogateEngine,
-                          VirtualRig, read_campaign, tacho_signal)
-from gearshot.rig.interference import (add_noise, bearing_impacts, extra_shaft,
-                                       motor_harmonics, rms)
+from gearshot.io import INDEX_COLUMNS, Recording, read_campaign
+from gearshot.rig import SimulatorEngine, SurrogateEngine, VirtualRig, tacho_signal
+from gearshot.rig.interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
 from gearshot.rig.path import apply_path, path_fir
-from gearshot.signal import difference_signal, harmonic_signal
+from gearshot.signal import difference_signal, harmonic_signal, rms
+from gearshot.transfer import TransferFunction
 
 ZG, ZP, N_SA = 38, 17, 2048
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
@@ -110,7 +110,7 @@ def test_interference_components():
 def test_transfer_path_stretch_and_attenuation():
     f = np.linspace(0.0, 1000.0, 1001)
     h = np.where(f < 500, 1.0, 0.1).astype(complex)  # step: 0-500 Hz -> 0-12.5 kHz
-    fir = path_fir(PathTF(f, h), 50_000.0, attenuation_db=10.0)
+    fir = path_fir(TransferFunction(f, h), 50_000.0, attenuation_db=10.0)
     t = np.arange(50_000) / 50_000.0
     gain = 10 ** (-10 / 20) / np.sqrt(np.mean(np.abs(h) ** 2))
     lo = apply_path(np.sin(2 * np.pi * 5000 * t), fir)[5000:]

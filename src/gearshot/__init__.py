@@ -14,8 +14,18 @@ Subpackages (imported on first use):
     Transfer-function estimation, I/O and propagation.
 ``gearshot.sim``
     The gear-pair dynamic simulator and simulated databases.
+``gearshot.io``
+    Reading real recordings (and campaign folders) into SA segments.
 ``gearshot.rig``
-    Recordings and the virtual test rig.
+    The virtual test rig.
+``gearshot.estimator``
+    The one-fault-shot estimator and its eight steps.
+``gearshot.experiments``
+    The paper's datasets and sweeps.
+``gearshot.plotting``
+    Figures.
+``gearshot.app``
+    The ``gearshot`` command line, the demo and report writing.
 """
 
 from __future__ import annotations
@@ -31,8 +41,8 @@ try:
 except PackageNotFoundError:  # running from a source tree
     __version__ = "0.0.0+unknown"
 
-_SUBMODULES = {"signal", "features", "transfer", "sim", "rig", "estimator", "experiments",
-               "plotting", "cli"}
+_SUBMODULES = {"signal", "features", "transfer", "sim", "io", "rig", "estimator",
+               "experiments", "plotting", "app"}
 
 __all__ = ["GearshotError", "data_home", "__version__", *sorted(_SUBMODULES)]
 

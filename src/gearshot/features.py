@@ -34,7 +34,8 @@ import scipy.fft
 
 from ._errors import GearshotError
 from ._validation import as_signal_array, check_int, check_positive
-from .signal._common import check_mesh_order, mesh_band_orders
+from .signal.level import rms as _rms
+from .signal.orders import check_mesh_order, mesh_band_orders
 
 __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features",
            "na4_baseline_variance"]
@@ -123,10 +124,6 @@ def _moment_ratio(x, order, *, variance=None):
     with np.errstate(divide="ignore", invalid="ignore"):
         out = num / var ** (order / 2)
     return np.where(small, 0.0, out)
-
-
-def _rms(x):
-    return np.sqrt(np.mean(x * x, axis=-1))
 
 
 _REGISTRY: dict[str, Callable[[_Parts], np.ndarray]] = {}

@@ -1,9 +1,9 @@
 """Builders of the paper's datasets and the experiments run on them."""
 
 from .runner import evaluate_variants, rig_experiment, simulated_experiment, summarize
-from .rig import RigDataset, recording_segments, rig_dataset
+from .rig import RigDataset, rig_dataset
 from .simulated import SimulatedDataset, simulated_dataset
 from .variants import RIG_VARIANTS, SIMULATED_VARIANTS, VARIANTS, variant_params
 
-__all__ = ["evaluate_variants", "rig_experiment", "simulated_experiment", "summarize", "RigDataset", "rig_dataset", "recording_segments", "SimulatedDataset", "simulated_dataset", "VARIANTS", "SIMULATED_VARIANTS",
+__all__ = ["evaluate_variants", "rig_experiment", "simulated_experiment", "summarize", "RigDataset", "rig_dataset", "SimulatedDataset", "simulated_dataset", "VARIANTS", "SIMULATED_VARIANTS",
            "RIG_VARIANTS", "variant_params"]

@@ -10,8 +10,9 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_int
+from ..io import recording_segments
 
-__all__ = ["RigDataset", "rig_dataset", "recording_segments"]
+__all__ = ["RigDataset", "rig_dataset"]
 
 
 @dataclass(frozen=True)
@@ -48,24 +49,8 @@ class RigDataset:
                 self.healthy_long)
 
 
-def recording_segments(path, *, gear_teeth=38, pinion_teeth=17, cycles_per_segment=50,
-                       samples_per_cycle=2048, long=False):
-    """SA segments (and optionally the angle-domain signal) of one recording file."""
-    from ..rig import Recording
-
-    rec = Recording.read(path)
-    sa = rec.to_sa_segments(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
-                            cycles_per_segment=cycles_per_segment,
-                            samples_per_cycle=samples_per_cycle)
-    if not long:
-        return sa
-    x = rec.angle_domain(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
-                         samples_per_cycle=samples_per_cycle)
-    return sa, x
-
-
 def _campaign_rows(campaign, speed, load):
-    from ..rig import read_campaign
+    from ..io import read_campaign
 
     index = campaign if isinstance(campaign, pd.DataFrame) else read_campaign(Path(campaign))
     rows = index

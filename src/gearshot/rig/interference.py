@@ -10,13 +10,9 @@ import numpy as np
 import scipy.signal
 
 from .._validation import check_positive
+from ..signal.level import rms
 
-__all__ = ["motor_harmonics", "extra_shaft", "bearing_impacts", "add_noise", "rms"]
-
-
-def rms(x: np.ndarray) -> float:
-    """Root mean square of ``x``."""
-    return float(np.sqrt(np.mean(np.square(x))))
+__all__ = ["motor_harmonics", "extra_shaft", "bearing_impacts", "add_noise"]
 
 
 def motor_harmonics(t: np.ndarray, *, speed: float, pole_pairs: int, slip: float,

@@ -40,19 +40,18 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_positive
-from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics, rms
+from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
+from ..signal.level import rms
+from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
 from .motion import load_torque, motor_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
 from .reality import RigReality, draw_reality
-from .recording import Recording
 from .sim_engine import SimulatorEngine
 from .surrogate import SurrogateEngine
 from .tacho import tacho_signal
 
-__all__ = ["VirtualRig", "read_campaign", "INDEX_NAME", "INDEX_COLUMNS"]
+__all__ = ["VirtualRig"]
 
-INDEX_NAME = "index.csv"
-INDEX_COLUMNS = ["path", "speed", "load", "fault_size", "repetition"]
 
 
 def _key(value: float) -> int:
@@ -339,22 +338,3 @@ def _override(reality: RigReality, changes: Mapping[str, Any], *, n_tfs: int) ->
                                     f"got {value!r}")
             out[key] = arr
     return dataclasses.replace(reality, **out)
-
-
-def read_campaign(folder: str | os.PathLike) -> pd.DataFrame:
-    """The index of a campaign folder, with absolute paths."""
-    folder = Path(folder)
-    index_path = folder / INDEX_NAME
-    if not index_path.is_file():
-        raise GearshotError(f"{str(folder)!r} holds no campaign index ({INDEX_NAME})")
-    try:
-        frame = pd.read_csv(index_path)
-    except Exception as exc:
-        raise GearshotError(f"cannot read {str(index_path)!r}: {exc}") from None
-    if list(frame.columns) != INDEX_COLUMNS:
-        raise GearshotError(f"{str(index_path)!r} has columns {list(frame.columns)}; "
-                            f"expected {INDEX_COLUMNS}")
-    frame["path"] = [str((folder / p).resolve()) for p in frame["path"]]
-    return frame
-
-

@@ -7,21 +7,28 @@ synchronous averages). Options are keyword-only. Bad input raises
 """
 
 from .alignment import fractional_shift, subtract_healthy
+from .angle import check_pulse_train, gear_cycle_times
 from .angular import angle_to_time, angular_resample, pulse_times
 from .averaging import synchronous_average
 from .cepstrum import minimum_phase, real_cepstrum
 from .envelope import envelope
-from .orders import difference_signal, harmonic_signal, order_mask
+from .level import mean_rms, rms
+from .orders import difference_signal, harmonic_signal, mesh_band_orders, order_mask
 from .spectra import acs_background, amplitude_spectrum
 
 __all__ = [
     "pulse_times",
     "angle_to_time",
     "angular_resample",
+    "check_pulse_train",
+    "gear_cycle_times",
     "synchronous_average",
     "harmonic_signal",
     "difference_signal",
     "order_mask",
+    "mesh_band_orders",
+    "rms",
+    "mean_rms",
     "envelope",
     "amplitude_spectrum",
     "acs_background",

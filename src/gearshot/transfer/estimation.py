@@ -9,6 +9,7 @@ from scipy.interpolate import CubicSpline
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_int
 from ..signal.cepstrum import minimum_phase
+from ..signal.level import mean_rms, rms
 from ..signal.spectra import acs_background, amplitude_spectrum
 
 __all__ = [
@@ -124,17 +125,6 @@ def propagate(signals, tf):
         raise GearshotError(
             f"tf has {tf.shape[-1]} points but signals have {signals.shape[-1]} per cycle")
     return scipy.fft.ifft(scipy.fft.fft(signals, axis=-1) * tf, axis=-1).real
-
-
-def rms(x):
-    """Root mean square along the last axis."""
-    x = as_signal_array(x, "x")
-    return np.sqrt(np.mean(x * x, axis=-1))
-
-
-def mean_rms(signals):
-    """Mean over signals of the RMS along the last axis: the RMS-normalization scale."""
-    return float(np.mean(rms(signals)))
 
 
 def rms_normalize(signals, reference):

@@ -7,7 +7,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from .._errors import GearshotError
-from .function import TransferFunction
+from ..transfer.function import TransferFunction
 
 __all__ = ["plot_transfer_function", "plot_transfer_functions"]
 

@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from gearshot import GearshotError
-from gearshot.rig import Recording, gear_cycle_times, tacho_signal
+from gearshot.io import Recording
+from gearshot.rig import tacho_signal
+from gearshot.signal import gear_cycle_times
 
 FS = 50_000.0
 ZG, ZP = 38, 17

@@ -37,11 +37,11 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
     repetitions : int
         Recordings per fault size (6 healthy recordings are always made).
     """
-    from . import data_home
-    from .experiments import RIG_VARIANTS, rig_experiment
-    from .rig import VirtualRig
-    from .sim import GearPair, build_database, load_database
-    from .transfer import TransferFunctionBank
+    from .. import data_home
+    from ..experiments import RIG_VARIANTS, rig_experiment
+    from ..rig import VirtualRig
+    from ..sim import GearPair, build_database, load_database
+    from ..transfer import TransferFunctionBank
 
     console = console or Console()
     out = Path(out)
@@ -117,11 +117,11 @@ def _figures(out, est, results, full_pred, campaign, rig):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from . import plotting
-    from .experiments import recording_segments
+    from .. import plotting
+    from ..io import recording_segments
     from .figures import estimator_figures
-    from .rig import read_campaign
-    from .signal import acs_background, amplitude_spectrum
+    from ..io import read_campaign
+    from ..signal import acs_background, amplitude_spectrum
 
     figs = {}
     fig, ax = plt.subplots(figsize=(4.5, 4.5))

@@ -1,12 +1,12 @@
-"""Tests of gearshot.transfer.plot."""
+"""Tests of gearshot.plotting.transfer."""
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
 from gearshot import GearshotError
-from gearshot.transfer import (TransferFunction, plot_transfer_function,
-                               plot_transfer_functions)
+from gearshot.plotting import plot_transfer_function, plot_transfer_functions
+from gearshot.transfer import TransferFunction
 
 mpl = pytest.importorskip("matplotlib")
 mpl.use("Agg")

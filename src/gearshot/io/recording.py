@@ -18,7 +18,7 @@ from ._format_csv import read_csv, write_csv
 from ._format_hdf5 import read_hdf5, write_hdf5
 from ._format_matlab import read_mat, write_mat
 from ._format_wav import read_wav, write_wav
-from .angle import (TACHO_SHAFTS, check_pulse_train, gear_cycle_times,
+from ..signal.angle import (TACHO_SHAFTS, check_pulse_train, gear_cycle_times,
                     uniform_cycle_times)
 
 __all__ = ["Recording", "FORMATS"]

@@ -1,5 +1,7 @@
 """Figures of the paper and of gearshot's diagnostics (matplotlib).
 
+The library never picks a matplotlib backend; the command line (:mod:`gearshot.app`) does.
+
 Every function takes ``ax=None`` (a new figure is made when omitted) and returns the
 artists it drew; :func:`save_figure` writes PNG and PDF side by side.
 """
@@ -34,11 +36,6 @@ VARIANT_LABELS = {
 
 def _ax(ax, **kw):
     if ax is None:
-        import matplotlib
-
-        if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg") and \
-                not matplotlib.is_interactive():
-            matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(**kw)
@@ -62,7 +59,7 @@ def save_figure(fig, path) -> list[Path]:
 
 def plot_sa_and_difference(sa, mesh_order, *, ax=None, n_sidebands=2):
     """An SA and its difference signal over one cycle."""
-    from .signal import difference_signal
+    from ..signal import difference_signal
 
     ax = _ax(ax, figsize=(8, 3.5))
     sa = np.asarray(sa, float)

@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._errors import GearshotError
+from .._errors import GearshotError
 
 __all__ = ["predict_from_files"]
 
 
 def _recording_files(path: Path):
-    from .rig import FORMATS, INDEX_NAME
+    from ..io import FORMATS, INDEX_NAME
 
     path = Path(path)
     if path.is_file():
@@ -38,10 +38,10 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     pandas.DataFrame
         ``recording, segment, predicted, low, high``.
     """
-    from .estimator import OneFaultShotEstimator
-    from .experiments import recording_segments
-    from .sim import load_database
-    from .transfer import TransferFunctionBank
+    from ..estimator import OneFaultShotEstimator
+    from ..io import recording_segments
+    from ..sim import load_database
+    from ..transfer import TransferFunctionBank
 
     for p in [*healthy, faulty]:
         if not Path(p).is_file():

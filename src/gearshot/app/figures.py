@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._errors import GearshotError
+from .._errors import GearshotError
 
 __all__ = ["simulated_figures", "rig_figures", "estimator_figures", "report_from_json"]
 
@@ -24,7 +24,7 @@ def _plt():
 
 def simulated_figures(results: pd.DataFrame, out) -> dict:
     """Fig. 13 a–d: MAE vs speed and vs TF (per load and averaged), one line per variant."""
-    from . import plotting
+    from .. import plotting
 
     plt = _plt()
     out = Path(out)
@@ -52,7 +52,7 @@ def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out, *,
     With a fitted full-algorithm ``estimator`` (the first repeat's), also Fig. 11 (its
     feature-selection scatter) and its DIN tuning curve.
     """
-    from . import plotting
+    from .. import plotting
 
     plt = _plt()
     out = Path(out)
@@ -80,7 +80,7 @@ def estimator_figures(estimator, out) -> dict:
 
     Returns {caption: png path}.
     """
-    from . import plotting
+    from .. import plotting
 
     plt = _plt()
     out = Path(out)
@@ -114,7 +114,7 @@ def report_from_json(path, out) -> Path:
     if payload.get("experiment") == "simulated":
         simulated_figures(rows, out)
     else:
-        from . import plotting
+        from .. import plotting
         from .report import write_report
 
         plt = _plt()

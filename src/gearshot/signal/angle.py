@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from .._errors import GearshotError
 from .._validation import check_int
-from ..signal import angle_to_time
+from .angular import angle_to_time
 
 __all__ = [
     "check_pulse_train",

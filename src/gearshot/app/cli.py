@@ -9,8 +9,8 @@ from typing import List, Optional
 
 import typer
 
-from . import __version__
-from ._errors import GearshotError
+from .. import __version__
+from .._errors import GearshotError
 
 app = typer.Typer(
     name="gearshot",
@@ -98,7 +98,7 @@ def simulate(
                                 "--scheduler is given."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
-    from .sim import GearPair, build_database, default_database_path
+    from ..sim import GearPair, build_database, default_database_path
 
     store = store or default_database_path()
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
@@ -138,7 +138,7 @@ def rig(
 
 
 def _make_rig(seed, frf_folder, rig_grade):
-    from .rig import VirtualRig
+    from ..rig import VirtualRig
 
     kwargs = {}
     if frf_folder is not None:
@@ -173,8 +173,8 @@ def experiment_simulated(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
-    from .experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
-    from .sim import GearPair, build_database, default_database_path
+    from ..experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
+    from ..sim import GearPair, build_database, default_database_path
 
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
@@ -230,10 +230,10 @@ def experiment_rig(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
-    from . import data_home
-    from .experiments import RIG_VARIANTS, rig_experiment, summarize
-    from .sim import GearPair, build_database, default_database_path, load_database
-    from .transfer import TransferFunctionBank
+    from .. import data_home
+    from ..experiments import RIG_VARIANTS, rig_experiment, summarize
+    from ..sim import GearPair, build_database, default_database_path, load_database
+    from ..transfer import TransferFunctionBank
 
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
@@ -295,7 +295,7 @@ def predict(
     seed: int = typer.Option(0, "--seed"),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
-    from .predict_files import predict_from_files
+    from .predict import predict_from_files
 
     frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
                                speed=speed, load=load, coverage=coverage,

@@ -13,7 +13,8 @@ import scipy.io
 import scipy.io.wavfile
 
 from gearshot import GearshotError
-from gearshot.rig import Recording, tacho_signal
+from gearshot.io import Recording
+from gearshot.rig import tacho_signal
 
 FS = 20_000.0
 
