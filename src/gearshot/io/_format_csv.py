@@ -39,6 +39,19 @@ def read_csv(path: Path) -> RawFile:
                     header.update(json.loads(line[len(_TAG):]))
                 except ValueError as exc:
                     raise GearshotError(f"{str(path)!r}: damaged header line ({exc})") from None
+    first = ""
+    with open(path, encoding="utf-8") as fh:
+        for i, line in enumerate(fh):
+            if i >= n_comment and line.strip():
+                first = line
+                break
+    if first and _numeric_row(first):
+        # no header row: never take the first data row for channel names
+        from ._format_text import read_text
+
+        raw = read_text(path, delimiter=",", header=False, skip_rows=n_comment)
+        raw.fs = header.get("fs", raw.fs)
+        return raw
     try:
         frame = pd.read_csv(path, skiprows=n_comment, skipinitialspace=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
@@ -63,6 +76,15 @@ def read_csv(path: Path) -> RawFile:
                             f"{n_expected} (truncated file?)")
     return RawFile(path, chans, fs, dict(header.get("metadata", {})),
                    positional_defaults=True, time_channel=time_name)
+
+
+def _numeric_row(line: str) -> bool:
+    cells = [c.strip() for c in line.split(",")]
+    try:
+        [float(c) for c in cells if c]
+    except ValueError:
+        return False
+    return True
 
 
 def write_csv(rec: Any, path: Path) -> None:

@@ -107,13 +107,21 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
     return curve(np.asarray(angles, dtype=float))
 
 
-def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2):
+def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2,
+                     antialias=True, passband=0.9):
     """Resample a time signal at equal steps of shaft angle.
 
-    The signal is over-sampled ×``upsample`` (polyphase FIR interpolation) and then read at
-    the instants the shaft passes each angle step, by cubic-spline interpolation. The time
-    of each angle comes from :func:`angle_to_time` (smooth spline through the pulses).
-    Only whole revolutions from the first pulse are returned.
+    The signal is over-sampled ×``upsample`` and then read at the instants the shaft passes
+    each angle step, by cubic-spline interpolation. The time of each angle comes from
+    :func:`angle_to_time` (smooth spline through the pulses). Only whole revolutions from
+    the first pulse are returned.
+
+    With ``antialias`` (default) the signal is first low-passed below the angular Nyquist
+    (``samples_per_rev / 2`` orders) at the lowest shaft speed of the record -- flat up to
+    ``passband`` times that frequency, zero from it on -- and over-sampled by band-limited
+    (FFT) interpolation (:func:`gearshot.signal.trains.antialias_filter`); content above the
+    angular Nyquist then cannot fold onto lower orders. ``antialias=False`` reproduces the
+    unfiltered resampler (polyphase FIR over-sampling), as the reference implementation has.
 
     Parameters
     ----------
@@ -129,6 +137,11 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
         Tacho pulses per shaft revolution.
     upsample : int, default 2
         Over-sampling factor before interpolation.
+    antialias : bool, default True
+        Low-pass below the angular Nyquist before resampling.
+    passband : float, default 0.9
+        Anti-alias pass-band edge as a fraction of the angular Nyquist (orders up to
+        ``passband * samples_per_rev / 2`` are untouched).
 
     Returns
     -------
@@ -153,11 +166,19 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
             f"pulses_per_rev={ppr}")
     angles = np.arange(n_revs * spr) / spr
     times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
-    if upsample > 1:
-        x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1)
+    if antialias:
+        from .trains import bandlimited_resynthesis, min_shaft_rate
+
+        # band-limit below the angular Nyquist and re-synthesize at upsample x the Nyquist
+        # rate of what is left (coarser than fs for slow shafts: cheaper, equally exact)
+        cutoff = 0.5 * spr * min_shaft_rate(pulses, pulses_per_rev=ppr)
+        rate = 2.0 * upsample * min(cutoff, fs / 2)
+        x_fine, fs_fine, t0 = bandlimited_resynthesis(x, fs, cutoff=cutoff, passband=passband,
+                                                      rate=rate)
+        position = (times - t0) * fs_fine
     else:
-        x_fine = x
-    position = times * fs * upsample  # fractional sample index in x_fine
+        x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1) if upsample > 1 else x
+        position = times * fs * upsample  # fractional sample index in x_fine
     flat = x_fine.reshape(-1, x_fine.shape[-1])
     out = np.empty((flat.shape[0], position.size))
     for i, row in enumerate(flat):
