@@ -185,7 +185,7 @@ def test_output_shaft_tacho_gives_the_same_sa():
     revs = pinion_revs(t, 30.0, drift=0.01, drift_period=6.0)
     gear = revs * ZP / ZG
     acc = template(gear)
-    on_input = Recording(acc, tacho_signal(revs), FS)
+    on_input = Recording(acc, tacho_signal(revs), FS, tacho_pulses_per_rev=1)
     on_output = Recording(acc, tacho_signal(gear, pulses_per_rev=2), FS, tacho_shaft="output",
                           tacho_pulses_per_rev=2)
     sa_out = on_output.to_sa_segments(gear_teeth=ZG, pinion_teeth=ZP)

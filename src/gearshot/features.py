@@ -35,7 +35,7 @@ import scipy.fft
 from ._errors import GearshotError
 from ._validation import as_signal_array, check_int, check_positive
 from .signal.level import rms as _rms
-from .signal.orders import check_mesh_order, mesh_band_orders
+from .signal.orders import check_mesh_orders, mesh_band_orders
 
 __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features",
            "na4_baseline_variance"]
@@ -49,12 +49,15 @@ _WORKERS = None  # scipy.fft threads: one (Dask workers parallelize across proce
 class _Parts:
     """Lazily computed decompositions of a batch of SAs, shared between features."""
 
-    def __init__(self, sa, mesh_order, n_sidebands, baseline_variance):
+    def __init__(self, sa, mesh_order, n_sidebands, baseline_variance,
+                 shaft_orders=_SHAFT_ORDERS):
         self.sa = sa
         self.n = sa.shape[-1]
-        self.mesh_order = mesh_order
+        self.mesh_orders = tuple(mesh_order) if isinstance(mesh_order, tuple) else (mesh_order,)
+        self.mesh_order = self.mesh_orders if len(self.mesh_orders) > 1 else self.mesh_orders[0]
         self.n_sidebands = n_sidebands
         self.baseline_variance = baseline_variance
+        self.shaft_orders = tuple(shaft_orders)
 
     @cached_property
     def spectrum(self):
@@ -101,12 +104,12 @@ class _Parts:
 
     @cached_property
     def zakrajsek_diff(self):
-        orders = np.union1d(self._mesh(1), [0, *_SHAFT_ORDERS])
+        orders = np.union1d(self._mesh(1), [0, *self.shaft_orders])
         return self._keep(orders, invert=True)
 
     @cached_property
     def residual(self):
-        orders = np.union1d(self._mesh(0), [0, *_SHAFT_ORDERS])
+        orders = np.union1d(self._mesh(0), [0, *self.shaft_orders])
         return self._keep(orders, invert=True)
 
 
@@ -159,7 +162,8 @@ def _skewness_env_diff(p):
 
 @_register("fm0")
 def _fm0(p):
-    harmonics = np.arange(1, (p.n // 2) // p.mesh_order + 1) * p.mesh_order
+    harmonics = np.unique(np.concatenate([np.arange(1, (p.n // 2) // m + 1) * m
+                                          for m in p.mesh_orders]))
     amp = 2.0 * np.abs(p.spectrum[..., harmonics]) / p.n
     amp[..., harmonics == p.n // 2] /= 2.0
     total = amp.sum(axis=-1)
@@ -219,34 +223,57 @@ def _check_names(names):
     return names
 
 
-def na4_baseline_variance(healthy_sa, mesh_order):
+def _check_shaft_orders(shaft_orders, n):
+    if isinstance(shaft_orders, (int, np.integer)) or shaft_orders is None:
+        raise GearshotError(f"shaft_orders must be a sequence of integers (may be empty); got "
+                            f"{shaft_orders!r}")
+    out = tuple(check_int(o, "shaft_orders[]", minimum=1) for o in shaft_orders)
+    bad = [o for o in out if o > n // 2]
+    if bad:
+        raise GearshotError(f"shaft_orders {bad} exceed the Nyquist order {n // 2}")
+    return out
+
+
+def _mesh_arg(mesh_order, n):
+    orders = check_mesh_orders(mesh_order, n)
+    return orders if len(orders) > 1 else orders[0]
+
+
+def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS):
     """Mean variance of the residual signal of healthy SAs: NA4's baseline.
 
     Parameters
     ----------
     healthy_sa : array_like, shape (..., n)
-    mesh_order : int
+    mesh_order : int or sequence of int
+        Mesh order(s) of the cycle's shaft.
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders removed from the residual.
 
     Returns
     -------
     float
     """
     sa = as_signal_array(healthy_sa, "healthy_sa", min_length=4)
-    mesh_order = check_mesh_order(mesh_order, sa.shape[-1])
-    residual = _Parts(sa, mesh_order, 0, None).residual
+    mesh_order = _mesh_arg(mesh_order, sa.shape[-1])
+    shaft_orders = _check_shaft_orders(shaft_orders, sa.shape[-1])
+    residual = _Parts(sa, mesh_order, 0, None, shaft_orders).residual
     centred = residual - residual.mean(axis=-1, keepdims=True)
     return float(np.mean(centred ** 2))
 
 
-def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None):
+def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None,
+                     shaft_orders=_SHAFT_ORDERS):
     """Condition indicators of synchronous averages.
 
     Parameters
     ----------
     sa : array_like, shape (..., n_points)
         Synchronous averages, one cycle each (e.g. ``(n_signals, 2048)``).
-    mesh_order : int
-        Gear-mesh order in the cycle.
+    mesh_order : int or sequence of int
+        Gear-mesh order in the cycle; a sequence for a shaft carrying several gears (every
+        mesh's harmonics and sidebands are removed from the difference/residual signals,
+        FM0 sums every mesh's harmonics).
     names : sequence of str, optional
         Features to compute, in order. Default: the paper's four (:data:`PAPER_FEATURES`).
         See :func:`available_features`.
@@ -254,6 +281,9 @@ def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_vari
         Sidebands removed around each mesh harmonic for the paper's difference signal.
     baseline_variance : float, optional
         Healthy residual variance for ``na4`` (see :func:`na4_baseline_variance`).
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders removed (with DC) from the Zakrajsek difference signal (FM4, M6A, M8A,
+        ER) and the residual signal (NA4).
 
     Returns
     -------
@@ -262,9 +292,10 @@ def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_vari
     """
     names = _check_names(names)
     sa = as_signal_array(sa, "sa", min_length=4)
-    mesh_order = check_mesh_order(mesh_order, sa.shape[-1])
+    mesh_order = _mesh_arg(mesh_order, sa.shape[-1])
+    shaft_orders = _check_shaft_orders(shaft_orders, sa.shape[-1])
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
-    parts = _Parts(sa, mesh_order, n_sidebands, baseline_variance)
+    parts = _Parts(sa, mesh_order, n_sidebands, baseline_variance, shaft_orders)
     return np.stack([_REGISTRY[name](parts) for name in names], axis=-1)

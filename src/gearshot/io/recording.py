@@ -411,8 +411,8 @@ class Recording:
             raise GearshotError(f"{self._label()}: the tacho shows {pulses.size} pulse(s)")
         rate = 1.0 / float(np.median(np.diff(pulses)))
         estimate = rate / (self.speed * float(tacho_over_input))
-        k = int(round(estimate))
-        if k < 1 or abs(estimate / k - 1.0) > SPEED_TOLERANCE:
+        k = max(1, int(round(estimate)))  # < 1: a wrong fs, reported by the speed check
+        if estimate > 0.75 and abs(estimate / k - 1.0) > SPEED_TOLERANCE:
             raise GearshotError(
                 f"{self._label()}: tacho_pulses_per_rev is not stated and the pulse rate "
                 f"{rate:.4g} Hz is {estimate:.3g} x the stated speed={self.speed:g} rev/s "
@@ -422,6 +422,9 @@ class Recording:
     def pulse_times(self, *, threshold: float | None = None) -> np.ndarray:
         """Validated tacho pulse times in s (raises on a missing/flat tacho or a dropout)."""
         pulses = self._raw_pulses(threshold)
+        if pulses.size < 3:  # nothing to infer from: report the empty tacho first
+            check_pulse_train(pulses, pulses_per_rev=self.tacho_pulses_per_rev or 1,
+                              label=self._label())
         ppr = self.resolved_pulses_per_rev(threshold=threshold)
         return check_pulse_train(pulses, pulses_per_rev=ppr, label=self._label())
 
@@ -599,10 +602,10 @@ class Recording:
         per = n_cycles if cycles_per_segment is None else cycles_per_segment
         n_seg = n_cycles // per if per else 0
         if n_seg < 1:
+            what = "gear revolution(s)" if shaft is None else f"revolution(s) of {shaft!r}"
             raise GearshotError(
-                f"{self._label()} ({self.duration:.3g} s) holds {n_cycles} whole "
-                f"revolution(s) of the cycle shaft; one segment needs cycles_per_segment="
-                f"{cycles_per_segment}")
+                f"{self._label()} ({self.duration:.3g} s) holds {n_cycles} whole {what}; one "
+                f"segment needs cycles_per_segment={cycles_per_segment}")
         seg_len = per * samples_per_cycle
         blocks = x[..., : n_seg * seg_len].reshape(*x.shape[:-1], n_seg, seg_len)
         return np.asarray(synchronous_average(blocks, samples_per_cycle, n_cycles=per))

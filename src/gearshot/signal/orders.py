@@ -9,7 +9,7 @@ from .._errors import GearshotError
 from .._validation import as_signal_array, check_int
 
 __all__ = ["harmonic_signal", "difference_signal", "order_mask", "mesh_band_orders",
-           "check_mesh_order"]
+           "check_mesh_order", "check_mesh_orders"]
 
 
 def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int:
@@ -22,14 +22,41 @@ def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int
     return mesh_order
 
 
-def mesh_band_orders(n_points: int, mesh_order: int, n_sidebands: int) -> np.ndarray:
+def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tuple[int, ...]:
+    """Validate one mesh order or a sequence of them (a shaft carrying several gears).
+
+    Returns
+    -------
+    tuple of int
+        The distinct orders, in the given order.
+    """
+    if isinstance(mesh_order, (list, tuple, np.ndarray)):
+        orders = list(np.asarray(mesh_order).ravel().tolist())
+        if not orders:
+            raise GearshotError(f"{name} must name at least one mesh order; got {mesh_order!r}")
+        out = []
+        for i, o in enumerate(orders):
+            o = check_mesh_order(o, n_points, f"{name}[{i}]")
+            if o not in out:
+                out.append(o)
+        return tuple(out)
+    return (check_mesh_order(mesh_order, n_points, name),)
+
+
+def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     """One-sided orders (0 … n_points//2) of the mesh harmonics and their sidebands.
+
+    ``mesh_order`` may be a sequence (a shaft carrying several gears): the union of the
+    bands of every mesh.
 
     Harmonics ``k * mesh_order`` for ``k = 1 … floor((n_points/2) / mesh_order)``, each with
     ``±1 … ±n_sidebands`` sidebands. Orders beyond Nyquist or below zero are folded onto
     their mirror, as zeroing both halves of a two-sided spectrum would do. DC (order 0) is
     not a mesh harmonic and is kept unless a sideband folds onto it.
     """
+    if isinstance(mesh_order, (list, tuple, np.ndarray)):
+        return np.unique(np.concatenate([mesh_band_orders(n_points, int(m), n_sidebands)
+                                         for m in np.asarray(mesh_order).ravel()]))
     k = np.arange(1, (n_points // 2) // mesh_order + 1)
     s = np.arange(-n_sidebands, n_sidebands + 1)
     idx = (k[:, None] * mesh_order + s[None, :]).ravel() % n_points
@@ -44,8 +71,9 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2):
     ----------
     n_points : int
         Samples per cycle.
-    mesh_order : int
-        Mesh order in the cycle (teeth of the wheel whose revolution is the cycle).
+    mesh_order : int or sequence of int
+        Mesh order(s) in the cycle (teeth of the wheel(s) on the shaft whose revolution is
+        the cycle).
     n_sidebands : int
         Sidebands on each side of every mesh harmonic.
 
@@ -54,7 +82,7 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2):
     mask : ndarray of bool, shape (n_points // 2 + 1,)
     """
     n_points = check_int(n_points, "n_points", minimum=2)
-    mesh_order = check_mesh_order(mesh_order, n_points)
+    mesh_order = list(check_mesh_orders(mesh_order, n_points))
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
     mask = np.zeros(n_points // 2 + 1, dtype=bool)
     mask[mesh_band_orders(n_points, mesh_order, n_sidebands)] = True
@@ -81,8 +109,8 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
     ----------
     sa : array_like, shape (..., n_points)
         Synchronous average(s), one cycle each.
-    mesh_order : int
-        Gear-mesh order in the cycle (38 for the paper's gear revolution).
+    mesh_order : int or sequence of int
+        Gear-mesh order(s) in the cycle (38 for the paper's gear revolution).
     n_sidebands : int, default 2
         Sidebands kept on each side of every harmonic.
 
@@ -104,8 +132,9 @@ def difference_signal(sa, mesh_order, *, n_sidebands=2):
     ----------
     sa : array_like, shape (..., n_points)
         Synchronous average(s).
-    mesh_order : int
-        Gear-mesh order in the cycle.
+    mesh_order : int or sequence of int
+        Gear-mesh order in the cycle; several for a shaft carrying several gears (e.g.
+        ``[96, 48]`` for an idler shaft: every mesh's harmonics and sidebands go).
     n_sidebands : int, default 2
         Sidebands removed on each side of every harmonic.
 
