@@ -155,7 +155,7 @@ def nominal_sa(engine, speed, load, seed):
     vib = ENGINES[engine]()(motor_revs=revs, load_torque=np.full(t.size, load), fs=fs,
                             fault_size=0.0, reality=None, rng=np.random.default_rng(seed))
     skip = int(fs) // 4  # drop the start-up transient
-    rec = Recording(vib[skip:], tacho_signal(revs[skip:]), fs)
+    rec = Recording(vib[skip:], tacho_signal(revs[skip:]), fs, tacho_pulses_per_rev=1)
     return sa_of(rec)[0]
 
 

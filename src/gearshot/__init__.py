@@ -26,6 +26,9 @@ Subpackages (imported on first use):
     Figures.
 ``gearshot.app``
     The ``gearshot`` command line, the demo and report writing.
+
+:class:`gearshot.Machine` describes a real gearbox (gear train, tacho, sensors, file
+layout, monitored gear) and is read from TOML.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from importlib.metadata import PackageNotFoundError, version
 
 from ._errors import GearshotError
 from ._paths import data_home
+from .machine import Machine
 
 try:
     __version__ = version("gearshot")
@@ -44,7 +48,7 @@ except PackageNotFoundError:  # running from a source tree
 _SUBMODULES = {"signal", "features", "transfer", "sim", "io", "rig", "estimator",
                "experiments", "plotting", "app"}
 
-__all__ = ["GearshotError", "data_home", "__version__", *sorted(_SUBMODULES)]
+__all__ = ["GearshotError", "Machine", "data_home", "__version__", *sorted(_SUBMODULES)]
 
 
 def __getattr__(name: str):

@@ -181,8 +181,9 @@ def select_channels(raw: RawFile, *, accel: Any, tacho: Any, channels: Any
 
     if accel is None:
         accel_name = _lookup(raw.channels, ACCEL_NAMES)
-        if accel_name is None and "acceleration" in aliases:
-            accel_name = _resolve(raw, "accel", "acceleration", aliases)
+        alias = _lookup(aliases, ACCEL_NAMES)  # names given by the caller's channels=
+        if accel_name is None and alias is not None:
+            accel_name = _resolve(raw, "accel", alias, aliases)
         if accel_name is None:
             if raw.positional_defaults or len(names) == 1:
                 accel_name = names[0]
@@ -198,8 +199,9 @@ def select_channels(raw: RawFile, *, accel: Any, tacho: Any, channels: Any
         tacho_name = None
     elif tacho is None:
         tacho_name = _lookup(raw.channels, TACHO_NAMES)
-        if tacho_name is None and "tacho" in aliases:
-            tacho_name = _resolve(raw, "tacho", "tacho", aliases)
+        alias = _lookup(aliases, TACHO_NAMES)
+        if tacho_name is None and alias is not None:
+            tacho_name = _resolve(raw, "tacho", alias, aliases)
         if tacho_name is None and raw.positional_defaults:
             rest = [n for n in names if n != accel_name]
             tacho_name = rest[0] if rest else None

@@ -45,11 +45,12 @@ def read_csv(path: Path) -> RawFile:
             if i >= n_comment and line.strip():
                 first = line
                 break
-    if first and _numeric_row(first):
-        # no header row: never take the first data row for channel names
+    if first and (_numeric_row(first) or "," not in first):
+        # no header row (never take the first data row for channel names), or not
+        # comma-separated: the delimited-text reader sniffs the delimiter and the header
         from ._format_text import read_text
 
-        raw = read_text(path, delimiter=",", header=False, skip_rows=n_comment)
+        raw = read_text(path, skip_rows=n_comment)
         raw.fs = header.get("fs", raw.fs)
         return raw
     try:
