@@ -29,6 +29,7 @@ shafts is an exact fraction). It is read from a TOML file (:meth:`Machine.from_t
     name = "acc_input"
     channel = "acc_input"
     sensitivity = "10 mV/g"        # or a number (file units per `unit`) with unit = "g"
+    ac_coupled = true              # remove the record's mean (sensor bias); default true
 
     [file]
     columns = ["acc_input", "acc_output", "tacho"]
@@ -224,13 +225,15 @@ class Sensor:
     """A vibration sensor: its name, file channel, sensitivity and physical unit.
 
     ``sensitivity`` is in file units per physical unit (0.01 for 10 mV/g); the physical
-    signal is the file's column divided by it.
+    signal is the file's column divided by it. ``ac_coupled`` (default): the record's mean
+    (a bias voltage, not an acceleration) is removed, as an AC-coupled input would.
     """
 
     name: str
     channel: str
     sensitivity: float = 1.0
     unit: str = "g"
+    ac_coupled: bool = True
 
     def __post_init__(self) -> None:
         _name(self.name, "sensor.name")
@@ -604,7 +607,12 @@ class Machine:
         for i, s in enumerate(raw_sensors):
             if not isinstance(s, Mapping):
                 raise GearshotError(f"sensor[{i}] must be a table; got {describe(s)}")
-            _check_keys(s, {"name", "channel", "sensitivity", "unit"}, f"[[sensor]] {i}")
+            _check_keys(s, {"name", "channel", "sensitivity", "unit", "ac_coupled"},
+                        f"[[sensor]] {i}")
+            ac = s.get("ac_coupled", True)
+            if not isinstance(ac, bool):
+                raise GearshotError(f"sensor[{i}].ac_coupled must be true or false; got "
+                                    f"{describe(ac)}")
             if "name" not in s:
                 raise GearshotError(f"sensor[{i}] needs 'name'")
             sname = _name(s["name"], f"sensor[{i}].name")
@@ -618,7 +626,7 @@ class Machine:
             else:
                 value = _float(sens, f"sensor[{i}].sensitivity")
                 unit = _name(s.get("unit", "g"), f"sensor[{i}].unit")
-            sensors.append(Sensor(sname, channel, value, unit))
+            sensors.append(Sensor(sname, channel, value, unit, ac))
 
         layout = None
         ft = _table(data, "file", required=False)

@@ -310,6 +310,36 @@ def predict(
 
 
 @app.command()
+def indicators(
+    recordings: List[Path] = typer.Argument(..., help="Recording files (the original zips "
+                                            "are fine)."),
+    machine: Path = typer.Option(..., "--machine", help="Machine description (TOML)."),
+    shaft: str = typer.Option(..., "--shaft", help="Shaft whose revolution is the SA cycle."),
+    sensor: Optional[str] = typer.Option(None, "--sensor", help="Sensor name (default: the "
+                                         "machine file's first)."),
+    json_out: Path = typer.Option(..., "--json", help="Write the indicators as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for one figure per "
+                                       "indicator."),
+    baseline: List[Path] = typer.Option([], "--baseline", help="Healthy recording(s): NA4 "
+                                        "against their residual variance."),
+) -> None:
+    """Condition indicators of one shaft per recording, through a machine description."""
+    from ..machine import Machine
+    from .indicators import indicator_figures, indicator_table, record_indicators
+
+    mach = Machine.from_toml(machine)
+    payload = record_indicators(recordings, mach, shaft=shaft, sensor=sensor,
+                                baseline_paths=baseline)
+    _write_json(json_out, payload)
+    table = indicator_table(payload)
+    typer.echo(table.drop(columns=["case", "condition"]).to_string(
+        index=False, float_format=lambda v: f"{v:.4g}"))
+    if out is not None:
+        indicator_figures(payload, out, title=f"{mach.name}, shaft {shaft}")
+    typer.echo(f"indicators written to {json_out}")
+
+
+@app.command()
 def report(
     results: Path = typer.Argument(..., help="A results JSON written by --json."),
     out: Path = typer.Option(Path("gearshot-report"), "--out"),

@@ -619,7 +619,8 @@ def _machine_channels(raw: RawFile, machine: Any
     rows = []
     for s in machine.sensors:
         name = _resolve(raw, f"sensor {s.name!r} channel", s.channel, {})
-        rows.append(np.asarray(raw.channels[name], dtype=np.float64).ravel() / s.sensitivity)
+        row = np.asarray(raw.channels[name], dtype=np.float64).ravel() / s.sensitivity
+        rows.append(row - row.mean() if s.ac_coupled else row)
     tname = _resolve(raw, "tacho.channel", machine.tacho.channel, {})
     tac = np.asarray(raw.channels[tname], dtype=np.float64).ravel()
     acc = rows[0] if len(rows) == 1 else np.stack(rows)
