@@ -96,10 +96,17 @@ def simulate(
                                             "running Dask scheduler."),
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
                                 "--scheduler is given."),
+    machine: Optional[Path] = typer.Option(None, "--machine", help="Machine description "
+                                           "(TOML): simulate its monitored pair; --speed is "
+                                           "then the tacho shaft's speed."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from ..sim import GearPair, build_database, default_database_path
 
+    if machine is not None:
+        _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
+                          scheduler, workers)
+        return
     store = store or default_database_path()
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
     n_blocks = len(speeds) * len(loads) * len(grade)
@@ -110,6 +117,33 @@ def simulate(
     finally:
         if client is not None:
             client.close()
+    typer.echo(f"database ready: {store}")
+
+
+def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_faulty, seed,
+                      scheduler, workers):
+    """``simulate --machine``: a database of the machine's monitored pair."""
+    from ..machine import Machine
+    from ..sim import build_database
+    from .predict_machine import machine_database_path
+
+    mach = Machine.from_toml(machine_file)
+    pair = mach.gear_pair()
+    store = store or machine_database_path(machine_file, n_healthy=n_healthy,
+                                           n_faulty=n_faulty, seed=seed)
+    sim_speeds = [mach.sim_speed(s) for s in speeds]
+    n_blocks = len(sim_speeds) * len(loads) * len(grades)
+    client = _client(scheduler, workers, needed=n_blocks > 1)
+    try:
+        build_database(store, pair, speeds=sim_speeds, loads=loads, grades=grades,
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+    finally:
+        if client is not None:
+            client.close()
+    mate_shaft, _ = mach.mate()
+    typer.echo(f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
+               f"gear); {mate_shaft} speeds {[round(s, 4) for s in sim_speeds]} rev/s for "
+               f"{mach.tacho.shaft} speeds {list(speeds)}")
     typer.echo(f"database ready: {store}")
 
 
@@ -284,8 +318,9 @@ def predict(
     healthy: List[Path] = typer.Option(..., "--healthy", help="Healthy recording file(s)."),
     faulty: Path = typer.Option(..., "--faulty", help="The one faulty recording."),
     faulty_size: float = typer.Option(..., "--faulty-size", help="Its fault size in (0, 1]."),
-    recordings: Path = typer.Option(..., "--recordings", help="Folder (or file) of "
-                                    "recordings to estimate."),
+    recordings: List[Path] = typer.Option([], "--recordings", help="Folder (or file) of "
+                                          "recordings to estimate; with --machine, any "
+                                          "number of files."),
     speed: float = typer.Option(..., "--speed", help="Condition of the database slice, rps."),
     load: float = typer.Option(..., "--load", help="Nm."),
     out: Path = typer.Option(Path("predictions.csv"), "--out", help="CSV or JSON output."),
@@ -293,19 +328,44 @@ def predict(
     gear_teeth: int = typer.Option(38, "--gear-teeth"),
     pinion_teeth: int = typer.Option(17, "--pinion-teeth"),
     seed: int = typer.Option(0, "--seed"),
+    machine: Optional[Path] = typer.Option(None, "--machine", help="Machine description "
+                                           "(TOML): SAs of the monitored gear's shaft through "
+                                           "its gear train; --speed is the tacho shaft's."),
+    cycles_per_segment: Optional[int] = typer.Option(None, "--cycles-per-segment",
+                                                     help="With --machine: revolutions per "
+                                                     "SA segment (default: the machine's)."),
+    sensor: Optional[str] = typer.Option(None, "--sensor", help="With --machine: sensor "
+                                         "name (default the first)."),
+    holdout: float = typer.Option(0.25, "--holdout", help="With --machine: fraction of each "
+                                  "healthy recording's segments kept out of the fit and "
+                                  "estimated."),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
-    from .predict import predict_from_files
+    if machine is not None:
+        from ..machine import Machine
+        from .predict_machine import predict_from_machine
 
-    frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
-                               speed=speed, load=load, coverage=coverage,
-                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed)
+        frame = predict_from_machine(Machine.from_toml(machine), database, healthy, faulty,
+                                     faulty_size, recordings, speed=speed, load=load,
+                                     cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                     holdout=holdout, coverage=coverage, seed=seed)
+    else:
+        from .predict import predict_from_files
+
+        if len(recordings) != 1:
+            raise GearshotError(f"--recordings takes one folder or file without --machine; "
+                                f"got {len(recordings)}")
+        frame = predict_from_files(database, healthy, faulty, faulty_size, recordings[0],
+                                   speed=speed, load=load, coverage=coverage,
+                                   gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
+                                   seed=seed)
     out.parent.mkdir(parents=True, exist_ok=True)
     if out.suffix.lower() == ".json":
         out.write_text(frame.to_json(orient="records", indent=2))
     else:
         frame.to_csv(out, index=False)
-    typer.echo(frame.groupby("recording")["predicted"].mean().to_string())
+    by = ["recording", "role"] if "role" in frame else "recording"
+    typer.echo(frame.groupby(by)["predicted"].mean().to_string())
     typer.echo(f"predictions written to {out}")
 
 

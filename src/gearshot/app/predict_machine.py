@@ -1,0 +1,154 @@
+"""Fit and predict on a real machine: SA segments of the monitored gear's shaft, through a
+machine description (gear train, tacho, sensors, file layout)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .._errors import GearshotError
+from .._validation import check_in_range, check_int
+
+__all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
+
+
+def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty: int,
+                          seed: int) -> Path:
+    """Default store of ``gearshot simulate --machine FILE``."""
+    from ..sim import default_database_path
+
+    return default_database_path(f"machine-{Path(machine_file).stem}-h{n_healthy}-"
+                                 f"f{n_faulty}-s{seed}")
+
+
+def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
+                     sensor: str | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+    """SA segments of the monitored gear's shaft for one recording file.
+
+    Returns
+    -------
+    sa : ndarray, shape (n_segments, samples_per_cycle)
+    x : ndarray, shape (n_cycles * samples_per_cycle,)
+        The whole angle-domain signal (whole cycles from the first pulse).
+    speed : float
+        Tacho-shaft speed read from the tacho, rev/s.
+    """
+    from ..io import Recording
+
+    if machine.monitored is None:
+        raise GearshotError(f"machine {machine.name!r} names no [monitored] gear")
+    rec = Recording.read(path, machine=machine)
+    name = machine.sensor(sensor).name
+    spc = machine.samples_per_cycle
+    x = rec.angle_domain(shaft=machine.monitored.shaft, sensor=name, samples_per_cycle=spc,
+                         antialias=machine.antialias)
+    n_cycles = x.size // spc
+    n_seg = n_cycles // cycles_per_segment
+    if n_seg < 1:
+        raise GearshotError(f"{str(path)!r} holds {n_cycles} revolution(s) of shaft "
+                            f"{machine.monitored.shaft!r}; --cycles-per-segment="
+                            f"{cycles_per_segment} is too many")
+    blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
+    return blocks.mean(axis=1), x, rec.shaft_speed()
+
+
+def predict_from_machine(machine, database, healthy: Sequence[str | Path],
+                         faulty: str | Path, faulty_size: float,
+                         recordings: Sequence[str | Path] = (), *, speed: float, load: float,
+                         cycles_per_segment: int | None = None, sensor: str | None = None,
+                         holdout: float = 0.25, example_segment: int = 0,
+                         coverage: float = 0.9, seed: int = 0) -> pd.DataFrame:
+    """Fit on healthy recordings + one faulty recording; estimate segments of a machine.
+
+    Parameters
+    ----------
+    machine : gearshot.Machine
+        With a ``[monitored]`` gear; its shaft's revolution is the SA cycle and its tooth
+        count the mesh order.
+    database : path
+        Simulated database built for ``machine.gear_pair()`` (``gearshot simulate
+        --machine``); its speeds are the mate's speeds (:meth:`Machine.sim_speed`).
+    healthy : sequence of path
+        Healthy recordings.
+    faulty : path
+        The faulty recording; its segment ``example_segment`` is the one example.
+    faulty_size : float
+        The example's declared size in (0, 1].
+    recordings : sequence of path
+        Further recordings to estimate (every segment).
+    speed : float
+        Nominal tacho-shaft speed, rev/s (selects the database slice).
+    load : float
+        Load of the database slice, N m.
+    cycles_per_segment : int, optional
+        Shaft revolutions per SA segment (default: the machine's).
+    sensor : str, optional
+        Default: the machine's first sensor.
+    holdout : float
+        Fraction of each healthy recording's segments (the last ones) kept out of the fit
+        and estimated (``role="healthy_holdout"``); the faulty recording's other segments
+        are estimated too (``role="faulty_rest"``; they come from the example's record).
+    example_segment, coverage, seed
+        Which faulty segment is the example; interval coverage; random state.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``recording, role, segment, speed_hz, predicted, low, high``.
+    """
+    from ..estimator import OneFaultShotEstimator
+    from ..sim import load_database
+    from ..transfer import TransferFunctionBank
+
+    cps = machine.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
+    if cps is None:
+        raise GearshotError("the machine file says cycles_per_segment = 'all'; predict needs "
+                            "several segments per record: pass --cycles-per-segment")
+    cps = check_int(cps, "cycles_per_segment", minimum=1)
+    holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
+    spc = machine.samples_per_cycle
+    if not healthy:
+        raise GearshotError("--healthy needs at least one recording")
+    for p in [*healthy, faulty, *recordings]:
+        if not Path(p).is_file():
+            raise GearshotError(f"recording {str(p)!r} does not exist")
+    db = load_database(database, speed=machine.sim_speed(speed), load=load)
+    rows = []
+    train, long = [], None
+    for p in healthy:
+        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        n_hold = int(np.floor(holdout * sa.shape[0]))
+        n_fit = sa.shape[0] - n_hold
+        if n_fit < 1:
+            raise GearshotError(f"{str(p)!r}: no segment left for the fit after holdout="
+                                f"{holdout}")
+        train.append(sa[:n_fit])
+        if long is None:
+            long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
+        for k in range(n_fit, sa.shape[0]):
+            rows.append((str(p), "healthy_holdout", k, sp, sa[k]))
+    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor)
+    example_segment = check_int(example_segment, "example_segment", minimum=0,
+                                maximum=fsa.shape[0] - 1)
+    for k in range(fsa.shape[0]):
+        if k != example_segment:
+            rows.append((str(faulty), "faulty_rest", k, fsp, fsa[k]))
+    for p in recordings:
+        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
+    est = OneFaultShotEstimator(random_state=seed, mesh_order=machine.monitored.teeth)
+    selection_tf = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
+    est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
+            selection_tf=selection_tf)
+    frame = pd.DataFrame([r[:4] for r in rows],
+                         columns=["recording", "role", "segment", "speed_hz"])
+    if rows:
+        sas = np.stack([r[4] for r in rows])
+        low, high = est.predict_interval(sas, coverage=coverage)
+        frame["predicted"] = est.predict(sas)
+        frame["low"], frame["high"] = low, high
+    frame.attrs["grade"] = getattr(est, "grade_", None)
+    return frame
