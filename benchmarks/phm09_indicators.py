@@ -29,6 +29,15 @@ from gearshot.io import Recording
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def markdown(frame: pd.DataFrame, fmt: str = "{:.3g}") -> str:
+    """A pipe table (no optional dependency)."""
+    cells = [[fmt.format(v) if isinstance(v, float) else str(v) for v in row]
+             for row in frame.itertuples(index=False)]
+    head = "| " + " | ".join(map(str, frame.columns)) + " |"
+    rule = "|" + "|".join("---" for _ in frame.columns) + "|"
+    return "\n".join([head, rule] + ["| " + " | ".join(c) + " |" for c in cells])
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data" / "phm09")
@@ -94,13 +103,12 @@ def main() -> None:
     summary = pd.DataFrame(out)
     summary.to_csv(args.out / "phm09_separation.csv", index=False)
     print(f"cells: {len(cells)} (speed x load)")
-    print(summary.to_markdown(index=False))
+    print(markdown(summary))
     # compact table: paper's four + classical, input sensor, monitored shafts
     show = table[(table.sensor == "acc_input") & (
         ((table.kind == "spur") & (table.shaft == "input"))
         | ((table.kind == "helical") & (table.shaft == "idler")))]
-    print(show[["file", "shaft", "speed_hz", "n_cycles", *names]].to_markdown(
-        index=False, floatfmt=".3g"))
+    print(markdown(show[["file", "shaft", "speed_hz", "n_cycles", *names]]))
 
 
 if __name__ == "__main__":

@@ -280,3 +280,23 @@ def test_exact_ratios():
     c = shaft_cycle_times(pulses, revs_per_cycle=Fraction(38, 17), pulses_per_rev=10)
     assert c.size == int(100 * 17 / 38) + 1
     assert_allclose(c, np.arange(c.size) * 38 / 17 / 10.0, atol=1e-12)
+
+
+def test_tdms_recordings_with_a_machine(tmp_path):
+    nptdms = pytest.importorskip("nptdms", reason="TDMS reading needs the optional npTDMS")
+    fs = 10_000.0
+    t = np.arange(int(3 * fs)) / fs
+    revs = 20.0 * t
+    acc_v = 0.01 * np.cos(2 * np.pi * 32 * revs) + 0.5  # 1 g at order 32, a 0.5 V bias
+    tach = (np.mod(revs * 10, 1.0) < 0.5) * 5.0
+    path = tmp_path / "run.tdms"
+    props = {"wf_increment": 1 / fs}
+    with nptdms.TdmsWriter(path) as w:
+        w.write_segment([nptdms.ChannelObject("daq", "acc_input", acc_v, properties=props),
+                         nptdms.ChannelObject("daq", "acc_output", acc_v, properties=props),
+                         nptdms.ChannelObject("daq", "tacho", tach, properties=props)])
+    machine = Machine.from_toml(EXAMPLES / "phm09_spur.toml")
+    rec = Recording.read(path, machine=machine)
+    assert rec.fs == pytest.approx(fs) and rec.acceleration.shape == (2, t.size)
+    sa = rec.to_sa_segments(shaft="input", sensor="acc_input", cycles_per_segment=None)
+    assert 2 * np.abs(np.fft.rfft(sa[0]))[32] / SPR == pytest.approx(1.0, rel=0.01)
