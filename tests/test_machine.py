@@ -161,3 +161,24 @@ def test_parse_sensitivity():
     assert parse_sensitivity("1.02V/m/s^2")[1] == "m/s^2"
     with pytest.raises(GearshotError, match="sensitivity"):
         parse_sensitivity(10)
+
+
+def test_helix_angle_reaches_gear_pair_only_if_it_accepts_one(tmp_path):
+    import dataclasses
+
+    m = Machine.from_toml(write(tmp_path, MINIMAL))
+    if "helix_angle" in {f.name for f in dataclasses.fields(GearPair)}:
+        assert m.gear_pair().helix_angle == pytest.approx(math.radians(15))
+    else:
+        with pytest.warns(UserWarning, match="helix"):
+            pair = m.gear_pair()
+        assert (pair.z_pinion, pair.z_gear, pair.module) == (25, 35, pytest.approx(2.5e-3))
+
+
+def test_indicators_help():
+    import subprocess
+    import sys
+
+    res = subprocess.run([sys.executable, "-m", "gearshot.app.cli", "indicators", "--help"],
+                         capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0 and "--machine" in res.stdout and "--shaft" in res.stdout

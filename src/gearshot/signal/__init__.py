@@ -15,11 +15,14 @@ from .envelope import envelope
 from .level import mean_rms, rms
 from .orders import difference_signal, harmonic_signal, mesh_band_orders, order_mask
 from .spectra import acs_background, amplitude_spectrum
+from .trains import antialias_filter, shaft_cycle_times
 
 __all__ = [
     "pulse_times",
     "angle_to_time",
     "angular_resample",
+    "antialias_filter",
+    "shaft_cycle_times",
     "check_pulse_train",
     "gear_cycle_times",
     "synchronous_average",
