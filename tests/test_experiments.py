@@ -66,7 +66,12 @@ def test_evaluate_variants_and_summary(sim_data):
                              random_state=0)
     frame = pd.DataFrame(rows)
     assert list(frame["variant"]) == list(SIMULATED_VARIANTS)
-    assert frame["mae"].between(0, 1).all()
+    mae = frame.set_index("variant")["mae"]
+    constant = np.mean(np.abs(ds.test_size - 0.5))  # the always-0.5 predictor
+    # every variant learns something; with an identity path, the variants that do not
+    # estimate a TF are far better than chance (measured 0.13-0.15 against 0.33)
+    assert (mae < constant).all(), (mae, constant)
+    assert mae["before_da"] < 0.6 * constant and mae["rms_only"] < 0.6 * constant
     table = summarize(frame)
     assert_allclose(table.set_index("variant").loc["full", "mae_percent"],
                     100 * frame.set_index("variant").loc["full", "mae"])
