@@ -73,11 +73,13 @@ def demo(
     out: Path = typer.Option(Path("gearshot-demo"), "--out", help="Folder for figures, "
                              "tables and the report."),
     seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
+    draws: int = typer.Option(5, "--draws", help="Draws of the faulty example; the table "
+                              "gives the mean ± std over them."),
 ) -> None:
     """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
     from .demo import run_demo
 
-    run_demo(out, seed=seed)
+    run_demo(out, seed=seed, draws=draws)
 
 
 @app.command()
