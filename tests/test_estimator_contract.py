@@ -8,12 +8,12 @@ run one by one, and the rest of the contract is tested here directly.
 import numpy as np
 import pytest
 import sklearn.exceptions
+from estimator_data import N, synthetic_database, synthetic_target
 from numpy.testing import assert_array_equal
 from sklearn.base import clone
 from sklearn.utils import estimator_checks
 from sklearn.utils.validation import check_is_fitted
 
-from estimator_data import N, synthetic_database, synthetic_target
 from gearshot import GearshotError
 from gearshot.estimator import STEP_SEEDS, NotFittedError, OneFaultShotEstimator, steps
 from gearshot.estimator._params import validate_params
@@ -243,7 +243,7 @@ def test_failed_refit_keeps_the_previous_model(data, tfs, fitted):
     _fit(est, data, tfs)
     before = est.predict(data[3])
     state = set(vars(est))
-    db, healthy, long, faulty, y = data
+    db, healthy, long, faulty, _ = data
     with pytest.raises(GearshotError, match="faulty_size"):
         est.fit(db, healthy, faulty[7], 1.5, long, selection_tf=tfs[1])
     assert set(vars(est)) == state

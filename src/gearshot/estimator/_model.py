@@ -350,6 +350,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         seeds = _step_seeds(self.random_state)
         names = PAPER_FEATURES if self.features is None else tuple(self.features)
 
+        # the block diagram: target side, feature selection, grade choice, grade models
         target = self._fit_target_side(inputs, names)
         selection = self._select_features(by_grade, nominal, inputs, names,
                                           seeds["select_features"])
@@ -357,7 +358,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"])
         strategy = self._grade_strategy(grades)
-        choice = getattr(self, f"_grade_{strategy}")(ctx)
+        choose = {"paper": self._grade_paper, "soft": self._grade_soft,
+                  "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot}[strategy]
+        choice = choose(ctx)
         models = {g: ctx.model_for(g) for g in choice.weights}
         best = ctx.model_for(choice.grade)
 

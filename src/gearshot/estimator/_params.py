@@ -163,7 +163,7 @@ class ArrayOrObject(Constraint):
             return False
         try:
             arr = np.asarray(value)
-        except Exception:
+        except (TypeError, ValueError):  # ragged nesting and the like
             return False
         return arr.ndim == 1 and arr.size > 0 and (
             np.issubdtype(arr.dtype, np.number) and not np.issubdtype(arr.dtype, np.bool_))
