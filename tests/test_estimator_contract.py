@@ -108,7 +108,7 @@ def test_learned_attributes_end_with_underscore(fitted):
     assert learned and all(a.endswith("_") and not a.startswith("_") for a in learned), learned
     assert "database_" not in learned
     assert set(fitted.step_seeds_) == set(STEP_SEEDS)
-    assert fitted.grade_strategy_ == "paper"
+    assert fitted.grade_strategy_ == "tuned"
 
 
 def test_fixed_random_state_is_deterministic(data, tfs, fitted):

@@ -4,7 +4,7 @@
 
 * the target side (steps 3 and 5–7 on the target's healthy SAs),
 * feature selection (step 1, on the nominal grade),
-* the grade choice, one strategy per mode: ``paper`` (step 2, the one tuned grade),
+* the grade choice, one strategy per mode: ``tuned`` (step 2: the one grade the paper keeps),
   ``soft`` (step 2, every grade weighted by how well it predicts the example),
   ``nominal`` (no tuning) and ``zero_shot`` (healthy statistics, no example),
 * the grade models (steps 4–8 on each chosen grade's simulated SAs).
@@ -239,7 +239,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     selection_features_ : (train, test) tuple of ndarray or None
         Step 1's paired candidate features through the estimated and the held-out TF
         (the paper's Fig. 11; see :func:`gearshot.plotting.plot_feature_invariance`).
-    grade_strategy_ : {"paper", "soft", "nominal", "zero_shot"}
+    grade_strategy_ : {"tuned", "soft", "nominal", "zero_shot"}
         The grade-choice strategy that ran.
     grade_ : int
         The best grade (the paper's choice).
@@ -358,7 +358,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"])
         strategy = self._grade_strategy(grades)
-        choose = {"paper": self._grade_paper, "soft": self._grade_soft,
+        choose = {"tuned": self._grade_tuned, "soft": self._grade_soft,
                   "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot}[strategy]
         choice = choose(ctx)
         models = {g: ctx.model_for(g) for g in choice.weights}
@@ -519,10 +519,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             return "zero_shot"
         if not self.tune_simulation or len(grades) == 1:
             return "nominal"
-        return "soft" if self.grade_weighting == "soft" else "paper"
+        return "soft" if self.grade_weighting == "soft" else "tuned"
 
-    def _grade_paper(self, ctx: _FitContext) -> _GradeChoice:
-        """Step 2 as in the paper: the grade whose model predicts the example best."""
+    def _grade_tuned(self, ctx: _FitContext) -> _GradeChoice:
+        """Step 2 (the paper): the one grade whose model predicts the example best."""
         x_example = ctx.example_features()
         assert ctx.inputs.faulty_size is not None
         grade, curve = steps.tune_grade(lambda g: float(ctx.model_for(g).predict(x_example)[0]),
@@ -532,12 +532,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
 
     def _grade_soft(self, ctx: _FitContext) -> _GradeChoice:
         """Step 2, soft: every grade weighted by the likelihood of the example's size."""
-        paper = self._grade_paper(ctx)
-        assert paper.tuning_curve is not None and ctx.inputs.faulty_size is not None
-        weights = grade_weights(paper.tuning_curve["prediction"], ctx.grades,
+        tuned = self._grade_tuned(ctx)
+        assert tuned.tuning_curve is not None and ctx.inputs.faulty_size is not None
+        weights = grade_weights(tuned.tuning_curve["prediction"], ctx.grades,
                                 ctx.inputs.faulty_size,
-                                ctx.model_for(paper.grade).validation_residuals)
-        return _GradeChoice(paper.grade, weights, paper.tuning_curve)
+                                ctx.model_for(tuned.grade).validation_residuals)
+        return _GradeChoice(tuned.grade, weights, tuned.tuning_curve)
 
     def _grade_nominal(self, ctx: _FitContext) -> _GradeChoice:
         """No tuning: ``nominal_grade`` (or the only grade tried)."""
