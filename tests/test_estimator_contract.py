@@ -166,6 +166,7 @@ def test_every_parameter_has_a_constraint():
     ("grades", [], "[]"),
     ("grades", [0], "[0]"),
     ("grades", [3, 13], "[3, 13]"),
+    ("grades", (g for g in [3, 6]), "generator"),
     ("select_features", "yes", "yes"),
     ("select_features", 1, "1"),
     ("tune_simulation", None, "None"),

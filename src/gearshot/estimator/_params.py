@@ -9,7 +9,7 @@ says what was expected.
 from __future__ import annotations
 
 import numbers
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,6 +45,12 @@ def _is_int(value: Any) -> bool:
 
 def _is_real(value: Any) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_collection(value: Any) -> bool:
+    """Iterable more than once and not a string (lists, tuples, ranges, arrays)."""
+    return (isinstance(value, Iterable) and not isinstance(value, (str, bytes, Iterator))
+            and not _is_int(value))
 
 
 @dataclass(frozen=True)
@@ -116,14 +122,13 @@ class NoneValue(Constraint):
 
 @dataclass(frozen=True)
 class IntegerSequence(Constraint):
-    """A non-empty iterable (not a string) of integers, each within ``[low, high]``."""
+    """A non-empty collection (no string or one-shot iterator) of integers in [low, high]."""
 
     low: int | None = None
     high: int | None = None
 
     def accepts(self, value: Any) -> bool:
-        if isinstance(value, (str, bytes)) or not isinstance(value, Iterable) \
-                or _is_int(value):
+        if not _is_collection(value):
             return False
         items = list(value)
         item = Interval(int, self.low, self.high)
@@ -135,12 +140,12 @@ class IntegerSequence(Constraint):
 
 @dataclass(frozen=True)
 class NameSequence(Constraint):
-    """A non-empty sequence (not a string) of names from ``choices()``."""
+    """A non-empty collection (no string or one-shot iterator) of names from choices()."""
 
     choices: Callable[[], Sequence[str]]
 
     def accepts(self, value: Any) -> bool:
-        if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        if not _is_collection(value):
             return False
         names = list(value)
         valid = set(self.choices())
