@@ -139,7 +139,7 @@ def test_rig_figures_include_fig11_and_the_tuning_curve(tmp_path, sim_data):
     ds = simulated_dataset(sa, y, tf, random_state=1)
     db = ds.database.assign_coords(grade=("signal", np.where(np.arange(ds.database.sizes[
         "signal"]) % 2 == 0, 3, 6)))
-    est = OneFaultShotEstimator(random_state=0, grades=[3, 6]).fit(
+    est = OneFaultShotEstimator(random_state=0, grades=[3, 6], nominal_grade=3).fit(
         db, ds.target_healthy, ds.faulty_example, ds.faulty_size, ds.healthy_long,
         selection_tf=tf)
     train, test = est.selection_features_
