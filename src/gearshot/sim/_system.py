@@ -9,6 +9,13 @@ rigid motion driven by the motor angle theta_m(t), and the brake rotation. The a
 and tilt DOFs of the 13-DOF model are left out: for a spur mesh whose load acts at
 mid-face the line-of-action vector has no axial or tilt terms, so those DOFs decouple
 exactly (K, M and C are block-diagonal) and do not reach the vertical acceleration.
+
+A helical pair adds the axial motions ``z1, z2`` (9 DOFs; axial bearing stiffness
+``pair.bearing_stiffness``): the mesh deflection is taken along the tooth normal,
+``cos(beta_b) (transverse deflection) + sin(beta_b) (z1 - z2)``, so the mesh force has the
+axial component ``F_n sin(beta_b)`` that loads the axial bearings, and the transverse
+component ``F_n cos(beta_b)``. (The tilts the axial force excites through its lever arm
+are left out.)
 """
 
 from __future__ import annotations
@@ -18,13 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import newmark_batch
+from ._kernel import newmark_batch, newmark_batch_tables
+from ._slices import box
 from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors
-from .stiffness import _N_TABLE, _pair_table
+from .stiffness import _N_TABLE, _pair_table, fault_tables, helical_tables
 
-__all__ = ["system_matrices", "Integrator", "integrator", "Batch", "warmup_time"]
+__all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
+           "make_batch", "warmup_time"]
 
 
 def system_matrices(pair: GearPair):
@@ -32,10 +41,10 @@ def system_matrices(pair: GearPair):
 
     Returns
     -------
-    M, K0, C : ndarray (7, 7)
+    M, K0, C : ndarray (7, 7), or (9, 9) for a helical pair
         Mass (kg, kg m^2), stiffness without the mesh, modal damping.
-    v : ndarray (7,)
-        Mesh deflection along the line of action = v . q (m).
+    v : ndarray (7,) or (9,)
+        Mesh deflection along the line of action (the tooth normal) = v . q (m).
     omega : ndarray (7,)
         Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
     """
@@ -43,7 +52,7 @@ def system_matrices(pair: GearPair):
     j1, j2 = pair.inertias
     kt1, kt2 = pair.shaft_torsional_stiffness
     kb = pair.bearing_stiffness
-    a = pair.pressure_angle
+    a = pair.transverse_pressure_angle
     rb1, rb2 = pair.base_radius(pair.z_pinion), pair.base_radius(pair.z_gear)
     M = np.diag([m1, m1, j1, m2, m2, j2, pair.inertia_brake])
     K0 = np.zeros((7, 7))
@@ -54,6 +63,13 @@ def system_matrices(pair: GearPair):
     K0[6, 6] += kt2
     K0[5, 6] = K0[6, 5] = -kt2
     v = np.array([math.sin(a), math.cos(a), rb1, -math.sin(a), -math.cos(a), -rb2, 0.0])
+    if pair.is_helical:
+        bb = pair.base_helix_angle
+        M = np.diag(np.concatenate([np.diag(M), [m1, m2]]))
+        K0 = np.pad(K0, (0, 2))
+        K0[7, 7] = K0[8, 8] = kb
+        v = np.concatenate([math.cos(bb) * v, [math.sin(bb), -math.sin(bb)]])
+    # the mean mesh stiffness (slices keep the spur mean: the face average preserves it)
     k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
     K = K0 + k_mean * np.outer(v, v)
     # modal damping on the mean system
@@ -101,10 +117,11 @@ def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
     B2 = Ai @ (a2 * M + a4 * C)
     B3 = Ai @ (a3 * M + a5 * C)
     w = Ai @ v
-    f_load = np.zeros(7)
+    f_load = np.zeros(v.size)
     f_load[6] = -1.0                      # brake torque opposes rotation (per N m)
     ratio = pair.z_pinion / pair.z_gear
-    f_motor = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
+    f_motor = np.zeros(v.size)
+    f_motor[:7] = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
     k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
     x_static = np.linalg.solve(K0 + k_mean * np.outer(v, v), f_load * load0)
     return Integrator(B1, B2, B3, w, float(v @ w), v, Ai @ f_load, Ai @ f_motor, x_static,
@@ -127,13 +144,11 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
     ef = np.zeros((n, _N_TABLE))
     tooth = np.full(n, -1, dtype=np.int64)
     healthy = _pair_table(pair, None)
-    u = np.linspace(0.0, 1.0, _N_TABLE)
     for i, f in enumerate(faults):
         if f is None or f.is_healthy:
             kf[i] = healthy
             continue
-        kf[i] = _pair_table(pair, f)
-        ef[i] = f.displacement(pair, 1.0 - u)
+        kf[i], ef[i] = fault_tables(pair, f)
         tooth[i] = f.tooth % pair.z_gear
     return kf, ef, tooth
 
@@ -169,3 +184,56 @@ class Batch:
                       integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
                       rec_start, out)
         return out
+
+
+class HelicalBatch(Batch):
+    """A batch of a helical pair: per-tooth tables of stiffness and error force over the
+    delay since a tooth pair's first contact (slice method, :mod:`._slices`)."""
+
+    def __init__(self, pair, integ, faults, gear_errs, pin_errs):
+        self.pair, self.integ = pair, integ
+        ea, eb = pair.contact_ratio, pair.overlap_ratio
+        self.span, self.k, _ = helical_tables(pair)
+        tau = np.linspace(0.0, self.span, self.k.size)
+        u = np.linspace(0.0, 1.0, _N_TABLE)
+        k_sp = _pair_table(pair, None)
+        n = len(faults)
+
+        def errors(errs):
+            teeth = np.arange(errs[0].slope.size)[:, None]
+            return np.stack([e(teeth, u[None, :]) for e in errs])
+
+        e_g, e_p = errors(gear_errs), errors(pin_errs)
+        self.fg = box(k_sp * e_g, ea, eb, 0.0, eb, tau)
+        self.fp = box(k_sp * e_p, ea, eb, 0.0, eb, tau)
+        self.fpf = self.fp.copy()
+        self.kf = np.tile(self.k, (n, 1))
+        self.tooth = np.full(n, -1, dtype=np.int64)
+        for i, f in enumerate(faults):
+            if f is None or f.is_healthy:
+                continue
+            t = f.tooth % pair.z_gear
+            _, self.kf[i], bands = helical_tables(pair, f)
+            self.tooth[i] = t
+            for lo, hi, dk, kd in bands:
+                self.fg[i, t] += box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau)
+                self.fpf[i] += box(dk * e_p[i], ea, eb, lo, hi, tau)
+        self.X = np.tile(integ.x_static, (n, 1))
+        self.V = np.zeros((n, integ.x_static.size))
+        self.A = np.zeros((n, integ.x_static.size))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+        integ = self.integ
+        out = np.empty((self.X.shape[0], n_rec))
+        newmark_batch_tables(
+            np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
+            np.ascontiguousarray(load), self.k, self.kf, self.tooth, self.fg, self.fp,
+            self.fpf, self.span, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
+            integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef, rec_start, out)
+        return out
+
+
+def make_batch(pair, integ, faults, gear_errs, pin_errs) -> Batch:
+    """A :class:`Batch` (spur) or :class:`HelicalBatch` for ``pair``."""
+    cls = HelicalBatch if pair.is_helical else Batch
+    return cls(pair, integ, faults, gear_errs, pin_errs)

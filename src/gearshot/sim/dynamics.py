@@ -25,7 +25,7 @@ from .._validation import check_int, check_positive
 from ._decimate import StreamingDecimator, fir_half_length
 from ._inputs import (as_rng, check_grade, check_pair, draw_errors, profile_fn,
                       resolve_faults)
-from ._system import Batch, integrator, system_matrices, warmup_time
+from ._system import integrator, make_batch, system_matrices, warmup_time
 from .geometry import GearPair
 
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
@@ -105,7 +105,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     out = np.empty((n_sig, n_points))
     for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        acc = Batch(pair, integ, faults[sl], ge[sl], pe[sl]).run(
+        acc = make_batch(pair, integ, faults[sl], ge[sl], pe[sl]).run(
             mesh_pos, zeros, loads, n_warm - 1, n_rev)
         out[sl] = _fft_resample(acc, n_points)
     return out
@@ -221,7 +221,7 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     chunk = 1 << 16
     for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        batch = Batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
         decimator = StreamingDecimator(acc[sl], up)
         # warm-up at the initial speed and load, t = -(n_warm - 1) dt ... 0; keep the
         # samples from t = -half dt to 0 (the filter's history and the first sample)
