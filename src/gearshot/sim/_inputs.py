@@ -7,6 +7,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_finite, check_int, check_positive, describe
+from .fault_types import check_fault_type, fault_of_type
 from .faults import FullToothFaceFault, ToothFault
 from .geometry import GearPair
 from .profile_errors import draw_profile_errors
@@ -90,8 +91,10 @@ def profile_fn(value, name, fs):
     return lambda t: np.interp(t, t_src, src)
 
 
-def resolve_faults(fault_sizes, faults, center, depth) -> list[ToothFault]:
-    """One fault object per signal, from FTFF sizes or from given fault objects."""
+def resolve_faults(fault_sizes, faults, center, depth, fault_type="ftff"
+                   ) -> list[ToothFault]:
+    """One fault object per signal, from sizes of ``fault_type`` or from fault objects."""
+    fault_type = check_fault_type(fault_type)
     if faults is not None:
         if fault_sizes is not None:
             raise GearshotError("give fault_sizes or faults, not both")
@@ -106,7 +109,11 @@ def resolve_faults(fault_sizes, faults, center, depth) -> list[ToothFault]:
     if fault_sizes is None:
         raise GearshotError("give fault_sizes (FTFF sizes) or faults (fault objects)")
     sizes = check_sizes(fault_sizes)
-    return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
+    if fault_type == "ftff":
+        return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
+    options = {"partial_face": dict(center=center, depth=depth),
+               "destruction": dict(center=center)}.get(fault_type, {})
+    return [fault_of_type(fault_type, float(y), **options) for y in sizes]
 
 
 def draw_errors(pair, grade, n, rng, same_gear, average_pinion):

@@ -40,7 +40,7 @@ _BATCH_CHUNK = 64
 def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_sizes=None,
                 n_points: int = 2048, same_gear: bool = False, rng=None,
                 fault_center: float = 0.5, fault_depth: float = 0.5, faults=None,
-                min_fs: float = DEFAULT_MIN_FS) -> np.ndarray:
+                min_fs: float = DEFAULT_MIN_FS, fault_type: str = "ftff") -> np.ndarray:
     """Synchronous averages over one revolution of the driven gear, steady state.
 
     The SA of the vertical acceleration over the hunting period averages the pinion's
@@ -60,7 +60,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     grade : int
         DIN 3962 quality grade 1 ... 12.
     fault_sizes : sequence of float
-        FTFF sizes y in [0, 1] (0 = healthy), one signal each.
+        Fault sizes y in [0, 1] of ``fault_type`` (0 = healthy), one signal each.
     n_points : int
         Points per SA cycle.
     same_gear : bool
@@ -70,12 +70,16 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
         Source of the profile errors; a list gives each signal its own stream (a signal
         is then reproducible alone from its seed).
     fault_center, fault_depth : float
-        FTFF placement and depth coefficient.
+        FTFF placement and depth coefficient (also the partial-face cut's; the
+        destruction band's centre).
     faults : sequence of ToothFault, optional
         Instead of ``fault_sizes``: one fault object per signal (any fault type; None =
         healthy).
     min_fs : float
         Lowest internal integration rate, Hz.
+    fault_type : {"ftff", "partial_face", "breakage", "destruction"}
+        Type of the faults of ``fault_sizes`` (:mod:`gearshot.sim.fault_types` says
+        what a size means for each).
 
     Returns
     -------
@@ -86,7 +90,7 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     speed = check_positive(speed, "speed")
     load = check_positive(load, "load")
     grade = check_grade(grade)
-    faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type)
     n_sig = len(faults)
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
@@ -147,7 +151,8 @@ class SimulationResult:
 def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: float,
              duration: float | None = None, n_revs: float | None = None, rng=None,
              same_gear: bool = False, fault_center: float = 0.5, fault_depth: float = 0.5,
-             faults=None, min_fs: float = DEFAULT_MIN_FS) -> SimulationResult:
+             faults=None, min_fs: float = DEFAULT_MIN_FS, fault_type: str = "ftff"
+             ) -> SimulationResult:
     """Vertical-acceleration time signals, steady state from the first sample.
 
     The run is integrated in chunks (memory stays bounded for long recordings) at an
@@ -166,13 +171,13 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     grade : int
         DIN grade 1 ... 12.
     fault_sizes : sequence of float
-        FTFF sizes, one signal each.
+        Fault sizes of ``fault_type``, one signal each.
     fs : float
         Output sampling rate, Hz; the integration runs at an integer multiple >= min_fs
         and is decimated with an anti-aliasing filter.
     duration, n_revs : float
         Signal length in seconds, or in input-shaft revolutions (one of the two).
-    rng, same_gear, fault_center, fault_depth, faults, min_fs
+    rng, same_gear, fault_center, fault_depth, faults, min_fs, fault_type
         As in :func:`simulate_sa`.
 
     Returns
@@ -182,7 +187,7 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     check_pair(pair)
     fs = check_positive(fs, "fs")
     grade = check_grade(grade)
-    faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth)
+    faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type)
     n_sig = len(faults)
     min_fs = check_positive(min_fs, "min_fs")
     rng = as_rng(rng, n_sig)
