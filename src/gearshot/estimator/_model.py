@@ -20,6 +20,31 @@ from .zero_shot import healthy_signature, match_grade, signature_weights
 __all__ = ["OneFaultShotEstimator"]
 
 
+def _select_fault_type(database, fault_type):
+    """The signals of one fault type (healthy ones included) of a database whose
+    ``fault_type`` coordinate names each signal's type; databases without it hold FTFFs."""
+    try:
+        types = np.asarray(database["fault_type"]).astype(str)
+    except (KeyError, TypeError):
+        types = None
+    if types is None or types.ndim == 0:
+        have = ["ftff"] if types is None else [str(types)]
+        if fault_type is not None and fault_type not in have:
+            raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                                f"(it has {have})")
+        return database
+    have = list(dict.fromkeys(types))
+    if fault_type is None:
+        if len(have) > 1:
+            raise GearshotError(f"the database holds several fault types {have}; choose "
+                                f"one with fault_type=...")
+        return database
+    if fault_type not in have:
+        raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                            f"(it has {have})")
+    return database.isel(signal=np.flatnonzero(types == fault_type))
+
+
 def _database_by_grade(database, n_points=None):
     """Split a simulated database (xarray.Dataset or mapping) into {grade: (sa, y)}."""
     try:
@@ -98,6 +123,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         error after domain adaptation (an MAE of about 6 %, as in the paper). 0 gives
         pure split-conformal intervals.
     random_state : int, numpy Generator/RandomState or None
+    fault_type : str, optional
+        Fault type whose database slice trains the model (``fault_type`` coordinate of
+        :func:`gearshot.sim.load_database`); ``None``: the database's only type.
 
     Attributes
     ----------
@@ -120,7 +148,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  rms_normalization=True, transfer_function="estimate",
                  n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
                  zero_shot=False, upsample=100, tuning_smoothing="isotonic",
-                 grade_weighting="soft", model_discrepancy=0.08, random_state=None):
+                 grade_weighting="soft", model_discrepancy=0.08, random_state=None,
+                 fault_type=None):
+        self.fault_type = fault_type
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -258,7 +288,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             faulty_size = float(faulty_size)
         if healthy_long is not None:
             healthy_long = as_signal_array(healthy_long, "healthy_long", max_ndim=1)
-        self.database_ = _database_by_grade(database, n_points)
+        self.database_ = _database_by_grade(_select_fault_type(database, self.fault_type),
+                                            n_points)
         grades = [g for g in grades if g in self.database_]
         if not grades:
             raise GearshotError(f"none of grades={list(self.grades)!r} is in the database "
