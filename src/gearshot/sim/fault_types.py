@@ -84,7 +84,7 @@ class PartialFaceFault(ToothFault):
             raise GearshotError(f"a partial face fault of size {self.size!r} starting at "
                                 f"face_start={self.face_start!r} leaves the face; choose "
                                 f"face_start <= {1 - self.size:.4g}")
-        self.transverse                         # validates profile_size, center, depth
+        _ = self.transverse                     # validates profile_size, center, depth
 
     @property
     def transverse(self) -> FullToothFaceFault:
