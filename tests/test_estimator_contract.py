@@ -249,3 +249,10 @@ def test_failed_refit_keeps_the_previous_model(data, tfs, fitted):
         est.fit(db, healthy, faulty[7], 1.5, long, selection_tf=tfs[1])
     assert set(vars(est)) == state
     assert_array_equal(est.predict(data[3]), before)
+
+
+def test_fault_type_names_follow_the_simulator():
+    from gearshot.estimator._model import FAULT_TYPE_NAMES
+    from gearshot.sim import FAULT_TYPES
+
+    assert FAULT_TYPE_NAMES == tuple(FAULT_TYPES)

@@ -98,17 +98,20 @@ def simulate(
                                             "running Dask scheduler."),
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
                                 "--scheduler is given."),
+    fault_type: List[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
+                                         "ftff, partial_face, breakage, destruction."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from ..sim import GearPair, build_database, default_database_path
 
     store = store or default_database_path()
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
-    n_blocks = len(speeds) * len(loads) * len(grade)
+    n_blocks = len(speeds) * len(loads) * len(grade) * len(fault_type)
     client = _client(scheduler, workers, needed=n_blocks > 1)
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
-                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
+                       fault_types=fault_type)
     finally:
         if client is not None:
             client.close()

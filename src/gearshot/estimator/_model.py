@@ -55,6 +55,35 @@ ComplexArray = NDArray[np.complex128]
 #: (in this order of :meth:`numpy.random.SeedSequence.spawn`).
 STEP_SEEDS = ("select_features", "fit_knn")
 
+#: Fault types a database may hold (:data:`gearshot.sim.FAULT_TYPES`; named here so that the
+#: estimator does not import the simulator).
+FAULT_TYPE_NAMES = ("ftff", "partial_face", "breakage", "destruction")
+
+
+def _select_fault_type(database, fault_type):
+    """The signals of one fault type (healthy ones included) of a database whose
+    ``fault_type`` coordinate names each signal's type; databases without it hold FTFFs."""
+    try:
+        types = np.asarray(database["fault_type"]).astype(str)
+    except (KeyError, TypeError):
+        types = None
+    if types is None or types.ndim == 0:
+        have = ["ftff"] if types is None else [str(types)]
+        if fault_type is not None and fault_type not in have:
+            raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                                f"(it has {have})")
+        return database
+    have = list(dict.fromkeys(types))
+    if fault_type is None:
+        if len(have) > 1:
+            raise GearshotError(f"the database holds several fault types {have}; choose "
+                                f"one with fault_type=...")
+        return database
+    if fault_type not in have:
+        raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                            f"(it has {have})")
+    return database.isel(signal=np.flatnonzero(types == fault_type))
+
 
 def _database_by_grade(database: Any,
                        n_points: int | None = None) -> dict[int, tuple[FloatArray, FloatArray]]:
@@ -228,6 +257,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
         step 1 and the validation split of step 8) gets its own child seed, so switching
         one step off leaves the others' random numbers unchanged.
+    fault_type : str, optional
+        Fault type whose database slice trains the model (``fault_type`` coordinate of
+        :func:`gearshot.sim.load_database`); ``None``: the database's only type.
 
     Attributes
     ----------
@@ -278,6 +310,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "grade_weighting": [Options(("soft", "best"))],
         "model_discrepancy": [Interval(float, 0, None)],
         "random_state": [RandomStateValue()],
+        "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
     }
 
     def __init__(self, *, features: Sequence[str] | None = None,
@@ -288,7 +321,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
                  mesh_order: int = 38, zero_shot: bool = False, upsample: int = 100,
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
-                 model_discrepancy: float = 0.08, random_state: Any = None) -> None:
+                 model_discrepancy: float = 0.08, random_state: Any = None,
+                 fault_type: str | None = None) -> None:
+        self.fault_type = fault_type
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -344,7 +379,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         validate_params(self.get_params(deep=False), self._parameter_constraints)
         inputs = self._check_fit_inputs(target_healthy, faulty_example, faulty_size,
                                         healthy_long, selection_tf)
-        by_grade = _database_by_grade(database, inputs.n_points)
+        by_grade = _database_by_grade(_select_fault_type(database, self.fault_type),
+                                      inputs.n_points)
         grades = self._grades_in(by_grade)
         nominal = self._nominal_grade_in(by_grade)
         seeds = _step_seeds(self.random_state)
