@@ -38,6 +38,8 @@ def test_version():
           "--speed", "15", "--load", "10"], ["h.h5", "does not exist"]),
         (["simulate", "--speed", "-3", "--grade", "7", "--store", "/tmp/gs-never"],
          ["speed", "-3"]),
+        (["simulate", "--fault-type", "rust", "--grade", "7", "--store", "/tmp/gs-never"],
+         ["fault_type", "rust"]),
     ],
 )
 def test_user_errors_are_one_line_without_traceback(args, words, tmp_path):

@@ -11,8 +11,12 @@ from sklearn.preprocessing import StandardScaler
 
 from estimator_data import N, synthetic_database, synthetic_sa, synthetic_target
 from gearshot import GearshotError
-from gearshot.estimator import OneFaultShotEstimator, signature_weights, steps
+from gearshot.estimator import OneFaultShotEstimator, signature_weights, steps, uncertainty
 from gearshot.transfer import resample_transfer_function
+
+# The synthetic database holds grades 3, 6 and 9; the default nominal_grade (7) is absent
+# and is an error where it is used (feature selection, no tuning).
+NOMINAL = 3
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +38,7 @@ def data(tf_pair):
 @pytest.fixture(scope="module")
 def fitted(data, tf_pair):
     db, healthy, long, faulty, y = data
-    est = OneFaultShotEstimator(random_state=0)
+    est = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL)
     return est.fit(db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
 
 
@@ -156,7 +160,7 @@ def test_predict_interval_brackets_the_prediction(fitted, data):
 
 def test_same_random_state_same_predictions_and_clone(data, tf_pair):
     db, healthy, long, faulty, y = data
-    a = OneFaultShotEstimator(random_state=7, grades=[3, 6])
+    a = OneFaultShotEstimator(random_state=7, grades=[3, 6], nominal_grade=NOMINAL)
     b = clone(a)
     assert b.get_params() == a.get_params()
     for est in (a, b):
@@ -248,7 +252,7 @@ def test_bad_input_names_the_argument(data, tf_pair, change, words):
                 sel=tf_pair[1])
     change(args)
     with pytest.raises(GearshotError) as info:
-        OneFaultShotEstimator(random_state=0, grades=[3]).fit(
+        OneFaultShotEstimator(random_state=0, grades=[3], nominal_grade=NOMINAL).fit(
             args["db"], args["healthy"], args["example"], args["size"], args["long"],
             selection_tf=args["sel"])
     message = str(info.value).lower()
@@ -281,9 +285,14 @@ def test_isotonic_tuning_ignores_a_lucky_outlier():
 
 
 # ------------------------------------------------------------------- soft grade weighting
+def test_moved_uncertainty_names_still_resolve_from_steps():
+    with pytest.warns(DeprecationWarning, match="uncertainty"):
+        assert steps.grade_weights is uncertainty.grade_weights
+
+
 def test_grade_weights_follow_a_gaussian_likelihood_of_the_example():
     residuals = np.full(99, 0.1)  # 90 % quantile 0.1 → sigma 0.05
-    w = steps.grade_weights([0.30, 0.35, 0.40, 0.90], [1, 2, 3, 4], 0.35, residuals)
+    w = uncertainty.grade_weights([0.30, 0.35, 0.40, 0.90], [1, 2, 3, 4], 0.35, residuals)
     assert list(w) == [2, 1, 3]  # largest first; grade 4 (10 sigma away) is dropped
     assert_allclose(sum(w.values()), 1.0)
     assert_allclose(w[1], w[3])
@@ -292,22 +301,22 @@ def test_grade_weights_follow_a_gaussian_likelihood_of_the_example():
 
 def test_conformal_quantile_is_the_finite_sample_rank():
     res = np.arange(1, 11) / 10  # 0.1 … 1.0
-    assert steps.conformal_quantile(res, 0.5) == 0.6  # ceil(11 * 0.5) = 6th
-    assert steps.conformal_quantile(res, 0.9) == 1.0
-    assert steps.conformal_quantile(-res, 0.5) == 0.6  # signs do not matter
+    assert uncertainty.conformal_quantile(res, 0.5) == 0.6  # ceil(11 * 0.5) = 6th
+    assert uncertainty.conformal_quantile(res, 0.9) == 1.0
+    assert uncertainty.conformal_quantile(-res, 0.5) == 0.6  # signs do not matter
 
 
 def test_mixture_interval_of_one_model_and_of_two_separated_models():
     res = np.linspace(0, 0.1, 1001)  # uniform |r| on [0, 0.1]
     pred = np.array([0.5])
-    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
+    lo, hi = uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
     assert_allclose([lo[0], hi[0]], [0.41, 0.59], atol=2e-3)
     # two equally weighted models 0.4 apart: the 90 % range reaches into both
-    lo, hi = steps.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.5, 2: 0.5},
+    lo, hi = uncertainty.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.5, 2: 0.5},
                                     {1: res, 2: res}, 0.9)
     assert lo[0] < 0.3 and hi[0] > 0.7
     # a lopsided mix sits mostly on the heavy model
-    lo, hi = steps.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.97, 2: 0.03},
+    lo, hi = uncertainty.mixture_interval({1: pred - 0.2, 2: pred + 0.2}, {1: 0.97, 2: 0.03},
                                     {1: res, 2: res}, 0.9)
     assert hi[0] < 0.4
 
@@ -315,21 +324,21 @@ def test_mixture_interval_of_one_model_and_of_two_separated_models():
 def test_mixture_interval_discrepancy_is_a_gaussian_widening():
     pred = np.array([0.5, 0.2])
     # zero simulated residuals: the interval is the Gaussian's central 90 % (±1.645 σ)
-    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: np.zeros(50)}, 0.9,
+    lo, hi = uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: np.zeros(50)}, 0.9,
                                     discrepancy=0.1, n_levels=2000)
     assert_allclose(hi - pred, 0.1645, atol=2e-3)
     assert_allclose(pred - lo, 0.1645, atol=2e-3)
     # Gaussian residuals (σ 0.06) and discrepancy (σ 0.08) add in quadrature: σ 0.1
     res = np.abs(np.random.default_rng(0).normal(0, 0.06, 200_000))
-    lo, hi = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.08,
+    lo, hi = uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.08,
                                     n_levels=2000)
     assert_allclose(hi - pred, 0.1645, atol=3e-3)
     res = np.linspace(0, 0.1, 1001)
-    narrow = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
-    wide = steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.05)
+    narrow = uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9)
+    wide = uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=0.05)
     assert np.all(wide[1] - wide[0] > narrow[1] - narrow[0] + 0.02)
     with pytest.raises(GearshotError, match="discrepancy"):
-        steps.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=-0.1)
+        uncertainty.mixture_interval({1: pred}, {1: 1.0}, {1: res}, 0.9, discrepancy=-0.1)
 
 
 def test_model_discrepancy_widens_intervals_and_zero_is_split_conformal(fitted, data,
@@ -339,7 +348,7 @@ def test_model_discrepancy_widens_intervals_and_zero_is_split_conformal(fitted, 
     pure = clone(fitted).set_params(grade_weighting="best", model_discrepancy=0.0).fit(
         *args, selection_tf=tf_pair[1])
     lo0, hi0 = pure.predict_interval(faulty)
-    q = steps.conformal_quantile(pure.model_.validation_residuals, 0.9)
+    q = uncertainty.conformal_quantile(pure.model_.validation_residuals, 0.9)
     assert_allclose(hi0, np.clip(pure.predict(faulty) + q, 0, 1))
     widened = clone(pure).set_params(model_discrepancy=0.1).fit(
         *args, selection_tf=tf_pair[1])
@@ -354,8 +363,10 @@ def test_model_discrepancy_widens_intervals_and_zero_is_split_conformal(fitted, 
 def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):
     db, healthy, long, faulty, y = data
     args = (db, healthy, faulty[20], y[20], long)
-    soft = OneFaultShotEstimator(random_state=0).fit(*args, selection_tf=tf_pair[1])
-    best = OneFaultShotEstimator(random_state=0, grade_weighting="best").fit(
+    soft = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
+        *args, selection_tf=tf_pair[1])
+    best = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL,
+                                 grade_weighting="best").fit(
         *args, selection_tf=tf_pair[1])
     assert best.grade_weights_ == {best.grade_: 1.0}
     assert soft.grade_ == best.grade_ and soft.grade_ in soft.grade_weights_

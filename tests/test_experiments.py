@@ -66,7 +66,12 @@ def test_evaluate_variants_and_summary(sim_data):
                              random_state=0)
     frame = pd.DataFrame(rows)
     assert list(frame["variant"]) == list(SIMULATED_VARIANTS)
-    assert frame["mae"].between(0, 1).all()
+    mae = frame.set_index("variant")["mae"]
+    constant = np.mean(np.abs(ds.test_size - 0.5))  # the always-0.5 predictor
+    # every variant learns something; with an identity path, the variants that do not
+    # estimate a TF are far better than chance (measured 0.13-0.15 against 0.33)
+    assert (mae < constant).all(), (mae, constant)
+    assert mae["before_da"] < 0.6 * constant and mae["rms_only"] < 0.6 * constant
     table = summarize(frame)
     assert_allclose(table.set_index("variant").loc["full", "mae_percent"],
                     100 * frame.set_index("variant").loc["full", "mae"])
@@ -134,7 +139,7 @@ def test_rig_figures_include_fig11_and_the_tuning_curve(tmp_path, sim_data):
     ds = simulated_dataset(sa, y, tf, random_state=1)
     db = ds.database.assign_coords(grade=("signal", np.where(np.arange(ds.database.sizes[
         "signal"]) % 2 == 0, 3, 6)))
-    est = OneFaultShotEstimator(random_state=0, grades=[3, 6]).fit(
+    est = OneFaultShotEstimator(random_state=0, grades=[3, 6], nominal_grade=3).fit(
         db, ds.target_healthy, ds.faulty_example, ds.faulty_size, ds.healthy_long,
         selection_tf=tf)
     train, test = est.selection_features_

@@ -255,7 +255,6 @@ def test_tf_bank_from_measured_frf_folder():
     folder = SHARED / "data" / "frf"
     if not folder.is_dir():
         pytest.skip(f"shared FRF folder not found at {folder}")
-    pytest.importorskip("gearshot.transfer.bank", reason="gearshot.transfer not merged yet")
     rig = VirtualRig(seed=2, tf_bank=folder)
     rec = rig.record(speed=15.0, load=5.0, duration=0.5)
     assert rig.reveal_path()[0] in {p.stem for p in folder.glob("*.uff")}

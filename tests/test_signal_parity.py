@@ -8,6 +8,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from gearshot import features, signal, transfer
+from gearshot.estimator import steps
 
 RTOL = 1e-8
 MESH = 38
@@ -52,14 +53,17 @@ def test_features_with_reference_centring(matlab_ref):
     train = matlab_ref["in_sa_train"].T
     healthy = matlab_ref["in_sa_healthy"].T
     test = matlab_ref["in_sa_test"].T
-    f_train = features.extract_features(train, MESH)
-    f_healthy = features.extract_features(healthy, MESH)
-    f_test = features.extract_features(test, MESH)
-    x_training = np.concatenate([f_train - f_train[:1], f_healthy - f_healthy.mean(0)]).T
+    names = features.PAPER_FEATURES
+    first_healthy = np.arange(len(train)) == 0  # the reference's training set: one healthy SA
+    x_train, _ = steps.centred_features(train, mesh_order=MESH, names=names,
+                                        healthy_mask=first_healthy)
+    x_healthy, healthy_mean = steps.centred_features(
+        healthy, mesh_order=MESH, names=names, healthy_mask=np.ones(len(healthy), bool))
+    x_test, _ = steps.centred_features(test, healthy_mean, mesh_order=MESH, names=names)
     # each feature row has its own scale: compare row by row
-    for row, ref in zip(x_training, matlab_ref["out_x_training"]):
+    for row, ref in zip(np.concatenate([x_train, x_healthy]).T, matlab_ref["out_x_training"]):
         assert_parity(row, ref)
-    for row, ref in zip((f_test - f_healthy.mean(0)).T, matlab_ref["out_x_test"]):
+    for row, ref in zip(x_test.T, matlab_ref["out_x_test"]):
         assert_parity(row, ref)
     assert_parity(np.r_[matlab_ref["in_y_train"], np.zeros(10)], matlab_ref["out_y_training"])
 
@@ -74,7 +78,9 @@ def test_subtract_healthy(matlab_ref):
 
 def test_subtract_simulated_healthy(matlab_ref):
     train = matlab_ref["in_sa_train"].T
-    assert_parity((train - train[0]).T, matlab_ref["out_sub_train"])
+    healthy_mask = np.arange(len(train)) == 0
+    assert_parity(steps.suppress_harmonics_simulated(train, healthy_mask).T,
+                  matlab_ref["out_sub_train"])
 
 
 def test_rms_normalize(matlab_ref):

@@ -1,4 +1,5 @@
 """FTFF geometry: the bridging retreat against an analytic small-cut limit."""
+import dataclasses
 import math
 
 import numpy as np
@@ -65,7 +66,7 @@ def test_section_loss_inside_cut_only():
 def test_fault_is_hashable_and_frozen():
     f = Fault.ftff(0.3)
     assert hash(f) == hash(FullToothFaceFault(size=0.3))
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         f.size = 0.5
 
 

@@ -1,4 +1,5 @@
 """GearPair: geometry, defaults and validation."""
+import dataclasses
 import math
 
 import pytest
@@ -36,7 +37,7 @@ def test_replace_validates_and_is_frozen():
     assert p.replace(face_width=0.02).face_width == 0.02
     with pytest.raises(GearshotError, match="face_width"):
         p.replace(face_width=-1.0)
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         p.module = 1.0
     assert hash(p) == hash(GearPair.paper())
 

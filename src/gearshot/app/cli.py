@@ -73,11 +73,13 @@ def demo(
     out: Path = typer.Option(Path("gearshot-demo"), "--out", help="Folder for figures, "
                              "tables and the report."),
     seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
+    draws: int = typer.Option(5, "--draws", help="Draws of the faulty example; the table "
+                              "gives the mean ± std over them."),
 ) -> None:
     """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
     from .demo import run_demo
 
-    run_demo(out, seed=seed)
+    run_demo(out, seed=seed, draws=draws)
 
 
 @app.command()
@@ -96,6 +98,8 @@ def simulate(
                                             "running Dask scheduler."),
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
                                 "--scheduler is given."),
+    fault_type: List[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
+                                         "ftff, partial_face, breakage, destruction."),
     machine: Optional[Path] = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
@@ -105,15 +109,16 @@ def simulate(
 
     if machine is not None:
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
-                          scheduler, workers)
+                          scheduler, workers, fault_type)
         return
     store = store or default_database_path()
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
-    n_blocks = len(speeds) * len(loads) * len(grade)
+    n_blocks = len(speeds) * len(loads) * len(grade) * len(fault_type)
     client = _client(scheduler, workers, needed=n_blocks > 1)
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
-                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
+                       fault_types=fault_type)
     finally:
         if client is not None:
             client.close()
@@ -121,7 +126,7 @@ def simulate(
 
 
 def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_faulty, seed,
-                      scheduler, workers):
+                      scheduler, workers, fault_types=("ftff",)):
     """``simulate --machine``: a database of the machine's monitored pair."""
     from ..machine import Machine
     from ..sim import build_database
@@ -132,11 +137,12 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
     store = store or machine_database_path(machine_file, n_healthy=n_healthy,
                                            n_faulty=n_faulty, seed=seed)
     sim_speeds = [mach.sim_speed(s) for s in speeds]
-    n_blocks = len(sim_speeds) * len(loads) * len(grades)
+    n_blocks = len(sim_speeds) * len(loads) * len(grades) * len(fault_types)
     client = _client(scheduler, workers, needed=n_blocks > 1)
     try:
         build_database(store, pair, speeds=sim_speeds, loads=loads, grades=grades,
-                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client)
+                       n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
+                       fault_types=list(fault_types))
     finally:
         if client is not None:
             client.close()

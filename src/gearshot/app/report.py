@@ -14,11 +14,19 @@ def write_report(folder, summary: dict, figures: dict) -> Path:
     if "speed" in summary:
         lines += [f"Condition: {summary['speed']:g} rps, {summary['load']:g} Nm; "
                   f"seed {summary.get('seed')}.", ""]
+    spread = summary.get("ablations_std")
+    over = f" (mean ± std over {summary['draws']} example draws)" if spread else ""
     if "mae" in summary:
-        lines += [f"**Full algorithm MAE: {summary['mae']:.1f} %**", ""]
+        pm = f" ± {summary['mae_std']:.1f}" if "mae_std" in summary else ""
+        lines += [f"**Full algorithm MAE: {summary['mae']:.1f}{pm} %**{over}", ""]
     if summary.get("ablations"):
-        lines += ["| variant | MAE [%] |", "|---|---|"]
-        lines += [f"| {k} | {v:.1f} |" for k, v in summary["ablations"].items()]
+        if spread:
+            lines += ["| variant | MAE mean [%] | std [%] |", "|---|---|---|"]
+            lines += [f"| {k} | {v:.1f} | {spread.get(k, 0.0):.1f} |"
+                      for k, v in summary["ablations"].items()]
+        else:
+            lines += ["| variant | MAE [%] |", "|---|---|"]
+            lines += [f"| {k} | {v:.1f} |" for k, v in summary["ablations"].items()]
         lines.append("")
     for key in ("grade", "rig_grade", "selected_features", "n_neighbors", "feature_errors"):
         if key in summary:

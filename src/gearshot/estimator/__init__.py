@@ -1,7 +1,17 @@
-"""The one-fault-shot estimator and its eight steps."""
+"""The one-fault-shot estimator and its eight steps.
 
-from . import steps
-from ._model import OneFaultShotEstimator
+=============================  ======================================================
+``steps``                      the paper's steps 1–8, in order, one function each
+``uncertainty``                grade weights and prediction intervals (not paper steps)
+``zero_shot``                  grade choice from healthy data alone
+``OneFaultShotEstimator``      the steps as a scikit-learn regressor
+``save_estimator`` / ``load``  persistence with version metadata
+=============================  ======================================================
+"""
+
+from .._errors import NotFittedError
+from . import steps, uncertainty
+from ._model import STEP_SEEDS, OneFaultShotEstimator
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -10,15 +20,20 @@ from .steps import (
     normalize_rms,
     propagate_simulated,
     select_features,
+    simulated_features,
     suppress_harmonics_simulated,
     suppress_harmonics_target,
     tune_grade,
 )
+from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = [
     "OneFaultShotEstimator",
+    "NotFittedError",
+    "STEP_SEEDS",
     "steps",
+    "uncertainty",
     "select_features",
     "tune_grade",
     "estimate_tf",
@@ -27,7 +42,12 @@ __all__ = [
     "suppress_harmonics_simulated",
     "suppress_harmonics_target",
     "centred_features",
+    "simulated_features",
     "fit_knn",
+    "grade_weights",
+    "prune_weights",
+    "conformal_quantile",
+    "mixture_interval",
     "healthy_signature",
     "match_grade",
     "signature_weights",

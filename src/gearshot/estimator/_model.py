@@ -1,26 +1,92 @@
-"""OneFaultShotEstimator: the paper's estimator as a scikit-learn regressor."""
+"""OneFaultShotEstimator: the paper's estimator as a scikit-learn regressor.
+
+``fit`` follows the block diagram of the paper (Fig. 12):
+
+* the target side (steps 3 and 5–7 on the target's healthy SAs),
+* feature selection (step 1, on the nominal grade),
+* the grade choice, one strategy per mode: ``tuned`` (step 2: the one grade the paper keeps),
+  ``soft`` (step 2, every grade weighted by how well it predicts the example),
+  ``nominal`` (no tuning) and ``zero_shot`` (healthy statistics, no example),
+* the grade models (steps 4–8 on each chosen grade's simulated SAs).
+
+Every part is a short method that returns what it learned; ``fit`` sets the learned
+attributes only once every part has succeeded, so a failed fit leaves the estimator as
+it was.
+"""
 
 from __future__ import annotations
 
 import numbers
-from typing import Any
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from sklearn.base import BaseEstimator, RegressorMixin
-from sklearn.utils import check_random_state
-from sklearn.utils.validation import check_is_fitted
 
-from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range, check_int
+from .._errors import GearshotError, NotFittedError
+from .._validation import as_signal_array, check_in_range
 from ..features import PAPER_FEATURES, available_features
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
+from ._params import (
+    ArrayOrObject,
+    Boolean,
+    Constraint,
+    IntegerSequence,
+    Interval,
+    NameSequence,
+    NoneValue,
+    Options,
+    RandomStateValue,
+    validate_params,
+)
+from .steps import KnnModel
+from .uncertainty import conformal_quantile, grade_weights, mixture_interval
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
-__all__ = ["OneFaultShotEstimator"]
+__all__ = ["OneFaultShotEstimator", "STEP_SEEDS"]
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+#: The steps that draw random numbers, each from its own child seed of ``random_state``
+#: (in this order of :meth:`numpy.random.SeedSequence.spawn`).
+STEP_SEEDS = ("select_features", "fit_knn")
+
+#: Fault types a database may hold (:data:`gearshot.sim.FAULT_TYPES`; named here so that the
+#: estimator does not import the simulator).
+FAULT_TYPE_NAMES = ("ftff", "partial_face", "breakage", "destruction")
 
 
-def _database_by_grade(database, n_points=None):
+def _select_fault_type(database, fault_type):
+    """The signals of one fault type (healthy ones included) of a database whose
+    ``fault_type`` coordinate names each signal's type; databases without it hold FTFFs."""
+    try:
+        types = np.asarray(database["fault_type"]).astype(str)
+    except (KeyError, TypeError):
+        types = None
+    if types is None or types.ndim == 0:
+        have = ["ftff"] if types is None else [str(types)]
+        if fault_type is not None and fault_type not in have:
+            raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                                f"(it has {have})")
+        return database
+    have = list(dict.fromkeys(types))
+    if fault_type is None:
+        if len(have) > 1:
+            raise GearshotError(f"the database holds several fault types {have}; choose "
+                                f"one with fault_type=...")
+        return database
+    if fault_type not in have:
+        raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                            f"(it has {have})")
+    return database.isel(signal=np.flatnonzero(types == fault_type))
+
+
+def _database_by_grade(database: Any,
+                       n_points: int | None = None) -> dict[int, tuple[FloatArray, FloatArray]]:
     """Split a simulated database (xarray.Dataset or mapping) into {grade: (sa, y)}."""
     try:
         sa = np.asarray(database["sa"], dtype=float)
@@ -50,6 +116,91 @@ def _database_by_grade(database, n_points=None):
     return out
 
 
+def _step_seeds(random_state: Any) -> dict[str, int]:
+    """One independent seed per random step, derived from ``random_state``.
+
+    The root entropy is ``random_state`` itself (an int), one draw from it (a RandomState
+    or Generator) or fresh OS entropy (None); :class:`numpy.random.SeedSequence` spawns
+    one child per name of :data:`STEP_SEEDS`. Switching a step off therefore does not move
+    any other step's random numbers.
+    """
+    if random_state is None:
+        root = np.random.SeedSequence()
+    elif isinstance(random_state, np.random.RandomState):
+        root = np.random.SeedSequence(int(random_state.randint(np.iinfo(np.int32).max)))
+    elif isinstance(random_state, np.random.Generator):
+        root = np.random.SeedSequence(int(random_state.integers(2**63)))
+    else:
+        root = np.random.SeedSequence(int(random_state))
+    children = root.spawn(len(STEP_SEEDS))
+    return {name: int(child.generate_state(1)[0]) for name, child in zip(STEP_SEEDS, children)}
+
+
+def _on_grid(tf: Any, n_points: int, name: str) -> ComplexArray:
+    """A TF on the n-point DFT grid from an array (grid or one-sided) or a TransferFunction."""
+    if hasattr(tf, "to_signal_grid"):
+        return np.asarray(tf.to_signal_grid(n_points), dtype=complex)
+    arr = as_signal_array(tf, name, max_ndim=1, allow_complex=True)
+    if arr.size == n_points:
+        return arr.astype(complex)
+    return np.asarray(resample_transfer_function(arr, n_points), dtype=complex)
+
+
+@dataclass(frozen=True)
+class _FitInputs:
+    """The checked arguments of :meth:`OneFaultShotEstimator.fit`."""
+
+    target_healthy: FloatArray
+    faulty_example: FloatArray | None
+    faulty_size: float | None
+    healthy_long: FloatArray | None
+    selection_tf: Any
+    n_points: int
+
+
+@dataclass(frozen=True)
+class _TargetSide:
+    """What steps 3 and 5–7 learn from the target's healthy SAs."""
+
+    transfer_function: ComplexArray | None
+    scale: float
+    scaled_healthy: FloatArray
+    references: FloatArray
+    healthy_mean: FloatArray
+    healthy_features: FloatArray
+
+
+@dataclass(frozen=True)
+class _Selection:
+    """Step 1's outcome."""
+
+    selected: tuple[str, ...]
+    errors: dict[str, float]
+    features: tuple[FloatArray, FloatArray] | None
+
+
+@dataclass(frozen=True)
+class _GradeChoice:
+    """A grade-choice strategy's outcome: the best grade and the weights that predict."""
+
+    grade: int
+    weights: dict[int, float]
+    tuning_curve: dict[str, Any] | None
+
+
+@dataclass
+class _FitContext:
+    """What the grade-choice strategies need: data, the target side and the grade models."""
+
+    by_grade: Mapping[int, tuple[FloatArray, FloatArray]]
+    grades: list[int]
+    nominal: int | None
+    target: _TargetSide
+    inputs: _FitInputs
+    example_features: Callable[[], FloatArray]
+    model_for: Callable[[int], KnnModel]
+
+
 class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     """Estimate FTFF size from SAs with one faulty example (Matania et al. 2023).
 
@@ -57,29 +208,33 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     ----------
     features : sequence of str, optional
         Candidate features (default the paper's four).
-    selection_threshold : float, default 0.10
+    selection_threshold : float > 0, default 0.10
         Keep features whose invariance error is below this (step 1).
-    grades : iterable of int, default range(1, 13)
+    grades : iterable of int in [1, 12], default range(1, 13)
         DIN grades tried by simulation tuning (step 2); those absent from the database
         are skipped.
     select_features : bool, default True
     tune_simulation : bool, default True
         When False, ``nominal_grade`` is used.
-    nominal_grade : int, default 7
-        Grade used without tuning and for feature selection.
+    nominal_grade : int in [1, 12], default 7
+        Grade used without tuning and for feature selection. It must be in the database
+        whenever it is used (``select_features=True``, or ``tune_simulation=False``
+        without ``zero_shot``).
     rms_normalization : bool, default True
     transfer_function : {"estimate", "none"} or array_like of complex, default "estimate"
         Estimate the TF from ``healthy_long`` (step 3), use none, or use a given TF
-        (on the SA grid, or one-sided to be resampled).
-    n_neighbors : iterable of int, default range(1, 101)
-    validation_fraction : float, default 0.3
-    mesh_order : int, default 38
+        (on the SA grid, one-sided to be resampled, or an object with
+        ``to_signal_grid(n)``).
+    n_neighbors : iterable of int >= 1, default range(1, 101)
+        Candidate K of step 8.
+    validation_fraction : float in (0, 1), default 0.3
+    mesh_order : int >= 1, default 38
     zero_shot : bool, default False
         No faulty example: choose the grade by matching healthy-signal statistics
         (:func:`~gearshot.estimator.match_grade`). With soft weighting the grades are
         weighted by that match, or uniformly when no grade's simulation resembles the
         target's healthy data (:func:`~gearshot.estimator.signature_weights`).
-    upsample : int, default 100
+    upsample : int >= 1, default 100
         Delay resolution (1/upsample sample) of target harmonic suppression.
     tuning_smoothing : {"isotonic", "none"}, default "isotonic"
         Fit the example's predicted size over the grades by a monotone curve before
@@ -89,38 +244,86 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         every grade, weighted by how well each predicts the faulty example (a Gaussian
         likelihood whose width is half the 90 % validation-residual quantile of the best
         grade): one example cannot pin the grade down, and averaging over the grades it
-        leaves plausible is steadier (see :func:`steps.grade_weights`).
+        leaves plausible is steadier (see :func:`~gearshot.estimator.grade_weights`).
     model_discrepancy : float >= 0, default 0.08
         Standard deviation (fault-size units) of the simulation-to-reality error that
         :meth:`predict_interval` adds to the simulated validation residuals. Conformal
         residuals come from the simulated domain and cannot show the bias that one
         example leaves after tuning; 0.08 is of the order of the method's typical
         error after domain adaptation (an MAE of about 6 %, as in the paper). 0 gives
-        pure split-conformal intervals.
-    random_state : int, numpy Generator/RandomState or None
+        pure split-conformal intervals. There is no upper bound (intervals are clipped
+        to [0, 1]).
+    random_state : int >= 0, numpy RandomState or Generator, or None
+        Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
+        step 1 and the validation split of step 8) gets its own child seed, so switching
+        one step off leaves the others' random numbers unchanged.
+    fault_type : str, optional
+        Fault type whose database slice trains the model (``fault_type`` coordinate of
+        :func:`gearshot.sim.load_database`); ``None``: the database's only type.
 
     Attributes
     ----------
+    candidate_features_ : tuple of str
     selected_features_ : tuple of str
+    selected_columns_ : list of int
+        Columns of the selected features among the candidates.
     feature_errors_ : dict
     selection_features_ : (train, test) tuple of ndarray or None
         Step 1's paired candidate features through the estimated and the held-out TF
         (the paper's Fig. 11; see :func:`gearshot.plotting.plot_feature_invariance`).
+    grade_strategy_ : {"tuned", "soft", "nominal", "zero_shot"}
+        The grade-choice strategy that ran.
     grade_ : int
         The best grade (the paper's choice).
     grade_weights_ : dict grade → weight
         Weights of the grade models that predict (``{grade_: 1.0}`` unless soft).
+    grade_models_ : dict grade → KnnModel
+    model_ : KnnModel
+        The best grade's model.
     tuning_curve_ : dict of arrays (grade, prediction, abs_error) or None
     transfer_function_ : ndarray of complex or None
+    target_scale_ : float
+    references_ : ndarray
+    target_healthy_mean_, target_healthy_features_ : ndarray
     n_neighbors_ : int
+    n_points_ : int
+    faulty_size_ : float or None
+    step_seeds_ : dict step → int
+        The seeds the random steps used.
     """
 
-    def __init__(self, *, features=None, selection_threshold=0.10, grades=range(1, 13),
-                 select_features=True, tune_simulation=True, nominal_grade=7,
-                 rms_normalization=True, transfer_function="estimate",
-                 n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
-                 zero_shot=False, upsample=100, tuning_smoothing="isotonic",
-                 grade_weighting="soft", model_discrepancy=0.08, random_state=None):
+    _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
+        "features": [NoneValue(), NameSequence(available_features)],
+        "selection_threshold": [Interval(float, 0, None, closed="neither")],
+        "grades": [IntegerSequence(1, 12)],
+        "select_features": [Boolean()],
+        "tune_simulation": [Boolean()],
+        "nominal_grade": [Interval(int, 1, 12)],
+        "rms_normalization": [Boolean()],
+        "transfer_function": [Options(("estimate", "none")), ArrayOrObject("to_signal_grid")],
+        "n_neighbors": [IntegerSequence(1, None)],
+        "validation_fraction": [Interval(float, 0, 1, closed="neither")],
+        "mesh_order": [Interval(int, 1, None)],
+        "zero_shot": [Boolean()],
+        "upsample": [Interval(int, 1, None)],
+        "tuning_smoothing": [Options(("isotonic", "none"))],
+        "grade_weighting": [Options(("soft", "best"))],
+        "model_discrepancy": [Interval(float, 0, None)],
+        "random_state": [RandomStateValue()],
+        "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
+    }
+
+    def __init__(self, *, features: Sequence[str] | None = None,
+                 selection_threshold: float = 0.10, grades: Iterable[int] = range(1, 13),
+                 select_features: bool = True, tune_simulation: bool = True,
+                 nominal_grade: int = 7, rms_normalization: bool = True,
+                 transfer_function: str | ArrayLike | Any = "estimate",
+                 n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
+                 mesh_order: int = 38, zero_shot: bool = False, upsample: int = 100,
+                 tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
+                 model_discrepancy: float = 0.08, random_state: Any = None,
+                 fault_type: str | None = None) -> None:
+        self.fault_type = fault_type
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -139,78 +342,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.model_discrepancy = model_discrepancy
         self.random_state = random_state
 
-    # ------------------------------------------------------------------ validation
-    def _check_params(self):
-        names = PAPER_FEATURES if self.features is None else tuple(self.features)
-        unknown = [n for n in names if n not in available_features()]
-        if not names or unknown:
-            raise GearshotError(f"features holds unknown name(s) {unknown}; valid names are "
-                                f"{list(available_features())}")
-        check_in_range(self.selection_threshold, "selection_threshold", 0, np.inf,
-                       low_inclusive=False)
-        check_in_range(self.validation_fraction, "validation_fraction", 0, 1,
-                       low_inclusive=False, high_inclusive=False)
-        check_int(self.mesh_order, "mesh_order", minimum=1)
-        check_int(self.upsample, "upsample", minimum=1)
-        if self.grade_weighting not in ("soft", "best"):
-            raise GearshotError(f"grade_weighting must be 'soft' or 'best'; got "
-                                f"{self.grade_weighting!r}")
-        check_in_range(self.model_discrepancy, "model_discrepancy", 0, 1)
-        grades = [check_int(g, "grades", minimum=1, maximum=12) for g in self.grades]
-        if not grades:
-            raise GearshotError("grades must list at least one DIN grade")
-        tf = self.transfer_function
-        if isinstance(tf, str) and tf not in ("estimate", "none"):
-            raise GearshotError(f"transfer_function must be 'estimate', 'none' or an array; "
-                                f"got {tf!r}")
-        return names, grades
-
-    def _target_tf(self, healthy_long, n_points):
-        tf = self.transfer_function
-        if isinstance(tf, str):
-            if tf == "none":
-                return None
-            if healthy_long is None:
-                raise GearshotError("healthy_long is required with "
-                                    "transfer_function='estimate'")
-            return steps.estimate_tf(healthy_long, n_points)
-        return _on_grid(tf, n_points, "transfer_function")
-
-    # ------------------------------------------------------------------ the simulated side
-    def _simulated_features(self, sa, y, names):
-        """Steps 4–7 on one grade's simulated SAs; returns centred features."""
-        healthy = y == 0
-        sim = steps.propagate_simulated(sa, self.transfer_function_)
-        if self.rms_normalization:
-            sim = steps.normalize_rms(sim, sim[healthy])
-        sim = steps.suppress_harmonics_simulated(sim, healthy)
-        feats, _ = steps.centred_features(sim, mesh_order=self.mesh_order, names=names,
-                                          healthy_mask=healthy)
-        return feats
-
-    def _target_features(self, sa):
-        """Steps 5–7 on target SAs, with the fitted scale, references and healthy mean."""
-        sa = np.atleast_2d(sa)
-        if self.rms_normalization:
-            sa = sa / self.target_scale_
-        sub = steps.suppress_harmonics_target(sa, self.references_, upsample=self.upsample)
-        feats, _ = steps.centred_features(sub, self.target_healthy_mean_,
-                                          mesh_order=self.mesh_order,
-                                          names=self.candidate_features_)
-        return feats
-
-    def _model_for_grade(self, grade, cols, seed):
-        sa, y = self.database_[grade]
-        X_sim = self._simulated_features(sa, y, self.candidate_features_)[:, cols]
-        X = np.vstack([X_sim, self.target_healthy_features_[:, cols]])
-        labels = np.concatenate([y, np.zeros(len(self.target_healthy_features_))])
-        return steps.fit_knn(X, labels, n_neighbors=self.n_neighbors,
-                             validation_fraction=self.validation_fraction,
-                             random_state=seed)
-
-    # ------------------------------------------------------------------ fit / predict
-    def fit(self, database, target_healthy, faulty_example=None, faulty_size=None,
-            healthy_long=None, *, selection_tf=None):
+    # ------------------------------------------------------------------ fit
+    def fit(self, database: Any, target_healthy: ArrayLike,
+            faulty_example: ArrayLike | None = None, faulty_size: float | None = None,
+            healthy_long: ArrayLike | None = None, *, selection_tf: Any = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters
@@ -234,125 +369,272 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         Returns
         -------
         self
+
+        Raises
+        ------
+        GearshotError
+            On a bad parameter or argument (the message names it and quotes the value).
+            The estimator is left as it was before the call.
         """
-        names, grades = self._check_params()
-        rng = check_random_state(self.random_state)
-        target_healthy = as_signal_array(target_healthy, "target_healthy", min_ndim=2,
-                                         max_ndim=2, min_length=16)
-        n_points = target_healthy.shape[1]
-        if target_healthy.shape[0] < 2:
-            raise GearshotError(f"target_healthy holds {target_healthy.shape[0]} SA(s); at "
+        validate_params(self.get_params(deep=False), self._parameter_constraints)
+        inputs = self._check_fit_inputs(target_healthy, faulty_example, faulty_size,
+                                        healthy_long, selection_tf)
+        by_grade = _database_by_grade(_select_fault_type(database, self.fault_type),
+                                      inputs.n_points)
+        grades = self._grades_in(by_grade)
+        nominal = self._nominal_grade_in(by_grade)
+        seeds = _step_seeds(self.random_state)
+        names = PAPER_FEATURES if self.features is None else tuple(self.features)
+
+        # the block diagram: target side, feature selection, grade choice, grade models
+        target = self._fit_target_side(inputs, names)
+        selection = self._select_features(by_grade, nominal, inputs, names,
+                                          seeds["select_features"])
+        cols = [names.index(n) for n in selection.selected]
+        ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
+                                seeds["fit_knn"])
+        strategy = self._grade_strategy(grades)
+        choose = {"tuned": self._grade_tuned, "soft": self._grade_soft,
+                  "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot}[strategy]
+        choice = choose(ctx)
+        models = {g: ctx.model_for(g) for g in choice.weights}
+        best = ctx.model_for(choice.grade)
+
+        learned = dict(
+            n_points_=inputs.n_points, transfer_function_=target.transfer_function,
+            target_scale_=target.scale, references_=target.references,
+            candidate_features_=names, target_healthy_mean_=target.healthy_mean,
+            target_healthy_features_=target.healthy_features,
+            selected_features_=selection.selected, feature_errors_=selection.errors,
+            selection_features_=selection.features, selected_columns_=cols,
+            grade_strategy_=strategy, grade_=choice.grade, grade_weights_=choice.weights,
+            grade_models_=models, model_=best, tuning_curve_=choice.tuning_curve,
+            n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
+            step_seeds_=seeds)
+        for name, value in learned.items():
+            setattr(self, name, value)
+        return self
+
+    # ------------------------------------------------------------------ fit: arguments
+    def _check_fit_inputs(self, target_healthy: ArrayLike, faulty_example: ArrayLike | None,
+                          faulty_size: float | None, healthy_long: ArrayLike | None,
+                          selection_tf: Any) -> _FitInputs:
+        """Check ``fit``'s arguments against each other and the parameters."""
+        healthy = as_signal_array(target_healthy, "target_healthy", min_ndim=2, max_ndim=2,
+                                  min_length=16)
+        n_points = healthy.shape[1]
+        if healthy.shape[0] < 2:
+            raise GearshotError(f"target_healthy holds {healthy.shape[0]} SA(s); at "
                                 f"least 2 are needed (5 or more recommended)")
+        example, size = None, None
         if not self.zero_shot:
             if faulty_example is None or faulty_size is None:
                 raise GearshotError("faulty_example and faulty_size are required unless "
                                     "zero_shot=True")
-            faulty_example = as_signal_array(faulty_example, "faulty_example", max_ndim=2)
-            faulty_example = faulty_example.reshape(-1)
-            if faulty_example.size != n_points:
-                raise GearshotError(f"faulty_example has {faulty_example.size} points but "
+            example = as_signal_array(faulty_example, "faulty_example",
+                                      max_ndim=2).reshape(-1)
+            if example.size != n_points:
+                raise GearshotError(f"faulty_example has {example.size} points but "
                                     f"target_healthy SAs have {n_points}")
             if (isinstance(faulty_size, bool) or not isinstance(faulty_size, numbers.Real)
                     or not 0 < float(faulty_size) <= 1):
                 raise GearshotError(f"faulty_size must lie in (0, 1]; got {faulty_size!r}")
-            faulty_size = float(faulty_size)
-        if healthy_long is not None:
-            healthy_long = as_signal_array(healthy_long, "healthy_long", max_ndim=1)
-        self.database_ = _database_by_grade(database, n_points)
-        grades = [g for g in grades if g in self.database_]
-        if not grades:
-            raise GearshotError(f"none of grades={list(self.grades)!r} is in the database "
-                                f"(it has {sorted(self.database_)})")
-        nominal = self.nominal_grade if self.nominal_grade in self.database_ else grades[0]
-        self.n_points_ = n_points
-        self.transfer_function_ = self._target_tf(healthy_long, n_points)
-
-        # target side (steps 5–7), independent of the grade
-        self.target_scale_ = mean_rms(target_healthy)
-        if self.rms_normalization and self.target_scale_ <= 0:
-            raise GearshotError("target_healthy has zero RMS")
-        scaled = target_healthy / self.target_scale_ if self.rms_normalization \
-            else target_healthy
-        train_h, self.references_ = steps.split_target_healthy(scaled)
-        sub_h = steps.suppress_harmonics_target(train_h, self.references_,
-                                                upsample=self.upsample)
-        self.candidate_features_ = names
-        feats_h, self.target_healthy_mean_ = steps.centred_features(
-            sub_h, mesh_order=self.mesh_order, names=names,
-            healthy_mask=np.ones(len(sub_h), bool))
-        self.target_healthy_features_ = feats_h
-
-        # step 1: feature selection on the nominal grade
+            size = float(faulty_size)
+        long = None if healthy_long is None else as_signal_array(
+            healthy_long, "healthy_long", max_ndim=1)
+        if isinstance(self.transfer_function, str) and self.transfer_function == "estimate" \
+                and long is None:
+            raise GearshotError("healthy_long is required with transfer_function='estimate'")
+        sel_tf = None
         if self.select_features:
             if selection_tf is None:
                 raise GearshotError("selection_tf is required with select_features=True "
                                     "(the held-out TF of step 1)")
             sel_tf = _on_grid(selection_tf, n_points, "selection_tf")
-            sa_n, y_n = self.database_[nominal]
-            selected, errors, self.selection_features_ = steps.select_features(
-                sa_n, y_n, sel_tf, mesh_order=self.mesh_order, names=names,
-                threshold=self.selection_threshold, random_state=rng, return_features=True)
-        else:
-            selected, errors, self.selection_features_ = names, {}, None
-        self.selected_features_ = tuple(selected)
-        self.feature_errors_ = errors
-        cols = [names.index(n) for n in self.selected_features_]
-        self.selected_columns_ = cols
+        return _FitInputs(healthy, example, size, long, sel_tf, n_points)
 
-        # step 2: simulation tuning (or zero-shot grade matching, or the nominal grade)
-        seed = int(rng.randint(np.iinfo(np.int32).max))
-        self.tuning_curve_ = None
-        self.grade_weights_ = None
+    def _grades_in(self, by_grade: Mapping[int, Any]) -> list[int]:
+        """The tried grades that the database holds (in the order of ``grades``)."""
+        grades = [int(g) for g in self.grades if int(g) in by_grade]
+        if not grades:
+            raise GearshotError(f"none of grades={list(self.grades)!r} is in the database "
+                                f"(it has {sorted(by_grade)})")
+        return grades
+
+    def _nominal_grade_in(self, by_grade: Mapping[int, Any]) -> int | None:
+        """``nominal_grade`` when it is used (feature selection, no tuning), else None."""
+        used_by = [what for what, used in (
+            ("select_features=True", self.select_features),
+            ("tune_simulation=False", not self.tune_simulation and not self.zero_shot))
+            if used]
+        if not used_by:
+            return None
+        if int(self.nominal_grade) not in by_grade:
+            raise GearshotError(
+                f"nominal_grade={self.nominal_grade!r} is not in the database (it has grades "
+                f"{sorted(by_grade)}); it is needed with {' and '.join(used_by)}")
+        return int(self.nominal_grade)
+
+    # ------------------------------------------------------------------ fit: target side
+    def _fit_target_side(self, inputs: _FitInputs, names: tuple[str, ...]) -> _TargetSide:
+        """Steps 3 and 5–7 on the target: TF, scale, references, healthy features."""
+        tf = self._target_tf(inputs.healthy_long, inputs.n_points)
+        scale = mean_rms(inputs.target_healthy)
+        if self.rms_normalization and scale <= 0:
+            raise GearshotError("target_healthy has zero RMS")
+        scaled = inputs.target_healthy / scale if self.rms_normalization \
+            else inputs.target_healthy
+        train_h, references = steps.split_target_healthy(scaled)
+        sub_h = steps.suppress_harmonics_target(train_h, references, upsample=self.upsample)
+        feats_h, mean_h = steps.centred_features(sub_h, mesh_order=self.mesh_order,
+                                                 names=names,
+                                                 healthy_mask=np.ones(len(sub_h), bool))
+        return _TargetSide(tf, scale, scaled, references, mean_h, feats_h)
+
+    def _target_tf(self, healthy_long: FloatArray | None,
+                   n_points: int) -> ComplexArray | None:
+        """Step 3, or the given TF on the SA grid, or None."""
+        tf = self.transfer_function
+        if isinstance(tf, str):
+            if tf == "none" or healthy_long is None:  # checked: "estimate" has it
+                return None
+            return steps.estimate_tf(healthy_long, n_points)
+        return _on_grid(tf, n_points, "transfer_function")
+
+    # ------------------------------------------------------------------ fit: step 1
+    def _select_features(self, by_grade: Mapping[int, tuple[FloatArray, FloatArray]],
+                         nominal: int | None, inputs: _FitInputs, names: tuple[str, ...],
+                         seed: int) -> _Selection:
+        """Step 1 on the nominal grade's simulated SAs (or every candidate when off)."""
+        if not self.select_features or nominal is None:
+            return _Selection(names, {}, None)
+        sa, y = by_grade[nominal]
+        selected, errors, features = steps.select_features(
+            sa, y, inputs.selection_tf, mesh_order=self.mesh_order, names=names,
+            threshold=self.selection_threshold, random_state=seed, return_features=True)
+        return _Selection(tuple(selected), errors, features)
+
+    # ------------------------------------------------------------------ fit: grade models
+    def _fit_context(self, by_grade: Mapping[int, tuple[FloatArray, FloatArray]],
+                     grades: list[int], nominal: int | None, target: _TargetSide,
+                     inputs: _FitInputs, names: tuple[str, ...], cols: list[int],
+                     seed: int) -> _FitContext:
+        """Bundle what the strategies need; grade models are fitted on first use and kept."""
+        models: dict[int, KnnModel] = {}
+
+        def model_for(grade: int) -> KnnModel:
+            if grade not in models:
+                models[grade] = self._fit_grade_model(by_grade[grade], target, names, cols,
+                                                      seed)
+            return models[grade]
+
+        def example_features() -> FloatArray:
+            feats = self._target_features(inputs.faulty_example, target.scale,
+                                          target.references, target.healthy_mean, names)
+            return feats[:, cols]
+
+        return _FitContext(by_grade, grades, nominal, target, inputs, example_features,
+                           model_for)
+
+    def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
+                         names: tuple[str, ...], cols: list[int], seed: int) -> KnnModel:
+        """Steps 4–8 for one grade: its simulated features with the target healthy, KNN."""
+        sa, y = grade_data
+        X_sim = steps.simulated_features(sa, y == 0, target.transfer_function,
+                                         mesh_order=self.mesh_order, names=names,
+                                         rms_normalization=self.rms_normalization)
+        X = np.vstack([X_sim[:, cols], target.healthy_features[:, cols]])
+        labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
+        return steps.fit_knn(X, labels, n_neighbors=self.n_neighbors,
+                             validation_fraction=self.validation_fraction, random_state=seed)
+
+    # ------------------------------------------------------------------ fit: grade choice
+    def _grade_strategy(self, grades: Sequence[int]) -> str:
+        """Which grade-choice strategy the parameters ask for."""
         if self.zero_shot:
-            target_sig = healthy_signature(scaled, self.mesh_order)
-            sims = {g: healthy_signature(
-                steps.propagate_simulated(sa[y == 0], self.transfer_function_),
-                self.mesh_order) for g, (sa, y) in self.database_.items() if g in grades}
-            self.grade_, self.tuning_curve_ = match_grade(target_sig, sims)
-            self.model_ = self._model_for_grade(self.grade_, cols, seed)
-            if self.grade_weighting == "soft":
-                weights, consistent = signature_weights(target_sig, sims)
-                self.tuning_curve_["consistent"] = consistent
-                self.grade_weights_ = weights
-                self.grade_models_ = {g: self.model_ if g == self.grade_ else
-                                      self._model_for_grade(g, cols, seed) for g in weights}
-        elif self.tune_simulation and len(grades) > 1:
-            x_example = self._target_features(faulty_example)[:, cols]
-            models = {}
+            return "zero_shot"
+        if not self.tune_simulation or len(grades) == 1:
+            return "nominal"
+        return "soft" if self.grade_weighting == "soft" else "tuned"
 
-            def predict_example(g):
-                models[g] = self._model_for_grade(g, cols, seed)
-                return models[g].predict(x_example)[0]
+    def _grade_tuned(self, ctx: _FitContext) -> _GradeChoice:
+        """Step 2 (the paper): the one grade whose model predicts the example best."""
+        x_example = ctx.example_features()
+        assert ctx.inputs.faulty_size is not None
+        grade, curve = steps.tune_grade(lambda g: float(ctx.model_for(g).predict(x_example)[0]),
+                                        ctx.grades, ctx.inputs.faulty_size,
+                                        smoothing=self.tuning_smoothing)
+        return _GradeChoice(grade, {grade: 1.0}, curve)
 
-            self.grade_, self.tuning_curve_ = steps.tune_grade(
-                predict_example, grades, faulty_size, smoothing=self.tuning_smoothing)
-            self.model_ = models[self.grade_]
-            if self.grade_weighting == "soft":
-                self.grade_weights_ = steps.grade_weights(
-                    self.tuning_curve_["prediction"], grades, faulty_size,
-                    self.model_.validation_residuals)
-                self.grade_models_ = {g: models[g] for g in self.grade_weights_}
-        else:
-            self.grade_ = nominal if not self.tune_simulation else grades[0]
-            self.model_ = self._model_for_grade(self.grade_, cols, seed)
-        if self.grade_weights_ is None:
-            self.grade_weights_ = {int(self.grade_): 1.0}
-            self.grade_models_ = {int(self.grade_): self.model_}
-        self.n_neighbors_ = self.model_.n_neighbors
-        self.faulty_size_ = faulty_size
-        del self.database_  # do not keep (or pickle) the whole database
-        return self
+    def _grade_soft(self, ctx: _FitContext) -> _GradeChoice:
+        """Step 2, soft: every grade weighted by the likelihood of the example's size."""
+        tuned = self._grade_tuned(ctx)
+        assert tuned.tuning_curve is not None and ctx.inputs.faulty_size is not None
+        weights = grade_weights(tuned.tuning_curve["prediction"], ctx.grades,
+                                ctx.inputs.faulty_size,
+                                ctx.model_for(tuned.grade).validation_residuals)
+        return _GradeChoice(tuned.grade, weights, tuned.tuning_curve)
 
-    def features_of(self, sa):
-        """Selected, centred target features of SAs (what the KNN sees, before scaling)."""
-        check_is_fitted(self, "model_")
-        sa = as_signal_array(sa, "sa", max_ndim=2)
-        if sa.shape[-1] != self.n_points_:
-            raise GearshotError(f"sa has {sa.shape[-1]} points per cycle; the estimator was "
+    def _grade_nominal(self, ctx: _FitContext) -> _GradeChoice:
+        """No tuning: ``nominal_grade`` (or the only grade tried)."""
+        grade = ctx.grades[0] if self.tune_simulation else ctx.nominal
+        assert grade is not None
+        return _GradeChoice(int(grade), {int(grade): 1.0}, None)
+
+    def _grade_zero_shot(self, ctx: _FitContext) -> _GradeChoice:
+        """No example: match healthy-signal statistics of target and simulation."""
+        target_sig = healthy_signature(ctx.target.scaled_healthy, self.mesh_order)
+        sims = {g: healthy_signature(
+            steps.propagate_simulated(sa[y == 0], ctx.target.transfer_function),
+            self.mesh_order) for g, (sa, y) in ctx.by_grade.items() if g in ctx.grades}
+        grade, curve = match_grade(target_sig, sims)
+        tuning_curve: dict[str, Any] = dict(curve)
+        weights = {grade: 1.0}
+        if self.grade_weighting == "soft":
+            weights, tuning_curve["consistent"] = signature_weights(target_sig, sims)
+        return _GradeChoice(grade, weights, tuning_curve)
+
+    # ------------------------------------------------------------------ predict
+    def __sklearn_is_fitted__(self) -> bool:
+        return hasattr(self, "model_")
+
+    def _check_fitted(self, method: str) -> None:
+        if not self.__sklearn_is_fitted__():
+            raise NotFittedError(f"This {type(self).__name__} is not fitted yet; call fit "
+                                 f"before {method}")
+
+    def _target_features(self, sa: ArrayLike | None, scale: float, references: FloatArray,
+                         healthy_mean: FloatArray, names: tuple[str, ...]) -> FloatArray:
+        """Steps 5–7 on target SAs with the target side's scale, references and mean."""
+        x = np.atleast_2d(np.asarray(sa, dtype=float))
+        if self.rms_normalization:
+            x = x / scale
+        sub = steps.suppress_harmonics_target(x, references, upsample=self.upsample)
+        feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=self.mesh_order,
+                                          names=names)
+        return feats
+
+    def features_of(self, sa: ArrayLike) -> FloatArray:
+        """Selected, centred target features of SAs (what the KNN sees, before scaling).
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+
+        Returns
+        -------
+        ndarray (n_signals, n_selected_features)
+        """
+        self._check_fitted("features_of")
+        arr = as_signal_array(sa, "sa", max_ndim=2)
+        if arr.shape[-1] != self.n_points_:
+            raise GearshotError(f"sa has {arr.shape[-1]} points per cycle; the estimator was "
                                 f"fitted on {self.n_points_}")
-        return self._target_features(sa)[:, self.selected_columns_]
+        feats = self._target_features(arr, self.target_scale_, self.references_,
+                                      self.target_healthy_mean_, self.candidate_features_)
+        return feats[:, self.selected_columns_]
 
-    def predict(self, sa):
+    def predict(self, sa: ArrayLike) -> FloatArray:
         """Fault sizes of target SAs.
 
         Parameters
@@ -363,64 +645,65 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         -------
         ndarray (n_signals,)
         """
+        self._check_fitted("predict")
         X = self.features_of(sa)
-        return sum(w * self.grade_models_[g].predict(X) for g, w in self.grade_weights_.items())
+        return sum((w * self.grade_models_[g].predict(X)
+                    for g, w in self.grade_weights_.items()), np.zeros(len(X)))
 
-    def predict_interval(self, sa, coverage=0.9):
+    def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
+                         ) -> tuple[FloatArray, FloatArray]:
         """Prediction intervals: split-conformal residuals widened by the model discrepancy.
 
         Each grade model says ``y = ŷ_g ± r + δ``: ``r`` from its validation residuals
         (split conformal), ``δ ~ N(0, model_discrepancy²)`` the simulation-to-reality
         error the validation split cannot show. With soft grade weighting the interval
         is the central ``coverage`` range of the weighted mixture over the grade models
-        (:func:`steps.mixture_interval`); with one model and ``model_discrepancy=0`` it
-        is the plain split-conformal interval.
+        (:func:`~gearshot.estimator.mixture_interval`); with one model and
+        ``model_discrepancy=0`` it is the plain split-conformal interval.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        coverage : float in (0, 1), default 0.9
 
         Returns
         -------
         low, high : ndarray (n_signals,)
             Clipped to [0, 1].
         """
+        self._check_fitted("predict_interval")
         coverage = check_in_range(coverage, "coverage", 0, 1, low_inclusive=False,
                                   high_inclusive=False)
         X = self.features_of(sa)
         discrepancy = float(self.model_discrepancy)
         if len(self.grade_weights_) == 1 and discrepancy == 0:
             pred = self.model_.predict(X)
-            q = steps.conformal_quantile(self.model_.validation_residuals, coverage)
+            q = conformal_quantile(self.model_.validation_residuals, coverage)
             return np.clip(pred - q, 0, 1), np.clip(pred + q, 0, 1)
         preds = {g: self.grade_models_[g].predict(X) for g in self.grade_weights_}
-        low, high = steps.mixture_interval(
+        low, high = mixture_interval(
             preds, self.grade_weights_,
             {g: self.grade_models_[g].validation_residuals for g in self.grade_weights_},
             coverage, discrepancy=discrepancy)
         return np.clip(low, 0, 1), np.clip(high, 0, 1)
 
-    def score(self, X, y, sample_weight=None):
-        """Negative mean absolute error (higher is better)."""
+    def score(self, X: ArrayLike, y: ArrayLike,
+              sample_weight: ArrayLike | None = None) -> float:
+        """Negative mean absolute error (higher is better) on SAs ``X`` of sizes ``y``."""
         pred = self.predict(X)
-        return -float(np.average(np.abs(pred - np.asarray(y, float)), weights=sample_weight))
+        weights = None if sample_weight is None else np.asarray(sample_weight, float)
+        return -float(np.average(np.abs(pred - np.asarray(y, float)), weights=weights))
 
     # ------------------------------------------------------------------ persistence
-    def save(self, path):
+    def save(self, path: str | Any) -> None:
         """Save the fitted estimator (joblib) with version metadata, atomically."""
         from .persistence import save_estimator
 
         save_estimator(self, path)
 
     @classmethod
-    def load(cls, path):
+    def load(cls, path: str | Any) -> OneFaultShotEstimator:
         """Load an estimator saved by :meth:`save`."""
         from .persistence import load_estimator
 
         return load_estimator(path)
-
-
-def _on_grid(tf: Any, n_points: int, name: str):
-    """A TF on the n-point DFT grid from an array (grid or one-sided) or a TransferFunction."""
-    if hasattr(tf, "to_signal_grid"):
-        return np.asarray(tf.to_signal_grid(n_points))
-    arr = as_signal_array(tf, name, max_ndim=1, allow_complex=True)
-    if arr.size == n_points:
-        return arr.astype(complex)
-    return resample_transfer_function(arr, n_points)

@@ -6,23 +6,30 @@ import os
 import tempfile
 import warnings
 from pathlib import Path
+from typing import Any
 
 import joblib
 import sklearn
 
 from .. import __version__
-from .._errors import GearshotError
+from .._errors import GearshotError, NotFittedError
 
 __all__ = ["save_estimator", "load_estimator"]
 
 _FORMAT = "gearshot-estimator/1"
 
 
-def save_estimator(estimator, path):
-    """Write ``estimator`` to ``path`` atomically (temporary file, then rename)."""
-    from sklearn.utils.validation import check_is_fitted
+def save_estimator(estimator: Any, path: str | os.PathLike[str]) -> None:
+    """Write the fitted ``estimator`` to ``path`` atomically (temporary file, then rename).
 
-    check_is_fitted(estimator, "model_")
+    Raises
+    ------
+    NotFittedError
+        When ``estimator`` has not been fitted.
+    """
+    if not hasattr(estimator, "model_"):
+        raise NotFittedError(f"estimator {type(estimator).__name__} is not fitted; fit it "
+                             f"before saving")
     path = Path(path)
     payload = {"format": _FORMAT, "gearshot_version": __version__,
                "sklearn_version": sklearn.__version__, "estimator": estimator}
@@ -37,7 +44,7 @@ def save_estimator(estimator, path):
         raise
 
 
-def load_estimator(path):
+def load_estimator(path: str | os.PathLike[str]) -> Any:
     """Read an estimator written by :func:`save_estimator`; warn on version differences."""
     path = Path(path)
     if not path.is_file():

@@ -16,15 +16,19 @@ grade models, not a guess driven by that foreign content.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..signal import difference_signal, harmonic_signal
-from .steps import prune_weights
+from .uncertainty import prune_weights
 
 __all__ = ["healthy_signature", "match_grade", "signature_weights"]
 
 
-def healthy_signature(sa, mesh_order, *, n_sidebands=2):
+def healthy_signature(sa: ArrayLike, mesh_order: int, *,
+                      n_sidebands: int = 2) -> NDArray[np.float64]:
     """``log(RMS(diff) / RMS(harmonic))`` of each SA (scale-free)."""
     diff = difference_signal(sa, mesh_order, n_sidebands=n_sidebands)
     harm = harmonic_signal(sa, mesh_order, n_sidebands=n_sidebands)
@@ -33,7 +37,9 @@ def healthy_signature(sa, mesh_order, *, n_sidebands=2):
     return np.log(np.maximum(d, 1e-300) / np.maximum(h, 1e-300))
 
 
-def match_grade(target_signature, simulated_signatures):
+def match_grade(target_signature: ArrayLike,
+                simulated_signatures: Mapping[int, ArrayLike],
+                ) -> tuple[int, dict[str, NDArray[np.float64]]]:
     """Grade whose simulated signature median is nearest the target's.
 
     Parameters
@@ -47,16 +53,19 @@ def match_grade(target_signature, simulated_signatures):
     curve : dict with arrays ``grade``, ``prediction`` (simulated median signature),
         ``abs_error`` (distance to the target median)
     """
-    target = float(np.median(target_signature))
+    target = float(np.median(np.asarray(target_signature, float)))
     grades = np.array(sorted(simulated_signatures))
-    medians = np.array([float(np.median(simulated_signatures[g])) for g in grades])
+    sims = {g: np.asarray(simulated_signatures[g], float) for g in grades}
+    medians = np.array([float(np.median(sims[g])) for g in grades])
     dist = np.abs(medians - target)
     return int(grades[int(np.argmin(dist))]), {"grade": grades, "prediction": medians,
                                                 "abs_error": dist}
 
 
-def signature_weights(target_signature, simulated_signatures, *, consistency=2.0,
-                      min_weight=1e-3):
+def signature_weights(target_signature: ArrayLike,
+                      simulated_signatures: Mapping[int, ArrayLike], *,
+                      consistency: float = 2.0, min_weight: float = 1e-3,
+                      ) -> tuple[dict[int, float], bool]:
     """Weights of the grades from healthy data alone.
 
     ``w_g ∝ exp(-½ ((m_g - t) / s)²)`` with ``m_g`` each grade's median simulated signature,
@@ -78,10 +87,11 @@ def signature_weights(target_signature, simulated_signatures, *, consistency=2.0
     consistent : bool
         Whether some grade matched (False: the uniform fallback was used).
     """
-    target = float(np.median(target_signature))
+    target = float(np.median(np.asarray(target_signature, float)))
     grades = np.array(sorted(simulated_signatures))
-    medians = np.array([float(np.median(simulated_signatures[g])) for g in grades])
-    spread = float(np.median([np.std(simulated_signatures[g]) for g in grades]))
+    sims = {g: np.asarray(simulated_signatures[g], float) for g in grades}
+    medians = np.array([float(np.median(sims[g])) for g in grades])
+    spread = float(np.median([np.std(sims[g]) for g in grades]))
     spread = max(spread, 1e-12)
     dist = np.abs(medians - target)
     consistent = bool(dist.min() <= consistency * spread)

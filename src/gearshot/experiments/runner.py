@@ -86,7 +86,7 @@ def _simulated_task(spec: dict) -> pd.DataFrame:
                                random_state=[spec["seed"], spec["tfs"].index(name)])
         for row in evaluate_variants(ds.fit_args(), ds.test_sa, ds.test_size,
                                      variants=spec["variants"], selection_tf=selection,
-                                     random_state=spec["seed"]):
+                                     random_state=spec["seed"], nominal_grade=spec["grade"]):
             row.pop("prediction")
             rows.append(dict(speed=spec["speed"], load=spec["load"], tf=name,
                              attenuation_db=spec["attenuation_db"], seed=spec["seed"], **row))

@@ -1,4 +1,5 @@
-"""MATLAB ``.mat`` recordings: v5 (scipy.io) and v7.3 (HDF5, via h5py).
+"""MATLAB ``.mat`` recordings: v5 (scipy.io) and v7.3 (HDF5: read with h5py, written with
+hdf5storage).
 
 Variables: every numeric vector (or each row/column of a numeric matrix, named
 ``name[i]``) is a channel; ``fs`` (or ``Fs``, ``sample_rate``, ...) is the sampling rate;
@@ -8,13 +9,13 @@ from elsewhere may instead carry scalar/string variables ``speed``, ``load``,
 read when there is no ``metadata_json``. The writers store ``acceleration``, ``tacho``,
 ``fs``, ``metadata_json`` and, for MATLAB users' convenience, ``speed``, ``load`` and
 ``fault_size`` when known (v7.3: HDF5 with the 512-byte MATLAB user block,
-``MATLAB_class`` attributes, UTF-16 chars and MATLAB's reversed dimension order).
+``MATLAB_class`` attributes, UTF-16 chars and MATLAB's reversed dimension order, as
+hdf5storage writes them).
 """
 
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 from typing import Any
 
@@ -122,27 +123,11 @@ def _mat_variables(rec: Any) -> dict[str, Any]:
 
 
 def _write_v73(variables: dict[str, Any], path: Path) -> None:
-    with h5py.File(path, "w", userblock_size=512) as f:
-        for name, value in variables.items():
-            if isinstance(value, str):
-                if value == "":
-                    ds = f.create_dataset(name, data=np.array([0, 0], dtype=np.uint64))
-                    ds.attrs["MATLAB_empty"] = np.uint8(1)
-                else:
-                    codes = np.frombuffer(value.encode("utf-16-le", "surrogatepass"),
-                                          dtype="<u2")
-                    ds = f.create_dataset(name, data=codes.reshape(-1, 1))
-                    ds.attrs["MATLAB_int_decode"] = np.int32(2)
-                ds.attrs["MATLAB_class"] = np.bytes_("char")
-            else:
-                arr = np.atleast_1d(np.asarray(value, dtype=np.float64))
-                ds = f.create_dataset(name, data=arr.reshape(-1, 1))  # MATLAB 1 x n row
-                ds.attrs["MATLAB_class"] = np.bytes_("double")
-    stamp = time.strftime("%a %b %d %H:%M:%S %Y", time.gmtime())
-    text = f"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: {stamp} HDF5 schema 1.00 ."
-    header = text.encode("ascii").ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02" + b"IM"
-    with open(path, "r+b") as fh:
-        fh.write(header)
+    import hdf5storage
+
+    hdf5storage.savemat(str(path), variables, appendmat=False, format="7.3", oned_as="row",
+                        matlab_compatible=True, store_python_metadata=False,
+                        truncate_existing=True)
 
 
 def write_mat(rec: Any, path: Path, *, version: str = "5") -> None:

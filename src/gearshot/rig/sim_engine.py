@@ -10,12 +10,9 @@ How the hidden reality reaches the simulator:
 * the true DIN grade, with profile errors drawn from the reality's ``profile_seed`` on
   every run (the rig always runs the same wheels);
 * the fault: the reality's centre and depth coefficient; its edge offsets widen/narrow and
-  shift the cut, so the physical fault differs from the nominal label ``y``.
-  ``simulate`` builds its own :class:`~gearshot.sim.FullToothFaceFault` (a circular arc)
-  from size/centre/depth and takes no fault object, so the reality's ``fault_roughness``
-  (depth varying along the profile) is not applied by this engine yet (it is by
-  :class:`~gearshot.rig.surrogate.SurrogateEngine`). :class:`IrregularFaceFault` is the
-  fault object to pass once ``simulate`` accepts one.
+  shift the cut, so the physical fault differs from the nominal label ``y``; the reality's
+  ``fault_roughness`` makes the depth vary along the cut. The fault reaches the physics as
+  an :class:`IrregularFaceFault` through ``simulate(faults=...)``.
 """
 
 from __future__ import annotations

@@ -1,11 +1,13 @@
-"""The spur-gear dynamic simulator and simulated SA databases.
+"""The spur and helical gear-pair dynamic simulator and simulated SA databases.
 
 Pieces (SI units; angles in rad; accelerations in g):
 
 * :class:`GearPair` — frozen parameter set (``GearPair.paper()`` is the paper's pair).
 * :func:`mesh_stiffness`, :func:`pair_stiffness` — potential-energy mesh stiffness
   (Hertz, bending, shear, axial, Sainsot fillet foundation).
-* :class:`ToothFault` (extensible base), :class:`FullToothFaceFault` via ``Fault.ftff``.
+* :class:`ToothFault` (extensible base), :class:`FullToothFaceFault` via ``Fault.ftff``;
+  :class:`PartialFaceFault`, :class:`ToothBreakage`, :class:`ToothDestruction` and
+  :func:`fault_of_type` (``simulate_sa(..., fault_type=NAME)``).
 * :func:`draw_profile_errors` — DIN 3962 profile errors per tooth.
 * :func:`simulate` — time signals with constant or time-varying speed and load;
   :func:`simulate_sa` — batched steady-state synchronous averages.
@@ -22,6 +24,8 @@ Example
 
 from .database import build_database, default_database_path, load_database
 from .dynamics import DEFAULT_MIN_FS, SimulationResult, simulate, simulate_sa, system_matrices
+from .fault_types import (FAULT_TYPES, PartialFaceFault, ToothBreakage, ToothDestruction,
+                          fault_of_type)
 from .faults import Fault, FullToothFaceFault, ToothFault
 from .geometry import GearPair
 from .profile_errors import DIN_PROFILE_TOLERANCES, ToothProfileErrors, draw_profile_errors
@@ -32,6 +36,11 @@ __all__ = [
     "Fault",
     "FullToothFaceFault",
     "ToothFault",
+    "PartialFaceFault",
+    "ToothBreakage",
+    "ToothDestruction",
+    "FAULT_TYPES",
+    "fault_of_type",
     "contact_ratio",
     "mesh_stiffness",
     "pair_stiffness",

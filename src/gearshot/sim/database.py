@@ -5,11 +5,15 @@ Layout of a store (a folder)::
     store/
       manifest.json                 build parameters (written first, atomically)
       blocks/s{i}_l{j}_g{k}.zarr    one (speed, load, grade) block, an xarray Dataset
+      blocks/s{i}_l{j}_g{k}_{type}.zarr   ... of a fault type other than "ftff"
 
 A block is written to a temporary folder beside its final name and renamed when complete,
 so a block is either absent or whole; an interrupted build resumes by skipping the blocks
 present. Each block's random stream derives from ``SeedSequence(seed, spawn_key=(i, j, k))``
-and each signal's from the block's, so contents do not depend on order or interruption.
+(``(i, j, k, code)`` for a fault type other than the FTFF, ``code`` its position in
+:data:`~gearshot.sim.FAULT_TYPES`) and each signal's from the block's, so contents do not
+depend on order or interruption. A build of FTFFs only keeps the layout and manifest of
+stores built before fault types existed.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, describe
 from .dynamics import simulate_sa
+from .fault_types import FAULT_TYPES, check_fault_type
 from .geometry import GearPair
 
 __all__ = ["build_database", "load_database", "default_database_path"]
@@ -62,14 +67,43 @@ def _check_values(values, name, *, integer=False, lo=None, hi=None):
     return arr
 
 
-def _block_name(i, j, k):
-    return f"s{i}_l{j}_g{k}.zarr"
+def _block_name(i, j, k, fault_type="ftff"):
+    if fault_type == "ftff":
+        return f"s{i}_l{j}_g{k}.zarr"
+    return f"s{i}_l{j}_g{k}_{fault_type}.zarr"
 
 
-def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points):
-    return {"format": _FORMAT, "pair": repr(pair), "speeds": [float(s) for s in speeds],
-            "loads": [float(x) for x in loads], "grades": [int(g) for g in grades],
-            "n_healthy": n_healthy, "n_faulty": n_faulty, "seed": seed, "n_points": n_points}
+def _pair_repr(pair):
+    # a spur pair keeps the text of stores built before helix_angle existed
+    text = repr(pair)
+    return text.replace(", helix_angle=0.0)", ")") if not pair.is_helical else text
+
+
+def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
+              fault_types=("ftff",)):
+    man = {"format": _FORMAT, "pair": _pair_repr(pair), "speeds": [float(s) for s in speeds],
+           "loads": [float(x) for x in loads], "grades": [int(g) for g in grades],
+           "n_healthy": n_healthy, "n_faulty": n_faulty, "seed": seed, "n_points": n_points}
+    if list(fault_types) != ["ftff"]:
+        man["fault_types"] = list(fault_types)
+    return man
+
+
+def _check_fault_types(fault_types):
+    if isinstance(fault_types, str):
+        fault_types = [fault_types]
+    try:
+        types = list(fault_types)
+    except TypeError:
+        raise GearshotError(f"fault_types must be a sequence of names; got "
+                            f"{describe(fault_types)}") from None
+    if not types:
+        raise GearshotError("fault_types must not be empty")
+    for t in types:
+        check_fault_type(t)
+    if len(set(types)) != len(types):
+        raise GearshotError(f"fault_types must not repeat names; got {types!r}")
+    return types
 
 
 def _write_json_atomic(path: Path, obj) -> None:
@@ -80,23 +114,26 @@ def _write_json_atomic(path: Path, obj) -> None:
 
 def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: float,
                  load: float, grade: int, n_healthy: int, n_faulty: int, seed: int,
-                 n_points: int, single_thread: bool = False) -> str:
+                 n_points: int, single_thread: bool = False, fault_type: str = "ftff"
+                 ) -> str:
     import xarray as xr
 
     if single_thread:
         import numba
         numba.set_num_threads(1)
     blocks = Path(store) / "blocks"
-    final = blocks / _block_name(i, j, k)
+    final = blocks / _block_name(i, j, k, fault_type)
     if final.exists():
         return final.name
-    ss = np.random.SeedSequence(seed, spawn_key=(i, j, k))
+    code = list(FAULT_TYPES).index(fault_type)
+    ss = np.random.SeedSequence(seed, spawn_key=(i, j, k) if code == 0 else (i, j, k, code))
     block_rng = np.random.default_rng(ss)
     n = n_healthy + n_faulty
     sizes = np.concatenate([np.zeros(n_healthy), block_rng.uniform(0.0, 1.0, n_faulty)])
     sig_seeds = block_rng.integers(0, 2 ** 63 - 1, n, dtype=np.int64)
     sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
-                     n_points=n_points, rng=[int(s) for s in sig_seeds])
+                     n_points=n_points, rng=[int(s) for s in sig_seeds],
+                     fault_type=fault_type)
     ds = xr.Dataset(
         {"sa": (("signal", "angle"), sa.astype(np.float64),
                 {"units": "g", "long_name": "vertical acceleration SA"})},
@@ -104,7 +141,8 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
                 "seed": ("signal", sig_seeds), "speed": float(speed), "load": float(load),
                 "angle": ("angle", 2 * np.pi * np.arange(n_points) / n_points,
                           {"units": "rad", "long_name": "driven-gear angle"})},
-        attrs={"speed_units": "rev/s (input shaft)", "load_units": "N m"})
+        attrs={"speed_units": "rev/s (input shaft)", "load_units": "N m",
+               "fault_type": fault_type})
     tmp = blocks / f".{final.name}.{uuid.uuid4().hex}.tmp"
     ds.to_zarr(tmp, mode="w", consolidated=False)
     try:
@@ -119,7 +157,8 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
 
 def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades,
                    n_healthy: int = 100, n_faulty: int = 700, seed: int = 0,
-                   n_points: int = 2048, client=None, progress: bool = True) -> Path:
+                   n_points: int = 2048, client=None, progress: bool = True,
+                   fault_types=("ftff",)) -> Path:
     """Simulate SAs for every (speed, load, grade) and store them as Zarr.
 
     Parameters
@@ -147,6 +186,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         in-process (numba threads over the batch) otherwise; ``False``: always in-process.
     progress : bool
         Show a rich progress bar.
+    fault_types : sequence of str
+        Fault types (:data:`~gearshot.sim.FAULT_TYPES`): one block of ``n_healthy`` +
+        ``n_faulty`` signals per type and (speed, load, grade); sizes mean the type's
+        size (:mod:`gearshot.sim.fault_types`). Default the FTFF only.
 
     Returns
     -------
@@ -165,15 +208,17 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         raise GearshotError("n_healthy + n_faulty must be > 0; got 0")
     seed = check_int(seed, "seed", minimum=0)
     n_points = check_int(n_points, "n_points", minimum=16)
+    fault_types = _check_fault_types(fault_types)
     store = Path(store).expanduser()
-    manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points)
+    manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
+                         fault_types)
     _prepare_store(store, manifest)
 
-    tasks = [(i, j, k, float(s), float(ld), int(g))
+    tasks = [(i, j, k, float(s), float(ld), int(g), ft)
              for i, s in enumerate(speeds) for j, ld in enumerate(loads)
-             for k, g in enumerate(grades)]
+             for k, g in enumerate(grades) for ft in fault_types]
     blocks = store / "blocks"
-    todo = [t for t in tasks if not (blocks / _block_name(*t[:3])).exists()]
+    todo = [t for t in tasks if not (blocks / _block_name(*t[:3], t[6])).exists()]
     own_cluster = None
     if client is None and len(todo) > _SMALL_BUILD:
         from dask.distributed import Client, LocalCluster
@@ -227,26 +272,39 @@ def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, 
         task = bar.add_task("blocks", total=n_total, completed=n_total - len(todo))
         if client is None:
             for t in todo:
-                _build_block(str(store), pair, *t, n_healthy, n_faulty, seed, n_points)
+                _build_block(str(store), pair, *t[:6], n_healthy, n_faulty, seed, n_points,
+                             fault_type=t[6])
                 bar.advance(task)
             return
         from dask.distributed import as_completed
-        futures = [client.submit(_build_block, str(store), pair, *t, n_healthy, n_faulty,
-                                 seed, n_points, True, pure=False) for t in todo]
+        futures = [client.submit(_build_block, str(store), pair, *t[:6], n_healthy,
+                                 n_faulty, seed, n_points, True, t[6], pure=False)
+                   for t in todo]
         for fut in as_completed(futures):
             fut.result()
             bar.advance(task)
 
 
-def load_database(store, *, speed: float, load: float, grade: int | None = None):
-    """The SAs of one (speed, load) condition, optionally one grade.
+def load_database(store, *, speed: float, load: float, grade: int | None = None,
+                  fault_type: str | None = None):
+    """The SAs of one (speed, load) condition, optionally one grade and one fault type.
+
+    Parameters
+    ----------
+    store : str or Path
+    speed, load : float
+        The condition (must be in the build).
+    grade : int, optional
+        One grade; ``None``: all, in the build's grade order.
+    fault_type : str, optional
+        One fault type of the build; ``None``: all, in the build's order.
 
     Returns
     -------
     xarray.Dataset
         ``sa`` (signal, angle) float64 in g; coords ``fault_size``, ``grade``, ``seed``
-        along ``signal``; scalar ``speed`` (rev/s) and ``load`` (N m). With ``grade=None``
-        all grades are concatenated along ``signal`` in the build's grade order.
+        and ``fault_type`` along ``signal``; scalar ``speed`` (rev/s) and ``load`` (N m).
+        Blocks are concatenated along ``signal`` (grades outer, fault types inner).
     """
     import xarray as xr
 
@@ -267,14 +325,25 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None)
     j = index(man["loads"], load, "load")
     ks = (range(len(man["grades"])) if grade is None
           else [index(man["grades"], grade, "grade")])
+    types = man.get("fault_types", ["ftff"])
+    if fault_type is not None:
+        if fault_type not in types:
+            raise GearshotError(f"fault_type {fault_type!r} is not in the database "
+                                f"(has {types})")
+        types = [fault_type]
     parts = []
     for k in ks:
-        path = store / "blocks" / _block_name(i, j, k)
-        if not path.exists():
-            raise GearshotError(f"block speed={speed!r}, load={load!r}, "
-                                f"grade={man['grades'][k]!r} of {str(store)!r} is not built "
-                                f"yet; run build_database again to finish it")
-        parts.append(xr.open_zarr(path, consolidated=False).load())
+        for ft in types:
+            path = store / "blocks" / _block_name(i, j, k, ft)
+            if not path.exists():
+                raise GearshotError(f"block speed={speed!r}, load={load!r}, "
+                                    f"grade={man['grades'][k]!r}, fault_type={ft!r} of "
+                                    f"{str(store)!r} is not built yet; run build_database "
+                                    f"again to finish it")
+            part = xr.open_zarr(path, consolidated=False).load()
+            part.attrs.pop("fault_type", None)
+            parts.append(part.assign_coords(
+                fault_type=("signal", np.full(part.sizes["signal"], ft, dtype=object))))
     parts = [p.drop_vars(["speed", "load"]) for p in parts]
     ds = parts[0] if len(parts) == 1 else xr.concat(parts, dim="signal", coords="minimal",
                                                     compat="override")

@@ -8,11 +8,13 @@ A fault acts on the gear pair in two ways (DESIGN.md section 2):
 * it adds a displacement excitation along the line of action
   (:meth:`ToothFault.displacement`).
 
-New fault types (tooth breakage, partial-face faults) subclass :class:`ToothFault`
-(a frozen dataclass, so faults are hashable and their tables can be cached) and override
-``is_healthy`` and these hooks, plus :meth:`ToothFault.affected_range` to tell where the
-stiffness changes and where it jumps; the stiffness and dynamics code only calls the
-hooks. Pass such faults to :func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate`
+New fault types subclass :class:`ToothFault` (a frozen dataclass, so faults are
+hashable and their tables can be cached) and override ``is_healthy`` and these hooks, plus
+:meth:`ToothFault.affected_range` to tell where the stiffness changes and where it jumps,
+:meth:`ToothFault.stiffness_scale` where contact is lost and
+:meth:`ToothFault.face_bands` when the fault is not uniform across the face width; the
+stiffness and dynamics code only calls the hooks (:mod:`gearshot.sim.fault_types` holds
+the partial-face, breakage and surface-destruction faults). Pass such faults to :func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate`
 with ``faults=[...]``.
 """
 
@@ -71,6 +73,22 @@ class ToothFault:
         """Displacement excitation along the line of action (m, negative = material
         missing) when the nominal contact is at gear roll fraction ``s``."""
         return np.zeros_like(np.asarray(s, dtype=float))
+
+    #: True when :meth:`stiffness_scale` is not 1 everywhere (contact area lost).
+    scales_contact = False
+
+    def stiffness_scale(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """Factor (0 ... 1) on the pair stiffness when the nominal contact is at gear roll
+        fraction ``s``: the share of the contact line that still bears (0 where the
+        flank is gone, e.g. a broken tip). Only used when :attr:`scales_contact`."""
+        return np.ones_like(np.asarray(s, dtype=float))
+
+    def face_bands(self, pair: GearPair) -> tuple:
+        """The fault along the face width: ``((start, end, transverse_fault), ...)`` with
+        start/end fractions of the face width (0 ... 1) and the fault of the transverse
+        section over that band (whose hooks above act on a slice of the face). Outside
+        the bands the tooth is healthy. Default: this fault over the whole face."""
+        return ((0.0, 1.0, self),)
 
 
 @dataclass(frozen=True)
@@ -132,7 +150,7 @@ class FullToothFaceFault(ToothFault):
         pts = []
         for s in (s0, s1):
             r = math.hypot(rb, l_lo + s * (l_hi - l_lo))
-            psi = float(involute_half_angle(z, pair.pressure_angle, np.array(r), rb))
+            psi = float(involute_half_angle(z, pair.transverse_pressure_angle, np.array(r), rb))
             pts.append((r * math.cos(psi), r * math.sin(psi)))
         return np.array(pts)  # [[x_start, h_start], [x_end, h_end]]
 
@@ -158,7 +176,7 @@ class FullToothFaceFault(ToothFault):
         rb = pair.base_radius(z)
         # healthy flank half-thickness at x (invert x(r) on a fine table)
         r_tab = np.linspace(rb, pair.tip_radius(z), 601)
-        psi = involute_half_angle(z, pair.pressure_angle, r_tab, rb)
+        psi = involute_half_angle(z, pair.transverse_pressure_angle, r_tab, rb)
         x_tab, h_tab = r_tab * np.cos(psi), r_tab * np.sin(psi)
         inside = (x > xa) & (x < xb)
         out = np.zeros_like(x)
@@ -213,7 +231,7 @@ class FullToothFaceFault(ToothFault):
                     np.linspace(s1, min(s1 + margin, 1.0), 5)]
         ls = l_lo + np.concatenate(pieces_s) * (l_hi - l_lo)
         r = np.hypot(rb, np.maximum(ls, 0.0))
-        psi = involute_half_angle(z, pair.pressure_angle, r, rb)
+        psi = involute_half_angle(z, pair.transverse_pressure_angle, r, rb)
         (xa, xb), (cx, ch), radius, _ = self._arc(pair)
         xx = np.linspace(xa, xb, n)
         hh = ch - np.sqrt(np.maximum(radius ** 2 - (xx - cx) ** 2, 0.0))
@@ -227,7 +245,7 @@ class FullToothFaceFault(ToothFault):
         (cut arc and the involute beyond its edges), points within the pinion's flank;
         and the gear radius (m) of the point where the pinion then touches."""
         z1, z2 = pair.z_pinion, pair.z_gear
-        a0 = pair.pressure_angle
+        a0 = pair.transverse_pressure_angle
         rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
         ra1 = pair.tip_radius(z1)
         (p_lo, p_hi), _ = pair.roll_limits

@@ -1,4 +1,12 @@
-"""Spur gear pair parameters and involute geometry (SI units throughout)."""
+"""Spur and helical gear pair parameters and involute geometry (SI units throughout).
+
+A helical pair (``helix_angle`` > 0) is described by its normal module and normal pressure
+angle (``module``, ``pressure_angle``, as on a drawing and in ISO 6336); its transverse
+section is an involute spur profile of transverse module ``m_t = m_n / cos(beta)`` and
+transverse pressure angle ``alpha_t = atan(tan(alpha_n) / cos(beta))``. Every transverse
+quantity (radii, base pitch, roll limits, the transverse contact ratio) is that of the
+transverse section; with ``helix_angle == 0`` they are exactly the spur values.
+"""
 
 from __future__ import annotations
 
@@ -16,7 +24,7 @@ __all__ = ["GearPair"]
 
 @dataclass(frozen=True)
 class GearPair:
-    """A spur gear pair on two shafts, with its test-rig surroundings.
+    """A spur or helical gear pair on two shafts, with its test-rig surroundings.
 
     The pinion (``z_pinion`` teeth) drives the gear (``z_gear`` teeth). All values SI.
 
@@ -25,11 +33,11 @@ class GearPair:
     z_pinion, z_gear : int
         Numbers of teeth (>= 12).
     module : float
-        Module, m.
+        Module, m (the normal module of a helical pair).
     face_width : float
         Face width, m.
     pressure_angle : float
-        Nominal pressure angle, rad.
+        Nominal pressure angle, rad (the normal pressure angle of a helical pair).
     youngs_modulus : float
         E, Pa.
     poisson : float
@@ -56,6 +64,10 @@ class GearPair:
         Lateral bearing stiffness per direction per wheel, N/m.
     damping_ratio : float
         Modal damping ratio applied to every mode.
+    helix_angle : float
+        Helix angle at the pitch circle, rad, in [0, 45 deg]; 0 is a spur pair (every
+        result unchanged). The axial bearing stiffness of a helical pair is
+        ``bearing_stiffness``.
     """
 
     z_pinion: int = 17
@@ -80,6 +92,7 @@ class GearPair:
     shear_modulus_shaft: float | None = None
     bearing_stiffness: float = 1.9e8
     damping_ratio: float = 0.05
+    helix_angle: float = 0.0
 
     def __post_init__(self) -> None:
         check_int(self.z_pinion, "z_pinion", minimum=12)
@@ -95,6 +108,7 @@ class GearPair:
         check_in_range(self.poisson, "poisson", 0.0, 0.5, high_inclusive=False)
         check_in_range(self.damping_ratio, "damping_ratio", 0.0, 1.0, low_inclusive=False)
         check_in_range(self.pressure_angle, "pressure_angle", math.radians(10), math.radians(35))
+        check_in_range(self.helix_angle, "helix_angle", 0.0, math.radians(45))
         if self.bore_radius >= self.root_radius(self.z_pinion) * 0.95:
             raise GearshotError(
                 f"bore_radius must be well below the pinion root radius "
@@ -105,9 +119,10 @@ class GearPair:
                 f"z_pinion={self.z_pinion}, z_gear={self.z_gear}: the path of contact starts "
                 f"below a base circle (involute interference); use more pinion teeth or a "
                 f"smaller addendum (addendum={self.addendum!r})")
-        if not self.contact_ratio > 1.0:
+        if not self.total_contact_ratio > 1.0:
             raise GearshotError(f"the pair's contact ratio must exceed 1; got "
-                                f"{self.contact_ratio:.4g} (z={self.z_pinion}/{self.z_gear})")
+                                f"{self.total_contact_ratio:.4g} "
+                                f"(z={self.z_pinion}/{self.z_gear})")
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -124,12 +139,42 @@ class GearPair:
         """A copy with some fields changed (validated)."""
         return dataclasses.replace(self, **changes)
 
+    @classmethod
+    def helical(cls, helix_angle: float, **overrides) -> "GearPair":
+        """The paper's pair (:meth:`paper`) cut with helical teeth of ``helix_angle``
+        (rad; normal module and pressure angle kept). Keyword overrides are applied."""
+        return cls.paper(helix_angle=helix_angle, **overrides)
+
     # ------------------------------------------------------------------ geometry
+    @property
+    def is_helical(self) -> bool:
+        """True when ``helix_angle`` > 0."""
+        return self.helix_angle > 0.0
+
+    @property
+    def transverse_module(self) -> float:
+        """Transverse module m_n / cos(beta), m (``module`` for a spur pair)."""
+        if not self.is_helical:
+            return self.module
+        return self.module / math.cos(self.helix_angle)
+
+    @property
+    def transverse_pressure_angle(self) -> float:
+        """Transverse pressure angle atan(tan(alpha_n) / cos(beta)), rad."""
+        if not self.is_helical:
+            return self.pressure_angle
+        return math.atan(math.tan(self.pressure_angle) / math.cos(self.helix_angle))
+
+    @property
+    def base_helix_angle(self) -> float:
+        """Helix angle at the base circle, rad: sin(beta_b) = sin(beta) cos(alpha_n)."""
+        return math.asin(math.sin(self.helix_angle) * math.cos(self.pressure_angle))
+
     def pitch_radius(self, z: int) -> float:
-        return 0.5 * self.module * z
+        return 0.5 * self.transverse_module * z
 
     def base_radius(self, z: int) -> float:
-        return self.pitch_radius(z) * math.cos(self.pressure_angle)
+        return self.pitch_radius(z) * math.cos(self.transverse_pressure_angle)
 
     def tip_radius(self, z: int) -> float:
         return self.pitch_radius(z) + self.addendum * self.module
@@ -139,12 +184,13 @@ class GearPair:
 
     @property
     def center_distance(self) -> float:
-        return 0.5 * self.module * (self.z_pinion + self.z_gear)
+        return 0.5 * self.transverse_module * (self.z_pinion + self.z_gear)
 
     @property
     def base_pitch(self) -> float:
-        """Base pitch, m (distance between successive pairs along the line of action)."""
-        return math.pi * self.module * math.cos(self.pressure_angle)
+        """Transverse base pitch, m (distance between successive pairs along the line of
+        action)."""
+        return math.pi * self.transverse_module * math.cos(self.transverse_pressure_angle)
 
     @property
     def roll_limits(self) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -152,7 +198,7 @@ class GearPair:
         ((pinion_low, pinion_tip), (gear_low, gear_tip))."""
         rb1, rb2 = self.base_radius(self.z_pinion), self.base_radius(self.z_gear)
         ra1, ra2 = self.tip_radius(self.z_pinion), self.tip_radius(self.z_gear)
-        total = self.center_distance * math.sin(self.pressure_angle)
+        total = self.center_distance * math.sin(self.transverse_pressure_angle)
         l1_tip = math.sqrt(ra1 ** 2 - rb1 ** 2)
         l2_tip = math.sqrt(ra2 ** 2 - rb2 ** 2)
         return (total - l2_tip, l1_tip), (total - l1_tip, l2_tip)
@@ -165,11 +211,30 @@ class GearPair:
 
     @property
     def contact_ratio(self) -> float:
-        """Transverse contact ratio (path of contact / base pitch)."""
+        """Transverse contact ratio epsilon_alpha (path of contact / transverse base
+        pitch); see :attr:`total_contact_ratio` for a helical pair."""
         (p_lo, p_hi), _ = self.roll_limits
         if p_lo <= 0:  # interference: contact would start below the pinion base circle
             return float("nan")
         return self.contact_length / self.base_pitch
+
+    @property
+    def transverse_contact_ratio(self) -> float:
+        """Transverse contact ratio epsilon_alpha (same as :attr:`contact_ratio`)."""
+        return self.contact_ratio
+
+    @property
+    def overlap_ratio(self) -> float:
+        """Overlap (face) contact ratio epsilon_beta = b sin(beta) / (pi m_n): how many
+        base pitches one tooth's contact line advances across the face width (0 for
+        spur)."""
+        return self.face_width * math.sin(self.helix_angle) / (math.pi * self.module)
+
+    @property
+    def total_contact_ratio(self) -> float:
+        """Total contact ratio epsilon_gamma = epsilon_alpha + epsilon_beta: the mesh
+        periods during which one tooth pair is (partly) in contact."""
+        return self.contact_ratio + self.overlap_ratio
 
     @property
     def masses(self) -> tuple[float, float]:

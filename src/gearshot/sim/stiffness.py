@@ -5,6 +5,12 @@ the Hertzian term ``k_h = pi E L / (4 (1 - nu^2))``, bending, shear and axial-co
 energies integrated along the tooth's centre line (involute flank above the base circle,
 constant section between root and base circle) and the fillet-foundation term of Sainsot
 et al. (2004). Pairs in contact follow from the contact ratio.
+
+Helical pairs: the slice method (:mod:`gearshot.sim._slices`): the transverse profile's
+spur single-pair stiffness is averaged over the face width with the slices staggered by the
+overlap ratio, so one tooth pair is in contact for ``epsilon_alpha + epsilon_beta`` mesh
+periods. Faults that cover part of the face (:meth:`~gearshot.sim.ToothFault.face_bands`)
+change only their band's slices.
 """
 
 from __future__ import annotations
@@ -14,7 +20,9 @@ import math
 
 import numpy as np
 
+from .._errors import GearshotError
 from .._validation import as_signal_array
+from ._slices import box, tau_grid
 from .faults import ToothFault
 from .geometry import GearPair, involute_half_angle
 
@@ -32,9 +40,24 @@ _SAINSOT = np.array([
 _N_NODES = 240  # integration nodes along the tooth
 
 
-def contact_ratio(pair: GearPair) -> float:
-    """Transverse contact ratio of ``pair``."""
-    return pair.contact_ratio
+def contact_ratio(pair: GearPair, *, kind: str = "total") -> float:
+    """Contact ratio of ``pair``.
+
+    Parameters
+    ----------
+    pair : GearPair
+    kind : {"total", "transverse", "overlap"}
+        ``"transverse"``: epsilon_alpha (path of contact / transverse base pitch);
+        ``"overlap"``: epsilon_beta = b sin(beta) / (pi m_n) (0 for spur);
+        ``"total"``: their sum (the transverse ratio for a spur pair).
+    """
+    if kind == "total":
+        return pair.total_contact_ratio
+    if kind == "transverse":
+        return pair.contact_ratio
+    if kind == "overlap":
+        return pair.overlap_ratio
+    raise GearshotError(f"kind must be 'total', 'transverse' or 'overlap'; got {kind!r}")
 
 
 def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
@@ -44,7 +67,7 @@ def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
     E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
     G = E / (2 * (1 + nu))
     rb, rf = pair.base_radius(z), pair.root_radius(z)
-    a0 = pair.pressure_angle
+    a0 = pair.transverse_pressure_angle
     roll = np.asarray(roll, dtype=float)
     rc = np.hypot(rb, roll)
     psi_c = involute_half_angle(z, a0, rc, rb)
@@ -100,8 +123,18 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
     u : array_like
         Position along the path of contact, 0 (entry: gear tip) to 1 (exit: pinion tip).
     fault : ToothFault, optional
-        Fault on the gear tooth of this pair.
+        Fault on the gear tooth of this pair; a fault over part of the face width
+        (:meth:`~gearshot.sim.ToothFault.face_bands`) weights its bands by their width.
+
+    For a helical pair this is the stiffness of the transverse profile over the whole
+    face width (all slices in phase); :func:`mesh_stiffness` staggers the slices.
     """
+    if fault is not None and not fault.is_healthy and not _whole_face(fault, pair):
+        healthy = pair_stiffness(pair, u)
+        out = healthy.copy()
+        for z0, z1, f in fault.face_bands(pair):
+            out += (z1 - z0) * (pair_stiffness(pair, u, fault=f) - healthy)
+        return out
     u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
     (p_lo, p_hi), (g_lo, g_hi) = pair.roll_limits
     s_gear = 1.0 - u
@@ -113,7 +146,16 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
     inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + s_pin * (p_hi - p_lo))
     inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + s_gear * (g_hi - g_lo), sec)
     k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
-    return 1.0 / (1.0 / k_h + inv_p + inv_g)
+    k = 1.0 / (1.0 / k_h + inv_p + inv_g)
+    if fault is not None and not fault.is_healthy and fault.scales_contact:
+        k = k * fault.stiffness_scale(pair, 1.0 - u)
+    return k
+
+
+def _whole_face(fault: ToothFault, pair: GearPair) -> bool:
+    """True when ``fault`` is its own transverse fault over the whole face width."""
+    bands = fault.face_bands(pair)
+    return len(bands) == 1 and bands[0][0] == 0.0 and bands[0][1] == 1.0 and bands[0][2] is fault
 
 
 _N_TABLE = 1025
@@ -164,6 +206,83 @@ def _pair_table(pair: GearPair, fault: ToothFault | None) -> np.ndarray:
         inv_g = _faulty_gear_compliance(pair, fault)
     k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
     tab = 1.0 / (1.0 / k_h + inv_p + inv_g)
+    if fault is not None and not fault.is_healthy and fault.scales_contact:
+        tab = tab * fault.stiffness_scale(pair, 1.0 - np.linspace(0.0, 1.0, _N_TABLE))
+    tab.setflags(write=False)
+    return tab
+
+
+@functools.lru_cache(maxsize=256)
+def _band_tables(pair: GearPair, fault: ToothFault):
+    """The fault's face bands as ``((z0, z1, k, d), ...)``: face fractions, the band's
+    transverse pair stiffness (N/m, full-width scale) and displacement excitation (m)
+    over the spur contact position u."""
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    out = []
+    for z0, z1, f in fault.face_bands(pair):
+        if z1 <= z0 or f is None or f.is_healthy:
+            continue
+        d = np.asarray(f.displacement(pair, 1.0 - u), dtype=float)
+        d.setflags(write=False)
+        out.append((float(z0), float(z1), _pair_table(pair, f), d))
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=256)
+def fault_tables(pair: GearPair, fault: ToothFault):
+    """Spur (all slices in phase) tables over u of the faulty tooth pair: stiffness k_f
+    (N/m) and the displacement excitation e_f (m) such that the pair's force is
+    ``k_f (e + e_f)`` for profile errors e; bands weighted by their face width."""
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    if _whole_face(fault, pair):
+        ef = np.asarray(fault.displacement(pair, 1.0 - u), dtype=float)
+        return _pair_table(pair, fault), ef
+    healthy = _pair_table(pair, None)
+    k = healthy.copy()
+    kd = np.zeros(_N_TABLE)
+    for z0, z1, kb, d in _band_tables(pair, fault):
+        k += (z1 - z0) * (kb - healthy)
+        kd += (z1 - z0) * kb * d
+    k = np.maximum(k, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ef = np.where(k > 0, kd / np.where(k > 0, k, 1.0), 0.0)
+    return k, ef
+
+
+def helical_tables(pair: GearPair, fault: ToothFault | None = None):
+    """Slice-method tables of one helical tooth pair over the delay tau.
+
+    Returns
+    -------
+    span : float
+        Length of the tables, mesh periods (>= the total contact ratio).
+    k : ndarray (n_tau,)
+        Pair stiffness (N/m) of the faulty tooth, or the healthy one.
+    bands : tuple of (lo, hi, dk, kd)
+        Per face band (delays lo ... hi in mesh periods): the band's stiffness change
+        ``k_band - k_healthy`` and force per displacement ``k_band d_band`` over u (spur
+        tables, full-width scale), to be boxed with the profile errors.
+    """
+    ea, eb = pair.contact_ratio, pair.overlap_ratio
+    tau = tau_grid(ea, eb, _N_TABLE)
+    span = float(tau[-1])
+    healthy = _pair_table(pair, None)
+    k = _helical_healthy(pair)
+    bands = ()
+    if fault is not None and not fault.is_healthy:
+        bands = tuple((z0 * eb, z1 * eb, kb - healthy, kb * d)
+                      for z0, z1, kb, d in _band_tables(pair, fault))
+        k = k.copy()
+        for lo, hi, dk, _ in bands:
+            k += box(dk, ea, eb, lo, hi, tau)
+        k = np.maximum(k, 0.0)
+    return span, k, bands
+
+
+@functools.lru_cache(maxsize=32)
+def _helical_healthy(pair: GearPair) -> np.ndarray:
+    ea, eb = pair.contact_ratio, pair.overlap_ratio
+    tab = box(_pair_table(pair, None), ea, eb, 0.0, eb, tau_grid(ea, eb, _N_TABLE))
     tab.setflags(write=False)
     return tab
 
@@ -176,7 +295,8 @@ def mesh_stiffness(pair: GearPair, pinion_angle, *, fault: ToothFault | None = N
     ----------
     pair : GearPair
     pinion_angle : array_like
-        Pinion rotation, rad (any shape). At angle 0 gear tooth 0 enters contact.
+        Pinion rotation, rad (any shape). At angle 0 gear tooth 0 enters contact (for a
+        helical pair: the first slice of gear tooth 0, at face position 0).
     fault : ToothFault, optional
         Fault on one gear tooth (e.g. ``Fault.ftff(0.5)``).
 
@@ -185,13 +305,15 @@ def mesh_stiffness(pair: GearPair, pinion_angle, *, fault: ToothFault | None = N
     ndarray, same shape as ``pinion_angle``
     """
     theta = as_signal_array(pinion_angle, "pinion_angle", min_ndim=0)
+    if pair.is_helical:
+        return _helical_mesh_stiffness(pair, theta, fault)
     eps = pair.contact_ratio
     t_mesh = np.asarray(theta) * pair.z_pinion / (2 * math.pi)
     u_grid = np.linspace(0.0, 1.0, _N_TABLE)
     k_healthy = _pair_table(pair, None)
     k_fault = None
     if fault is not None and not fault.is_healthy:
-        k_fault = _pair_table(pair, fault)
+        k_fault = fault_tables(pair, fault)[0]
     total = np.zeros_like(t_mesh, dtype=float)
     base = np.floor(t_mesh)
     for j in range(int(math.ceil(eps)) + 1):
@@ -202,5 +324,26 @@ def mesh_stiffness(pair: GearPair, pinion_angle, *, fault: ToothFault | None = N
         if k_fault is not None:
             faulty = np.mod(n, pair.z_gear) == fault.tooth % pair.z_gear
             k = np.where(faulty, np.interp(u, u_grid, k_fault), k)
+        total += np.where(inside, k, 0.0)
+    return total
+
+
+def _helical_mesh_stiffness(pair, theta, fault):
+    span, k_healthy, _ = helical_tables(pair)
+    k_fault = None
+    if fault is not None and not fault.is_healthy:
+        k_fault = helical_tables(pair, fault)[1]
+    t_mesh = np.asarray(theta) * pair.z_pinion / (2 * math.pi)
+    grid = np.linspace(0.0, span, k_healthy.size)
+    total = np.zeros_like(t_mesh, dtype=float)
+    base = np.floor(t_mesh)
+    for j in range(int(math.ceil(span)) + 1):
+        n = base - j
+        tau = t_mesh - n
+        inside = (tau >= 0) & (tau < span)
+        k = np.interp(tau, grid, k_healthy)
+        if k_fault is not None:
+            faulty = np.mod(n, pair.z_gear) == fault.tooth % pair.z_gear
+            k = np.where(faulty, np.interp(tau, grid, k_fault), k)
         total += np.where(inside, k, 0.0)
     return total

@@ -2,7 +2,7 @@
 container, UFF58/CSV I/O, hammer-test estimation, modal synthesis, physical-time filtering.
 """
 
-from .bank import TransferFunctionBank
+from .bank import TransferFunctionBank, synthetic_bank
 from .estimation import (
     estimate_transfer_function,
     mean_rms,
@@ -14,7 +14,7 @@ from .estimation import (
 from .filtering import filter_signal, fir_from_transfer_function
 from .function import TransferFunction
 from .impacts import ImpactFRF, frf_from_impacts, impact_arrays
-from .modal import Mode, antiresonances, attenuation_db, modal_frf, synthetic_bank
+from .modal import Mode, antiresonances, attenuation_db, modal_frf, synthetic_tfs
 from .uff import FRF_SUFFIXES, UffRecord, read_frf, read_uff_records, write_frf
 
 __all__ = [
@@ -26,6 +26,6 @@ __all__ = [
     "rms_normalize",
     "TransferFunction", "TransferFunctionBank", "UffRecord", "read_frf", "write_frf",
     "read_uff_records", "FRF_SUFFIXES", "ImpactFRF", "frf_from_impacts", "impact_arrays",
-    "Mode", "modal_frf", "synthetic_bank", "attenuation_db", "antiresonances",
+    "Mode", "modal_frf", "synthetic_bank", "synthetic_tfs", "attenuation_db", "antiresonances",
     "filter_signal", "fir_from_transfer_function",
 ]

@@ -11,9 +11,10 @@ import numpy as np
 from .._errors import GearshotError
 from .._validation import check_int
 from .function import TransferFunction
+from .modal import synthetic_tfs
 from .uff import FRF_SUFFIXES, read_frf
 
-__all__ = ["TransferFunctionBank"]
+__all__ = ["TransferFunctionBank", "synthetic_bank"]
 
 
 class TransferFunctionBank:
@@ -82,9 +83,7 @@ class TransferFunctionBank:
     @classmethod
     def synthetic(cls, n: int, *, rng: np.random.Generator | int, **kwargs) -> TransferFunctionBank:
         """A seeded bank of modal accelerance FRFs; see :func:`synthetic_bank`."""
-        from .modal import synthetic_bank
-
-        return synthetic_bank(n, rng=rng, **kwargs)
+        return cls(synthetic_tfs(n, rng=rng, **kwargs))
 
     # ------------------------------------------------------------------ container protocol
     def __len__(self) -> int:
@@ -163,3 +162,13 @@ class TransferFunctionBank:
     def to_signal_grid(self, n: int) -> np.ndarray:
         """All TFs resampled to an ``n``-point signal grid; shape (n_tf, n), complex."""
         return np.stack([tf.to_signal_grid(n) for tf in self._tfs])
+
+
+def synthetic_bank(n: int, **kwargs) -> TransferFunctionBank:
+    """A seeded bank of realistic accelerance FRFs (stand-ins for measured hammer-test TFs).
+
+    The FRFs of :func:`gearshot.transfer.modal.synthetic_tfs` (same arguments: ``band``,
+    ``n_lines``, ``rng`` — required —, ``n_modes``, ``damping``, ``attenuation``,
+    ``nonminimum_fraction``) as a :class:`TransferFunctionBank`.
+    """
+    return TransferFunctionBank(synthetic_tfs(n, **kwargs))

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,10 +22,7 @@ from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive, describe
 from .function import TransferFunction
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .bank import TransferFunctionBank
-
-__all__ = ["Mode", "modal_frf", "synthetic_bank", "attenuation_db", "antiresonances"]
+__all__ = ["Mode", "modal_frf", "synthetic_tfs", "attenuation_db", "antiresonances"]
 
 _QUANTITIES = {"accelerance": "acceleration", "mobility": "velocity",
                "receptance": "displacement"}
@@ -188,12 +184,12 @@ def _peak_until_lower(side: np.ndarray, level: float) -> float:
     return float(seg.max()) if seg.size else -np.inf
 
 
-def synthetic_bank(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines: int = 1001,
+def synthetic_tfs(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines: int = 1001,
                    rng: np.random.Generator | int | None = None,
                    n_modes: tuple[int, int] = (4, 12),
                    damping: tuple[float, float] = (0.01, 0.05),
                    attenuation: tuple[float, float] = (10.0, 20.0),
-                   nonminimum_fraction: float = 0.5) -> TransferFunctionBank:
+                   nonminimum_fraction: float = 0.5) -> list[TransferFunction]:
     """A seeded bank of realistic accelerance FRFs (stand-ins for measured hammer-test TFs).
 
     Each FRF is a free structure (rigid-body mass line, so |H(0)| > 0) with
@@ -219,10 +215,8 @@ def synthetic_bank(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines
 
     Returns
     -------
-    TransferFunctionBank
+    list of TransferFunction
     """
-    from .bank import TransferFunctionBank
-
     n = check_int(n, "n", minimum=1)
     n_lines = check_int(n_lines, "n_lines", minimum=16)
     if rng is None:
@@ -269,7 +263,7 @@ def synthetic_bank(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines
                     nonminimum_phase_added=bool(nmp_flags[i]))
         tfs.append(TransferFunction(freqs=freqs, values=tf.values * gain, name=tf.name,
                                     response_quantity="acceleration", metadata=meta))
-    return TransferFunctionBank(tfs)
+    return tfs
 
 
 def _spread_modes(rng: np.random.Generator, k: int, lo: float, hi: float) -> np.ndarray:

@@ -1,0 +1,106 @@
+"""Helical pairs and fault types: speed and the lab-model comparison (issue #13).
+
+    PYTHONPATH=src python benchmarks/bench_helical.py            # speed + comparison
+    PYTHONPATH=src python benchmarks/bench_helical.py --full     # + 12 grades x 800 helical
+
+Prints numbers (no asserts); the load average is printed with each timing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from gearshot.signal import difference_signal
+from gearshot.sim import (GearPair, PartialFaceFault, ToothBreakage, ToothDestruction,
+                          build_database, mesh_stiffness, simulate_sa)
+
+REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "bgu_fault_types.npz"
+
+
+def _diff_rms(sa):
+    return np.sqrt(np.mean(difference_signal(sa, 38, n_sidebands=2) ** 2, axis=-1))
+
+
+def per_sa_ms(pair, batch=64, fault_type="ftff"):
+    rng = np.random.default_rng(0)
+    simulate_sa(pair, speed=15, load=10, grade=7, fault_sizes=[0.5], rng=0,
+                fault_type=fault_type)
+    best = np.inf
+    for _ in range(2):
+        t0 = time.perf_counter()
+        simulate_sa(pair, speed=15, load=10, grade=7, fault_sizes=rng.uniform(0, 1, batch),
+                    rng=rng, fault_type=fault_type)
+        best = min(best, time.perf_counter() - t0)
+    return 1e3 * best / batch
+
+
+def iso_c_gamma_alpha(pair):
+    """ISO 6336-1 mesh stiffness c_gamma_alpha (N/m over the face width), basic rack,
+    solid wheels, x = 0: c' = c'_th C_M C_R C_B cos(beta), c_ga = c' (0.75 eps_a + 0.25)."""
+    b = pair.helix_angle
+    zn1, zn2 = pair.z_pinion / math.cos(b) ** 3, pair.z_gear / math.cos(b) ** 3
+    q = 0.04723 + 0.15551 / zn1 + 0.25791 / zn2
+    c_prime = (1 / q) * 0.8 * 1.0 * 1.0 * math.cos(b)          # N / (mm um)
+    c_ga = c_prime * (0.75 * pair.contact_ratio + 0.25)
+    return c_ga * pair.face_width * 1e3 * 1e6                     # N/m
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--full", action="store_true")
+    args = ap.parse_args()
+    spur, hel = GearPair.paper(), GearPair.helical(math.radians(20))
+    theta = np.linspace(0, 2 * np.pi * 38 / 17, 20000, endpoint=False)
+    print("mesh stiffness: mean, (max-min)/mean, ISO 6336-1 c_gamma_alpha")
+    for name, p in (("spur", spur), ("helical 20 deg", hel)):
+        k = mesh_stiffness(p, theta)
+        print(f"  {name:15s} eps_a {p.contact_ratio:.3f} eps_b {p.overlap_ratio:.3f}: "
+              f"mean {k.mean():.4g} N/m, fluct {np.ptp(k) / k.mean():.3f}, "
+              f"ISO {iso_c_gamma_alpha(p):.4g} N/m (ratio {k.mean() / iso_c_gamma_alpha(p):.2f})")
+
+    print(f"\nper-SA wall time, batch 64, 15 rps; load avg {os.getloadavg()[0]:.2f}")
+    for name, p in (("spur", spur), ("helical 20 deg", hel)):
+        for ft in ("ftff", "breakage"):
+            print(f"  {name:15s} {ft:9s}: {per_sa_ms(p, fault_type=ft):6.2f} ms/SA")
+
+    if REF.exists():
+        d = np.load(REF)
+        ref = {k: float(_diff_rms(d[k])) for k in
+               ("healthy", "PartialFaceFault", "ToothBreakage", "ToothDestruction")}
+        faults = [None, PartialFaceFault(size=2 / 15, profile_size=0.6),
+                  ToothBreakage(size=0.4), ToothDestruction(size=10 / 14, center=8 / 14),
+                  ToothBreakage(size=1.0)]
+        names = ["healthy", "PartialFaceFault", "ToothBreakage", "ToothDestruction",
+                 "missing tooth (breakage y=1)"]
+        out = np.array([_diff_rms(simulate_sa(spur, speed=15, load=10, grade=7,
+                                              faults=faults, same_gear=True, rng=s))
+                        for s in range(6)])
+        ratio = out / out[:, :1]
+        print("\ndifference-signal RMS ratio faulty/healthy, 15 rps 10 Nm DIN 7, "
+              "6 gears (mean, min-max) vs the lab model")
+        for i, n in enumerate(names):
+            lab = f"{ref[n] / ref['healthy']:.2f}" if n in ref else "-"
+            print(f"  {n:30s} ours {ratio[:, i].mean():5.2f} ({ratio[:, i].min():.2f}-"
+                  f"{ratio[:, i].max():.2f})  lab {lab}")
+
+    if args.full:
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            build_database(os.path.join(tmp, "db"), hel, speeds=[15], loads=[10],
+                           grades=range(1, 13), client=False, progress=False,
+                           fault_types=["breakage"])
+            wall = time.perf_counter() - t0
+        print(f"\nhelical 20 deg, one condition x 12 grades x 800 breakage signals: "
+              f"{wall:.1f} s ({1e3 * wall / 9600:.2f} ms/signal); load avg "
+              f"{os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,239 @@
+"""The 7-DOF lumped-parameter model, its Newmark integrator and a prepared batch.
+
+Degrees of freedom (``q``, 7 of the 13 of DESIGN.md section 2)::
+
+    [x1, y1, phi1, x2, y2, phi2, phib]
+
+lateral bearing motions of pinion (1) and gear (2), their rotations about the nominal
+rigid motion driven by the motor angle theta_m(t), and the brake rotation. The axial
+and tilt DOFs of the 13-DOF model are left out: for a spur mesh whose load acts at
+mid-face the line-of-action vector has no axial or tilt terms, so those DOFs decouple
+exactly (K, M and C are block-diagonal) and do not reach the vertical acceleration.
+
+A helical pair adds the axial motions ``z1, z2`` (9 DOFs; axial bearing stiffness
+``pair.bearing_stiffness``): the mesh deflection is taken along the tooth normal,
+``cos(beta_b) (transverse deflection) + sin(beta_b) (z1 - z2)``, so the mesh force has the
+axial component ``F_n sin(beta_b)`` that loads the axial bearings, and the transverse
+component ``F_n cos(beta_b)``. (The tilts the axial force excites through its lever arm
+are left out.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._kernel import newmark_batch, newmark_batch_tables
+from ._slices import box
+from .faults import ToothFault
+from .geometry import GearPair
+from .profile_errors import ToothProfileErrors
+from .stiffness import _N_TABLE, _pair_table, fault_tables, helical_tables
+
+__all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
+           "make_batch", "warmup_time"]
+
+
+def system_matrices(pair: GearPair):
+    """Mass, constant stiffness, damping and line-of-action vector of the 7-DOF model.
+
+    Returns
+    -------
+    M, K0, C : ndarray (7, 7), or (9, 9) for a helical pair
+        Mass (kg, kg m^2), stiffness without the mesh, modal damping.
+    v : ndarray (7,) or (9,)
+        Mesh deflection along the line of action (the tooth normal) = v . q (m).
+    omega : ndarray (7,)
+        Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
+    """
+    m1, m2 = pair.masses
+    j1, j2 = pair.inertias
+    kt1, kt2 = pair.shaft_torsional_stiffness
+    kb = pair.bearing_stiffness
+    a = pair.transverse_pressure_angle
+    rb1, rb2 = pair.base_radius(pair.z_pinion), pair.base_radius(pair.z_gear)
+    M = np.diag([m1, m1, j1, m2, m2, j2, pair.inertia_brake])
+    K0 = np.zeros((7, 7))
+    for i in (0, 1, 3, 4):
+        K0[i, i] = kb
+    K0[2, 2] = kt1
+    K0[5, 5] += kt2
+    K0[6, 6] += kt2
+    K0[5, 6] = K0[6, 5] = -kt2
+    v = np.array([math.sin(a), math.cos(a), rb1, -math.sin(a), -math.cos(a), -rb2, 0.0])
+    if pair.is_helical:
+        bb = pair.base_helix_angle
+        M = np.diag(np.concatenate([np.diag(M), [m1, m2]]))
+        K0 = np.pad(K0, (0, 2))
+        K0[7, 7] = K0[8, 8] = kb
+        v = np.concatenate([math.cos(bb) * v, [math.sin(bb), -math.sin(bb)]])
+    # the mean mesh stiffness (slices keep the spur mean: the face average preserves it)
+    k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
+    K = K0 + k_mean * np.outer(v, v)
+    # modal damping on the mean system
+    L = np.linalg.cholesky(M)
+    Li = np.linalg.inv(L)
+    w2, psi = np.linalg.eigh(Li @ K @ Li.T)
+    phi = Li.T @ psi                          # mass-normalised modes
+    omega = np.sqrt(np.maximum(w2, 0.0))
+    C = M @ phi @ np.diag(2 * pair.damping_ratio * omega) @ phi.T @ M
+    return M, K0, C, v, omega
+
+
+@dataclass(frozen=True)
+class Integrator:
+    """Newmark (beta 1/4, gamma 1/2) update matrices for one pair and time step."""
+
+    B1: np.ndarray
+    B2: np.ndarray
+    B3: np.ndarray
+    w: np.ndarray
+    s: float
+    v: np.ndarray
+    c_load: np.ndarray
+    c_motor: np.ndarray
+    x_static: np.ndarray
+    coef: np.ndarray      # a0, a2, a3, a6, a7
+    omega_min: float
+
+
+def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
+    M, K0, C, v, omega = system_matrices(pair)
+    beta, gamma = 0.25, 0.5
+    a0 = 1 / (beta * dt ** 2)
+    a1 = gamma / (beta * dt)
+    a2 = 1 / (beta * dt)
+    a3 = 1 / (2 * beta) - 1
+    a4 = gamma / beta - 1
+    a5 = dt / 2 * (gamma / beta - 2)
+    a6 = dt * (1 - gamma)
+    a7 = gamma * dt
+    A = K0 + a0 * M + a1 * C
+    Ai = np.linalg.inv(A)
+    Ai = 0.5 * (Ai + Ai.T)
+    B1 = Ai @ (a0 * M + a1 * C)
+    B2 = Ai @ (a2 * M + a4 * C)
+    B3 = Ai @ (a3 * M + a5 * C)
+    w = Ai @ v
+    f_load = np.zeros(v.size)
+    f_load[6] = -1.0                      # brake torque opposes rotation (per N m)
+    ratio = pair.z_pinion / pair.z_gear
+    f_motor = np.zeros(v.size)
+    f_motor[:7] = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
+    k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
+    x_static = np.linalg.solve(K0 + k_mean * np.outer(v, v), f_load * load0)
+    return Integrator(B1, B2, B3, w, float(v @ w), v, Ai @ f_load, Ai @ f_motor, x_static,
+                      np.array([a0, a2, a3, a6, a7]), float(omega[omega > 0].min()))
+
+
+def warmup_time(pair: GearPair, integ: Integrator) -> float:
+    """Time (s) for the start transient of the slowest mode to decay to 1 %."""
+    # the start transient (from the static state under the mean mesh stiffness; small)
+    # of the slowest mode decays to 1 % of its start: SA error ~2e-5 relative for the
+    # paper pair (benchmarks/RESULTS.md, gearshot.sim section)
+    return 4.6 / (pair.damping_ratio * integ.omega_min)
+
+
+def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
+    """Per-signal tables over the contact position u of the faulty pair's stiffness and
+    displacement excitation (from the fault's hooks), and the faulty tooth index."""
+    n = len(faults)
+    kf = np.empty((n, _N_TABLE))
+    ef = np.zeros((n, _N_TABLE))
+    tooth = np.full(n, -1, dtype=np.int64)
+    healthy = _pair_table(pair, None)
+    for i, f in enumerate(faults):
+        if f is None or f.is_healthy:
+            kf[i] = healthy
+            continue
+        kf[i], ef[i] = fault_tables(pair, f)
+        tooth[i] = f.tooth % pair.z_gear
+    return kf, ef, tooth
+
+
+def _stack_errors(errs: list[ToothProfileErrors]):
+    return (np.stack([e.slope for e in errs]), np.stack([e.waviness for e in errs]),
+            np.stack([e.phase for e in errs]), np.stack([e.noise for e in errs]),
+            float(errs[0].n_waves))
+
+
+class Batch:
+    """Prepared per-signal tables and the integration state of a batch of signals."""
+
+    def __init__(self, pair, integ, faults, gear_errs, pin_errs):
+        self.pair, self.integ = pair, integ
+        self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
+        self.g = _stack_errors(gear_errs)
+        self.p = _stack_errors(pin_errs)
+        n = len(faults)
+        self.X = np.tile(integ.x_static, (n, 1))
+        self.V = np.zeros((n, integ.x_static.size))
+        self.A = np.zeros((n, integ.x_static.size))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+        """Advance over the given steps; return the vertical acceleration (g) of steps
+        ``rec_start ... rec_start + n_rec - 1``."""
+        pair, integ = self.pair, self.integ
+        out = np.empty((self.X.shape[0], n_rec))
+        newmark_batch(np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
+                      np.ascontiguousarray(load), _pair_table(pair, None), self.kf,
+                      self.ef, self.tooth, *self.g, *self.p, pair.contact_ratio,
+                      pair.z_gear, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
+                      integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
+                      rec_start, out)
+        return out
+
+
+class HelicalBatch(Batch):
+    """A batch of a helical pair: per-tooth tables of stiffness and error force over the
+    delay since a tooth pair's first contact (slice method, :mod:`._slices`)."""
+
+    def __init__(self, pair, integ, faults, gear_errs, pin_errs):
+        self.pair, self.integ = pair, integ
+        ea, eb = pair.contact_ratio, pair.overlap_ratio
+        self.span, self.k, _ = helical_tables(pair)
+        tau = np.linspace(0.0, self.span, self.k.size)
+        u = np.linspace(0.0, 1.0, _N_TABLE)
+        k_sp = _pair_table(pair, None)
+        n = len(faults)
+
+        def errors(errs):
+            teeth = np.arange(errs[0].slope.size)[:, None]
+            return np.stack([e(teeth, u[None, :]) for e in errs])
+
+        e_g, e_p = errors(gear_errs), errors(pin_errs)
+        self.fg = box(k_sp * e_g, ea, eb, 0.0, eb, tau)
+        self.fp = box(k_sp * e_p, ea, eb, 0.0, eb, tau)
+        self.fpf = self.fp.copy()
+        self.kf = np.tile(self.k, (n, 1))
+        self.tooth = np.full(n, -1, dtype=np.int64)
+        for i, f in enumerate(faults):
+            if f is None or f.is_healthy:
+                continue
+            t = f.tooth % pair.z_gear
+            _, self.kf[i], bands = helical_tables(pair, f)
+            self.tooth[i] = t
+            for lo, hi, dk, kd in bands:
+                self.fg[i, t] += box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau)
+                self.fpf[i] += box(dk * e_p[i], ea, eb, lo, hi, tau)
+        self.X = np.tile(integ.x_static, (n, 1))
+        self.V = np.zeros((n, integ.x_static.size))
+        self.A = np.zeros((n, integ.x_static.size))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+        integ = self.integ
+        out = np.empty((self.X.shape[0], n_rec))
+        newmark_batch_tables(
+            np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
+            np.ascontiguousarray(load), self.k, self.kf, self.tooth, self.fg, self.fp,
+            self.fpf, self.span, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
+            integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef, rec_start, out)
+        return out
+
+
+def make_batch(pair, integ, faults, gear_errs, pin_errs) -> Batch:
+    """A :class:`Batch` (spur) or :class:`HelicalBatch` for ``pair``."""
+    cls = HelicalBatch if pair.is_helical else Batch
+    return cls(pair, integ, faults, gear_errs, pin_errs)

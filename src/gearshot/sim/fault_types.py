@@ -1,0 +1,323 @@
+"""Fault types beyond the full tooth face fault, each with a size in [0, 1].
+
+=================  ===========================================================================
+name               geometry (size y: 0 = healthy ... 1)
+=================  ===========================================================================
+``"ftff"``         :class:`~gearshot.sim.FullToothFaceFault`: the flank cut by a circular arc
+                   over the whole face width; y = cut width along the active profile / its
+                   width (1: the whole active profile).
+``"partial_face"`` :class:`PartialFaceFault`: the same arc cut (``profile_size`` of the
+                   active profile, default 0.6) over part of the face width; y = the cut
+                   band's width / the face width (1: an FTFF of size ``profile_size``).
+``"breakage"``     :class:`ToothBreakage`: a chipped corner: the tooth above a break line is
+                   lost; the lost height at face position zeta (0 ... 1) is
+                   ``H clip(y (1 + c) - c zeta, 0, 1)`` (H: height of the tooth above
+                   its lowest contact point, c: ``obliqueness``), so a small y is a corner
+                   chip at one face end, y = 0.5 the full height at that end tapering to
+                   nothing at the other, and y = 1 the whole tooth lost down to the lowest
+                   contact point; what lies below never touches the mating tooth, so y = 1
+                   acts as a missing tooth.
+``"destruction"``  :class:`ToothDestruction`: surface destruction (pitting / wear): a band
+                   of the active profile, centred at ``center``, over the whole face,
+                   pitted with craters ``y depth`` deep (the damage deepens as it
+                   spreads) and bearing only ``1 - contact_loss`` of the contact line;
+                   y = the band's width / the active profile's (1: the whole active profile
+                   destroyed, pits ``depth`` deep).
+=================  ===========================================================================
+
+How each acts on the pair (hooks of :class:`~gearshot.sim.ToothFault`): the partial face
+fault and the breakage change only the slices of their face band
+(:meth:`~gearshot.sim.ToothFault.face_bands`, the slice method); a lost tip takes the
+slice's contact away where the gear contact would lie above the break
+(:meth:`~gearshot.sim.ToothFault.stiffness_scale` = 0, so the neighbouring pairs carry
+the load); the destroyed band lowers the pair stiffness by the lost contact share and adds
+a displacement excitation of its craters (raised-cosine pits 5 % of the active profile
+wide), tapered at the band's edges where the mating flank bridges onto the intact surface.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._errors import GearshotError
+from .._validation import check_in_range, check_int
+from .faults import FullToothFaceFault, ToothFault
+from .geometry import GearPair
+
+__all__ = ["PartialFaceFault", "ToothBreakage", "ToothDestruction", "FAULT_TYPES",
+           "fault_of_type"]
+
+
+@dataclass(frozen=True)
+class PartialFaceFault(ToothFault):
+    """A flank cut (as the FTFF's circular arc) over part of the face width.
+
+    Parameters
+    ----------
+    size : float
+        y in [0, 1]: width of the cut band / face width.
+    profile_size : float
+        Extent of the cut along the active profile (the FTFF size), (0, 1].
+    center, depth : float
+        Centre along the active profile and depth coefficient of the cut (as the FTFF).
+    face_start : float
+        Face position (0 ... 1) where the band starts; it spans
+        ``face_start ... face_start + size`` (<= 1).
+    tooth : int
+        Faulty gear tooth.
+    """
+
+    size: float = 0.0
+    profile_size: float = 0.6
+    center: float = 0.5
+    depth: float = 0.5
+    face_start: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_in_range(self.size, "size", 0.0, 1.0)
+        check_in_range(self.face_start, "face_start", 0.0, 1.0)
+        if self.face_start + self.size > 1 + 1e-12:
+            raise GearshotError(f"a partial face fault of size {self.size!r} starting at "
+                                f"face_start={self.face_start!r} leaves the face; choose "
+                                f"face_start <= {1 - self.size:.4g}")
+        _ = self.transverse                     # validates profile_size, center, depth
+
+    @property
+    def transverse(self) -> FullToothFaceFault:
+        """The cut of the transverse section inside the band."""
+        return FullToothFaceFault(tooth=self.tooth, size=self.profile_size,
+                                  center=self.center, depth=self.depth)
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.size <= 0.0 or self.profile_size <= 0.0
+
+    def face_bands(self, pair: GearPair) -> tuple:
+        if self.is_healthy:
+            return ()
+        z0 = self.face_start
+        return ((z0, min(z0 + self.size, 1.0), self.transverse),)
+
+
+@dataclass(frozen=True)
+class _TipLoss(ToothFault):
+    """The transverse section of a broken tooth: everything above ``height`` (m, measured
+    down from the tip circle) is gone."""
+
+    height: float = 0.0
+
+    scales_contact = True
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.height <= 0.0
+
+    def affected_range(self, pair: GearPair):
+        return 1.0, np.array([])     # the compliance below the break is unchanged
+
+    def cut_fraction(self, pair: GearPair) -> float:
+        """Gear roll fraction of the break radius (contact above it is lost)."""
+        z = pair.z_gear
+        rb = pair.base_radius(z)
+        r_cut = pair.tip_radius(z) - self.height
+        _, (l_lo, l_hi) = pair.roll_limits
+        if r_cut <= rb:
+            return -1.0
+        return (math.sqrt(r_cut ** 2 - rb ** 2) - l_lo) / (l_hi - l_lo)
+
+    def stiffness_scale(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=float)
+        if self.is_healthy:
+            return np.ones_like(s)
+        return np.where(s <= self.cut_fraction(pair), 1.0, 0.0)
+
+
+@dataclass(frozen=True)
+class ToothBreakage(ToothFault):
+    """Tooth breakage / chipped tip: a corner of the tooth lost above an oblique break
+    line (module docstring for the geometry).
+
+    Parameters
+    ----------
+    size : float
+        y in [0, 1]; 1 = the whole tooth lost down to the lowest contact point (acts as a
+        missing tooth).
+    obliqueness : float
+        c > 0: how fast the lost height falls across the face (per face width, in tooth
+        heights); the break reaches across the face at y >= c / (1 + c).
+    n_bands : int
+        Face bands the break is resolved into (piecewise-constant height).
+    tooth : int
+        Faulty gear tooth.
+    """
+
+    size: float = 0.0
+    obliqueness: float = 1.0
+    n_bands: int = 16
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_in_range(self.size, "size", 0.0, 1.0)
+        check_in_range(self.obliqueness, "obliqueness", 0.0, 100.0, low_inclusive=False)
+        check_int(self.n_bands, "n_bands", minimum=1, maximum=256)
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.size <= 0.0
+
+    def lost_height(self, pair: GearPair, zeta) -> np.ndarray:
+        """Lost height (m, from the tip) at face positions ``zeta`` (0 ... 1)."""
+        c = self.obliqueness
+        z = pair.z_gear
+        _, (l_lo, _) = pair.roll_limits
+        height = pair.tip_radius(z) - math.hypot(pair.base_radius(z), l_lo)
+        frac = np.clip(self.size * (1 + c) - c * np.asarray(zeta, dtype=float), 0.0, 1.0)
+        return height * frac
+
+    def face_bands(self, pair: GearPair) -> tuple:
+        if self.is_healthy:
+            return ()
+        edges = np.linspace(0.0, 1.0, self.n_bands + 1)
+        # band height: the exact mean of the lost height over the band
+        fine = np.linspace(0.0, 1.0, 32 * self.n_bands + 1)
+        h = self.lost_height(pair, 0.5 * (fine[1:] + fine[:-1])).reshape(self.n_bands, 32)
+        out = []
+        for z0, z1, hb in zip(edges[:-1], edges[1:], h.mean(axis=1)):
+            if hb > 0:
+                out.append((float(z0), float(z1), _TipLoss(tooth=self.tooth,
+                                                           height=float(hb))))
+        return tuple(out)
+
+
+@dataclass(frozen=True)
+class _DamagedBand(ToothFault):
+    """The transverse section of surface destruction: a band [s0, s1] of the active
+    profile, ``depth`` deep, bearing ``1 - contact_loss`` of its contact line."""
+
+    s0: float = 0.0
+    s1: float = 0.0
+    depth: float = 0.0
+    contact_loss: float = 0.0
+    ramp: float = 0.03
+    pit: float = 0.05
+
+    scales_contact = True
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.s1 <= self.s0
+
+    def affected_range(self, pair: GearPair):
+        return 1.0, np.array([])     # a surface band: the tooth section is unchanged
+
+    def _inside(self, s):
+        """Smooth 0 ... 1 indicator of the band (linear ramps ``ramp`` wide inside)."""
+        s = np.asarray(s, dtype=float)
+        w = min(self.ramp, 0.5 * (self.s1 - self.s0))
+        if w <= 0:
+            return np.zeros_like(s)
+        return np.clip(np.minimum(s - self.s0, self.s1 - s) / w, 0.0, 1.0)
+
+    def stiffness_scale(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        return 1.0 - self.contact_loss * self._inside(s)
+
+    def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        # pits: craters ``pit`` wide (fraction of the active profile), ``depth`` deep
+        s = np.asarray(s, dtype=float)
+        pits = 0.5 - 0.5 * np.cos(2 * np.pi * (s - self.s0) / self.pit)
+        return -self.depth * self._inside(s) * pits
+
+
+@dataclass(frozen=True)
+class ToothDestruction(ToothFault):
+    """Surface destruction (pitting, wear) in a band along the profile, whole face.
+
+    Parameters
+    ----------
+    size : float
+        y in [0, 1]: the band's width along the active profile / the active profile.
+    center : float
+        Band centre along the active profile (0 = lowest contact point, 1 = tip); the band
+        is kept inside the profile (shifted when it would leave it).
+    depth : float
+        Crater depth at size 1, m (default 30 um); a size-y band is ``y depth`` deep.
+    contact_loss : float
+        Share of the contact line lost in the band, [0, 1).
+    tooth : int
+        Faulty gear tooth.
+    """
+
+    size: float = 0.0
+    center: float = 0.5
+    depth: float = 30e-6
+    contact_loss: float = 0.5
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_in_range(self.size, "size", 0.0, 1.0)
+        check_in_range(self.center, "center", 0.0, 1.0)
+        check_in_range(self.depth, "depth", 0.0, 1e-3)
+        check_in_range(self.contact_loss, "contact_loss", 0.0, 1.0, high_inclusive=False)
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.size <= 0.0
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """(start, end) of the band along the active profile."""
+        lo = min(max(self.center - 0.5 * self.size, 0.0), 1.0 - self.size)
+        return lo, lo + self.size
+
+    def face_bands(self, pair: GearPair) -> tuple:
+        if self.is_healthy:
+            return ()
+        s0, s1 = self.window
+        return ((0.0, 1.0, _DamagedBand(tooth=self.tooth, s0=s0, s1=s1,
+                                        depth=self.size * self.depth,
+                                        contact_loss=self.contact_loss)),)
+
+
+def _ftff(size, *, tooth=0, center=0.5, depth=0.5, **kw):
+    if size <= 0:
+        return FullToothFaceFault(tooth=tooth, size=0.0, center=center, depth=depth, **kw)
+    c = min(max(center, 0.5 * size), 1.0 - 0.5 * size)   # keep the cut on the profile
+    return FullToothFaceFault(tooth=tooth, size=size, center=c, depth=depth, **kw)
+
+
+#: name -> constructor ``f(size, **options)`` of the fault types (keep the order: a type's
+#: position is its code in database seeds).
+FAULT_TYPES = {
+    "ftff": _ftff,
+    "partial_face": lambda size, **kw: PartialFaceFault(size=size, **kw),
+    "breakage": lambda size, **kw: ToothBreakage(size=size, **kw),
+    "destruction": lambda size, **kw: ToothDestruction(size=size, **kw),
+}
+
+
+def check_fault_type(name) -> str:
+    """Validate a fault type name."""
+    if not isinstance(name, str) or name not in FAULT_TYPES:
+        raise GearshotError(f"fault_type must be one of {sorted(FAULT_TYPES)}; got {name!r}")
+    return name
+
+
+def fault_of_type(name: str, size: float, **options) -> ToothFault:
+    """A fault of type ``name`` (:data:`FAULT_TYPES`) and size ``size`` in [0, 1].
+
+    Options go to the type's class (e.g. ``tooth``, ``center``, ``depth``).
+    """
+    check_fault_type(name)
+    try:
+        size = float(size)
+    except (TypeError, ValueError):
+        raise GearshotError(f"size must be a real number; got {size!r}") from None
+    check_in_range(size, "size", 0.0, 1.0)
+    try:
+        return FAULT_TYPES[name](size, **options)
+    except TypeError as exc:
+        raise GearshotError(f"bad option for fault_type {name!r}: {exc}") from None
