@@ -79,7 +79,7 @@ def check_writable(path: str | os.PathLike, name: str, *, folder: bool = False) 
         if folder and not path.is_dir():
             raise GearshotError(f"{name} {str(path)!r} must be a folder; it is a file")
         if not folder and not path.is_file():
-            kind = "a folder" if path.is_dir() else "not a regular file"
+            kind = "a folder" if path.is_dir() else "a device or other special file"
             raise GearshotError(f"{name} {str(path)!r} must be a regular file; it is {kind}")
     start = path if (folder and path.is_dir()) else path.parent
     parent = start
