@@ -158,8 +158,9 @@ def select_channels(raw: RawFile, *, accel: Any, tacho: Any, channels: Any
                 accel_name = names[0]
             else:
                 raise GearshotError(
-                    f"{str(raw.path)!r}: cannot tell which channel is the acceleration; pass "
-                    f"accel=<name or index>; available: {names}")
+                    f"{str(raw.path)!r}: cannot tell which channel is the acceleration; name it "
+                    f"'acceleration' in the file (API: Recording.read(path, accel=<name or "
+                    f"index>)); available: {names}")
     else:
         accel_name = _resolve(raw, "accel", accel, aliases)
 
@@ -201,8 +202,10 @@ def reconcile_fs(raw: RawFile, fs: Any) -> float:
         file_fs = float(file_fs)
     if fs is None:
         if file_fs is None:
-            raise GearshotError(f"{str(raw.path)!r} does not state its sampling rate; pass "
-                                f"fs=<Hz>")
+            side = sidecar_path(raw.path).name
+            raise GearshotError(f"{str(raw.path)!r} does not state its sampling rate: add a "
+                                f"'time' column, or a sidecar {side!r} holding "
+                                f"{{\"fs\": <Hz>}} (API: Recording.read(path, fs=<Hz>))")
         return file_fs
     if isinstance(fs, bool) or not isinstance(fs, (int, float, np.number)) or not (
             math.isfinite(fs) and fs > 0):
