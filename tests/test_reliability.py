@@ -20,6 +20,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -122,9 +123,54 @@ def test_file_size_limit_leaves_nothing(tmp_path):
     assert not list(tmp_path.iterdir())
 
 
+class _FsizeLimit:
+    """Lower this process's soft file-size limit (Python ignores SIGXFSZ: writes fail EFBIG)."""
+
+    def __init__(self, limit):
+        self.limit = limit
+
+    def __enter__(self):
+        self.old = resource.getrlimit(resource.RLIMIT_FSIZE)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (self.limit, self.old[1]))
+
+    def __exit__(self, *exc):
+        resource.setrlimit(resource.RLIMIT_FSIZE, self.old)
+
+
+@pytest.mark.parametrize("fmt", ["h5", "csv", "mat", "wav"])
+def test_recording_write_under_file_size_limit(tmp_path, fmt):
+    from gearshot.io import Recording
+
+    rec = Recording(np.random.default_rng(0).standard_normal(50_000), None, 1000.0)
+    with _FsizeLimit(20_000), pytest.raises(GearshotError, match=f"rec.{fmt}"):
+        rec.write(tmp_path / f"rec.{fmt}")
+    assert not list(tmp_path.iterdir())
+
+
+def test_database_under_file_size_limit_then_resume(tmp_path):
+    from gearshot.sim import build_database, load_database
+
+    kw = dict(DB_KW, n_points=512, n_healthy=2, n_faulty=2)
+    with _FsizeLimit(3_000), pytest.raises(GearshotError, match="s0_l0_g0.zarr"):
+        build_database(tmp_path / "db", **kw)
+    assert not list((tmp_path / "db" / "blocks").iterdir())   # no block, no temporary
+    build_database(tmp_path / "db", **kw)
+    assert load_database(tmp_path / "db", speed=15, load=10).sa.shape == (8, 512)
+
+
 # --------------------------------------------------------------------- damaged databases
 DB_KW = dict(speeds=[15], loads=[10], grades=[7, 8], n_healthy=1, n_faulty=2, seed=3,
              n_points=64, client=False, progress=False)
+
+
+def _fake_simulate_sa(pair, *, speed, load, grade, fault_sizes, n_points, rng):
+    """Stands in for the simulator (no numba compile): one deterministic row per seed."""
+    return np.stack([np.random.default_rng(s).standard_normal(n_points) for s in rng])
+
+
+@pytest.fixture(autouse=True)
+def fast_simulator(monkeypatch):
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
 
 
 @pytest.fixture(scope="module")
@@ -132,7 +178,9 @@ def small_db(tmp_path_factory):
     from gearshot.sim import build_database, load_database
 
     store = tmp_path_factory.mktemp("db") / "db"
-    build_database(store, **DB_KW)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+        build_database(store, **DB_KW)
     return store, load_database(store, speed=15, load=10).sa.values
 
 
@@ -386,8 +434,15 @@ def test_fuzz_covers_every_public_function():
 
 
 # ---------------------------------------------------------------- command line, failures
+_HOME = None
+
+
 def _env(**extra):
-    return dict(os.environ, PYTHONPATH=str(SRC), GEARSHOT_DATA=extra.pop("data", "/nonexistent"),
+    global _HOME
+    if _HOME is None:
+        import tempfile
+        _HOME = tempfile.mkdtemp(prefix="gearshot-reliability-")
+    return dict(os.environ, PYTHONPATH=str(SRC), GEARSHOT_DATA=extra.pop("data", _HOME),
                 **extra)
 
 
@@ -435,15 +490,19 @@ def predict_args(campaign, db, out):
             "--out", out]
 
 
-@pytest.mark.parametrize("case", ["dev-full", "parent-is-file", "out-is-folder",
-                                  "missing-db"])
-def test_cli_predict_bad_outputs_fail_early(campaign, tmp_path, case):
+DUMMY = (None, pd.DataFrame({"path": ["/nonexistent/h.h5", "/nonexistent/f.h5"],
+                             "fault_size": [0.0, 0.5]}))
+
+
+@pytest.mark.parametrize("case", ["dev-full", "parent-is-file", "out-is-folder"])
+def test_cli_predict_bad_outputs_fail_early(tmp_path, case):
+    """Checked before anything is read or fitted (the recordings here do not even exist)."""
     (tmp_path / "file").write_text("x")
     out = {"dev-full": "/dev/full", "parent-is-file": tmp_path / "file" / "p.csv",
-           "out-is-folder": tmp_path, "missing-db": tmp_path / "p.csv"}[case]
-    res = run_cli(predict_args(campaign, tmp_path / "no-db", out))
+           "out-is-folder": tmp_path}[case]
+    res = run_cli(predict_args(DUMMY, tmp_path / "no-db", out))
     words = {"dev-full": ["/dev/full"], "parent-is-file": ["file"],
-             "out-is-folder": [str(tmp_path)], "missing-db": ["no-db"]}[case]
+             "out-is-folder": [str(tmp_path)]}[case]
     one_line_error(res, *words)
     assert (tmp_path / "file").read_text() == "x"
     assert not (tmp_path / "p.csv").exists() and not leftovers(tmp_path)
@@ -466,14 +525,14 @@ def _unlock(folder: Path) -> None:
 
 
 @pytest.mark.parametrize("command", ["rig", "predict", "simulate"])
-def test_cli_read_only_folder(tmp_path, command, campaign):
+def test_cli_read_only_folder(tmp_path, command):
     locked = tmp_path / "locked"
     locked.mkdir()
     _lock(locked)
     try:
         args = {"rig": ["rig", locked / "camp", "--duration", "8", "--healthy", "1",
                         "--repetitions", "0"],
-                "predict": predict_args(campaign, tmp_path / "no-db", locked / "p.csv"),
+                "predict": predict_args(DUMMY, tmp_path / "no-db", locked / "p.csv"),
                 "simulate": ["simulate", "--store", locked / "db", "--grade", "7"]}[command]
         one_line_error(run_cli(args), "locked")
         assert not list(locked.iterdir())
@@ -481,6 +540,7 @@ def test_cli_read_only_folder(tmp_path, command, campaign):
         _unlock(locked)
 
 
+@pytest.mark.slow
 def test_cli_rig_file_size_limit_leaves_nothing(tmp_path):
     res = run_cli(["rig", tmp_path / "camp", "--duration", "8", "--healthy", "1",
                    "--repetitions", "0"], preexec_fn=_limit_fsize(100_000))
@@ -489,6 +549,7 @@ def test_cli_rig_file_size_limit_leaves_nothing(tmp_path):
     assert not camp.exists() or not any(camp.iterdir())
 
 
+@pytest.mark.slow
 def test_cli_simulate_file_size_limit_then_resume(tmp_path):
     store = tmp_path / "db"
     args = ["simulate", "--store", store, "--speed", "15", "--load", "10", "--grade", "7",
@@ -523,6 +584,7 @@ def test_cli_bad_command_lines(tmp_path, args, words):
     assert not leftovers(tmp_path)
 
 
+@pytest.mark.slow
 def test_cli_damaged_database_is_named(small_db, tmp_path, campaign):
     store = _copy(small_db[0], tmp_path)
     (store / "blocks" / "s0_l0_g0.zarr" / "sa" / "c" / "0" / "0").write_bytes(b"junk")

@@ -162,9 +162,9 @@ def demo(
     seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
 ) -> None:
     """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
+    _early(out, "--out", folder=True)
     from .demo import run_demo
 
-    _early(out, "--out", folder=True)
     run_demo(out, seed=seed)
 
 
@@ -186,13 +186,14 @@ def simulate(
                                 "--scheduler is given."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
-    from ..sim import GearPair, build_database, default_database_path
+    from .._paths import data_home
 
-    store = store or default_database_path()
+    store = store or data_home(create=False) / "databases" / "sim-db"  # default_database_path
     _early(store, "--store", folder=True)
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
+    from ..sim import GearPair, build_database
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
     n_blocks = len(speeds) * len(loads) * len(grade)
     client = _client(scheduler, workers, needed=n_blocks > 1)
@@ -269,9 +270,6 @@ def experiment_simulated(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
-    from ..experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
-    from ..sim import GearPair, build_database, default_database_path
-
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     _early(json_out, "--json")
@@ -280,6 +278,9 @@ def experiment_simulated(
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
+    from ..experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
+    from ..sim import GearPair, build_database, default_database_path
+
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if full else (speed, load)
     tag = "paper" if full else "-".join(f"{s:g}" for s in speeds) + "rps-" + \
         "-".join(f"{ld:g}" for ld in loads) + "Nm"
@@ -332,10 +333,6 @@ def experiment_rig(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
-    from ..experiments import RIG_VARIANTS, rig_experiment, summarize
-    from ..sim import GearPair, build_database, default_database_path, load_database
-    from ..transfer import TransferFunctionBank
-
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     _check_duration(duration, speed)
@@ -347,6 +344,10 @@ def experiment_rig(
     _early(out, "--out", folder=True)
     _early(store, "--store", folder=True)
     _early(campaign, "--campaign", folder=True)
+    from ..experiments import RIG_VARIANTS, rig_experiment, summarize
+    from ..sim import GearPair, build_database, default_database_path, load_database
+    from ..transfer import TransferFunctionBank
+
     store = store or default_database_path(
         f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
     client = _client(scheduler, workers, needed=True)
@@ -432,11 +433,11 @@ def report(
     out: Path = typer.Option(Path("gearshot-report"), "--out"),
 ) -> None:
     """Figures and a Markdown report from a results JSON."""
-    from .figures import report_from_json
-
     if not results.is_file():
         raise GearshotError(f"results file {str(results)!r} does not exist")
     _early(out, "--out", folder=True)
+    from .figures import report_from_json
+
     path = report_from_json(results, out)
     typer.echo(f"report: {path}")
 
