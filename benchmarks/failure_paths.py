@@ -170,11 +170,11 @@ def main() -> None:
     from hypothesis import HealthCheck, given, settings
 
     n_fuzz = n_fuzz_bad = 0
-    for name, (func, args_st, kwargs_st) in rel.FUZZ.items():
+    def fuzz(name, func, args_st, kwargs_st):
         @settings(max_examples=120, deadline=None, derandomize=True, database=None,
                   suppress_health_check=list(HealthCheck))
         @given(args=args_st, kwargs=kwargs_st)
-        def run(args, kwargs, func=func, name=name):
+        def run(args, kwargs):
             nonlocal n_fuzz, n_fuzz_bad
             n_fuzz += 1
             try:
@@ -183,6 +183,9 @@ def main() -> None:
                 n_fuzz_bad += 1
                 print(f"fuzz {name}: {type(exc).__name__}: {str(exc)[:120]}")
         run()
+
+    for name, (func, args_st, kwargs_st) in rel.FUZZ.items():
+        fuzz(name, func, args_st, kwargs_st)
 
     if immutable:
         subprocess.run(["chattr", "-i", str(locked)], capture_output=True)

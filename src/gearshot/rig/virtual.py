@@ -277,7 +277,11 @@ class VirtualRig:
                 rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
                                   repetition=r)
                 name = self.file_name(speed, load, y, r)
-                rec.write(staging / name, dtype=dtype)
+                try:
+                    rec.write(staging / name, dtype=dtype)
+                except GearshotError as exc:  # name the destination, not the staging copy
+                    raise GearshotError(str(exc).replace(str(staging / name),
+                                                         str(folder / name))) from None
                 rows.append({"path": name, "speed": speed, "load": load, "fault_size": y,
                              "repetition": r})
             new = pd.DataFrame(rows, columns=INDEX_COLUMNS)
