@@ -228,10 +228,8 @@ def staging_dir(folder: str | os.PathLike) -> Iterator[Path]:
     except OSError as exc:
         raise _fail(folder, exc) from None
     try:
-        yield staging
-    except (OSError, RuntimeError) as exc:
-        if not _is_io_error(exc):
-            raise
+        yield staging      # the writes inside use atomic_path, which names failures
+    except OSError as exc:
         raise _fail(folder, exc) from exc
     finally:
         shutil.rmtree(staging, ignore_errors=True)
