@@ -8,8 +8,8 @@ Layout of a store (a folder)::
 
 A block is written to a temporary folder beside its final name and renamed when complete
 (:func:`gearshot._atomic.atomic_dir`), so a block is either absent or whole; an interrupted
-build resumes by skipping the blocks present. Each block carries ``gearshot-block.json``: the
-size and CRC-32 of every other file in it and the build's manifest (an attribute
+build resumes by skipping the blocks present. Each block carries a checksum list: the size
+and CRC-32 of every other file in it and the build's manifest (the attribute
 ``gearshot_block`` of the block's root ``zarr.json``). Every read checks a block
 against it (a missing or overwritten chunk is named, never read as NaN), and a build
 rebuilds exactly the blocks found damaged, reusing the rest; a lost ``manifest.json`` is
