@@ -33,7 +33,7 @@ import numpy as np
 import scipy.fft
 
 from ._errors import GearshotError
-from ._validation import as_signal_array, check_int, check_positive
+from ._validation import as_signal_array, check_int, check_positive, describe, finite_result
 from .signal.level import rms as _rms
 from .signal.orders import check_mesh_order, mesh_band_orders
 
@@ -209,7 +209,13 @@ def _check_names(names):
         return PAPER_FEATURES
     if isinstance(names, str):
         names = (names,)
-    names = tuple(names)
+    try:
+        names = tuple(names)
+    except TypeError:
+        raise GearshotError(f"names must be a feature name or a sequence of them; got "
+                            f"{describe(names)}") from None
+    if not all(isinstance(n, str) for n in names):
+        raise GearshotError(f"names must be feature names (str); got {describe(names)}")
     if not names:
         raise GearshotError("names must list at least one feature; got an empty list")
     unknown = [n for n in names if n not in _REGISTRY]
@@ -219,6 +225,7 @@ def _check_names(names):
     return names
 
 
+@finite_result
 def na4_baseline_variance(healthy_sa, mesh_order):
     """Mean variance of the residual signal of healthy SAs: NA4's baseline.
 
@@ -238,6 +245,7 @@ def na4_baseline_variance(healthy_sa, mesh_order):
     return float(np.mean(centred ** 2))
 
 
+@finite_result
 def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None):
     """Condition indicators of synchronous averages.
 
@@ -263,7 +271,7 @@ def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_vari
     names = _check_names(names)
     sa = as_signal_array(sa, "sa", min_length=4)
     mesh_order = check_mesh_order(mesh_order, sa.shape[-1])
-    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=sa.shape[-1])
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
     parts = _Parts(sa, mesh_order, n_sidebands, baseline_variance)

@@ -92,10 +92,11 @@ class Recording:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        acc = as_signal_array(self.acceleration, "acceleration", max_ndim=1, min_length=2)
+        acc = as_signal_array(self.acceleration, "acceleration", max_ndim=1, min_length=2,
+                              max_abs=None)
         set_(self, "acceleration", acc)
         if self.tacho is not None:
-            tac = as_signal_array(self.tacho, "tacho", max_ndim=1)
+            tac = as_signal_array(self.tacho, "tacho", max_ndim=1, max_abs=None)
             if tac.shape != acc.shape:
                 raise GearshotError(f"tacho must have as many samples as acceleration "
                                     f"({acc.size}); got {tac.size}")
