@@ -70,10 +70,10 @@ def test_1_zipped_whitespace_text_is_read_as_it_comes(spur, spur_rec):
     assert abs(spur_rec.acceleration[1].mean()) < 1e-9
     assert spur_rec.tacho[0] == pytest.approx(float(first[2]))
     # without a machine: no silent guess, a clear error naming the parameter
-    with pytest.raises(GearshotError, match=r"cannot tell which channel is the acceleration; "
-                                            r"pass accel="):
+    with pytest.raises(GearshotError, match=r"cannot tell which channel is the acceleration;"
+                                            r".*accel=<name or index>"):
         Recording.read(phm_file("spur2_30hz_High_1.zip"), fs=FS)
-    with pytest.raises(GearshotError, match="pass fs="):
+    with pytest.raises(GearshotError, match="fs="):
         Recording.read(phm_file("spur2_30hz_High_1.zip"), accel=0, tacho=2)
 
 

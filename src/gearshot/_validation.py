@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import functools
 import numbers
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -17,7 +19,18 @@ __all__ = [
     "check_in_range",
     "check_increasing",
     "describe",
+    "finite_result",
+    "MAX_ABS",
+    "MAX_POINTS",
 ]
+
+#: Largest magnitude accepted in a signal: its square, sums of squares over millions of
+#: samples and FFTs stay far from float64 overflow (1.8e308). Physical data never come near.
+MAX_ABS = 1e100
+#: Largest length/size argument (points per cycle, FFT length, ...): 16 Mi points.
+MAX_POINTS = 1 << 24
+
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 
 def describe(value: Any) -> str:
@@ -50,6 +63,7 @@ def as_signal_array(
     max_ndim: int | None = None,
     min_length: int = 1,
     allow_complex: bool = False,
+    max_abs: float | None = MAX_ABS,
 ) -> np.ndarray:
     """Convert ``x`` to a finite float (or complex) array with signals along the last axis.
 
@@ -65,6 +79,9 @@ def as_signal_array(
         Minimum length of the last axis.
     allow_complex : bool
         Keep complex input complex; otherwise complex input is an error.
+    max_abs : float or None
+        Largest accepted magnitude (default :data:`MAX_ABS`, which keeps squares and sums
+        far from overflow); ``None`` for containers that only store values.
     """
     try:
         arr = np.asarray(x)
@@ -92,7 +109,40 @@ def as_signal_array(
             f"{name} must have at least {min_length} samples along its last axis; "
             f"got {arr.shape[-1]}")
     check_finite(arr, name)
+    peak = float(np.max(np.abs(arr)))
+    if max_abs is not None and peak > max_abs:
+        raise GearshotError(f"{name} holds a value of magnitude {peak:.3g}; values up to "
+                            f"{max_abs:g} are accepted (rescale the units)")
     return arr
+
+
+def _all_finite(out: Any) -> bool:
+    if isinstance(out, tuple):
+        return all(_all_finite(o) for o in out)
+    if isinstance(out, (np.ndarray, np.generic, float, complex)):
+        arr = np.asarray(out)
+        return not np.issubdtype(arr.dtype, np.inexact) or bool(np.all(np.isfinite(arr)))
+    return True
+
+
+def finite_result(func: _F) -> _F:
+    """Decorator: run ``func`` without floating-point warnings and refuse a non-finite result.
+
+    Inputs are finite and bounded by :data:`MAX_ABS`, so a NaN or inf in the result means an
+    overflow (e.g. an 8th moment of large values) or a degenerate input (a constant signal
+    where a ratio needs a spread); either is a :class:`GearshotError`, never a silent NaN.
+    """
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with np.errstate(all="ignore"):
+            out = func(*args, **kwargs)
+        if not _all_finite(out):
+            raise GearshotError(
+                f"{func.__name__} gives non-finite values for this input: an overflow "
+                f"(rescale the input to smaller values) or a degenerate input (e.g. a "
+                f"constant signal, whose moment ratios are 0/0)")
+        return out
+    return wrapper  # type: ignore[return-value]
 
 
 def check_int(value: Any, name: str, *, minimum: int | None = None,

@@ -33,7 +33,7 @@ import numpy as np
 import scipy.fft
 
 from ._errors import GearshotError
-from ._validation import as_signal_array, check_int, check_positive
+from ._validation import as_signal_array, check_int, check_positive, describe, finite_result
 from .signal.level import rms as _rms
 from .signal.orders import check_mesh_orders, mesh_band_orders
 
@@ -213,7 +213,13 @@ def _check_names(names):
         return PAPER_FEATURES
     if isinstance(names, str):
         names = (names,)
-    names = tuple(names)
+    try:
+        names = tuple(names)
+    except TypeError:
+        raise GearshotError(f"names must be a feature name or a sequence of them; got "
+                            f"{describe(names)}") from None
+    if not all(isinstance(n, str) for n in names):
+        raise GearshotError(f"names must be feature names (str); got {describe(names)}")
     if not names:
         raise GearshotError("names must list at least one feature; got an empty list")
     unknown = [n for n in names if n not in _REGISTRY]
@@ -239,6 +245,7 @@ def _mesh_arg(mesh_order, n):
     return orders if len(orders) > 1 else orders[0]
 
 
+@finite_result
 def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS):
     """Mean variance of the residual signal of healthy SAs: NA4's baseline.
 
@@ -262,6 +269,7 @@ def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS)
     return float(np.mean(centred ** 2))
 
 
+@finite_result
 def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None,
                      shaft_orders=_SHAFT_ORDERS):
     """Condition indicators of synchronous averages.
@@ -294,7 +302,7 @@ def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_vari
     sa = as_signal_array(sa, "sa", min_length=4)
     mesh_order = _mesh_arg(mesh_order, sa.shape[-1])
     shaft_orders = _check_shaft_orders(shaft_orders, sa.shape[-1])
-    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=sa.shape[-1])
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
     parts = _Parts(sa, mesh_order, n_sidebands, baseline_variance, shaft_orders)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
+import os
 import sys
 from pathlib import Path
 from typing import List, Optional
@@ -10,6 +12,7 @@ from typing import List, Optional
 import typer
 
 from .. import __version__
+from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
 
 app = typer.Typer(
@@ -62,10 +65,94 @@ def _client(scheduler: Optional[str], workers: int, *, needed: bool):
 def _write_json(path: Optional[Path], payload: dict) -> None:
     if path is None:
         return
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(json.dumps(payload, indent=2, default=float))
-    tmp.replace(path)
+    write_json_atomic(payload, path, make_parents=True, indent=2, sort_keys=False,
+                      default=float)
+
+
+def _early(path: Optional[Path], option: str, *, folder: bool = False) -> None:
+    """Fail now, before the long work, if an output cannot be written."""
+    if path is not None:
+        check_writable(path, option, folder=folder)
+
+
+#: Gear revolutions averaged per SA segment by the experiments and ``predict`` (the paper's 50)
+SEGMENT_REVOLUTIONS = 50
+MAX_DURATION = 1200.0   # s per recording (60 s in the paper)
+MAX_COUNT = 10_000      # recordings per campaign size / simulated signals are bounded below
+
+
+def _check_duration(duration: float, speed: float, *, option: str = "--duration",
+                    gear_teeth: int = 38, pinion_teeth: int = 17) -> None:
+    """A recording must hold one SA segment (50 gear revolutions) at this speed."""
+    if not (0 < speed <= 1000):
+        raise GearshotError(f"--speed must lie in (0, 1000] rps; got {speed!r}")
+    if not (0 < duration <= MAX_DURATION):
+        raise GearshotError(f"{option} must lie in (0, {MAX_DURATION:g}] s; got {duration!r}")
+    revs = duration * speed * pinion_teeth / gear_teeth
+    need = SEGMENT_REVOLUTIONS * gear_teeth / (pinion_teeth * speed)
+    if revs < SEGMENT_REVOLUTIONS:
+        raise GearshotError(
+            f"{option} {duration:g} s holds {revs:.3g} gear revolution(s) at --speed "
+            f"{speed:g} rps; one SA segment needs {SEGMENT_REVOLUTIONS} "
+            f"(--duration >= {need:.3g} s)")
+
+
+def _check_count(value: int, option: str, *, minimum: int = 0,
+                 maximum: int = MAX_COUNT) -> None:
+    if not minimum <= value <= maximum:
+        raise GearshotError(f"{option} must lie in {minimum} … {maximum}; got {value}")
+
+
+def _folder_digest(folder: Optional[Path]) -> Optional[str]:
+    """Content hash of every file of an FRF folder (names and bytes), or None."""
+    if folder is None:
+        return None
+    h = hashlib.sha256()
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        h.update(path.relative_to(folder).as_posix().encode() + b"\0")
+        with open(path, "rb") as fh:
+            while chunk := fh.read(1 << 20):
+                h.update(chunk)
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+CACHE_MANIFEST = "gearshot-cache.json"
+
+
+def _cached_campaign(campaign: Optional[Path], inputs: dict, record) -> Path:
+    """The campaign for ``inputs``: reuse one recorded from exactly these inputs, else record.
+
+    The default folder's name carries a hash of every input (seed, condition, grade,
+    attenuation, the FRF files' content, duration, counts) and the folder holds those
+    inputs in ``gearshot-cache.json``, checked on every reuse.
+    """
+    from .. import data_home
+
+    key = hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:16]
+    if campaign is None:
+        campaign = data_home() / (f"campaign-s{inputs['seed']}-{inputs['speed']:g}rps-"
+                                  f"{inputs['load']:g}Nm-{key}")
+    manifest = campaign / CACHE_MANIFEST
+    if (campaign / "index.csv").is_file():
+        if not manifest.exists():
+            return campaign   # a campaign the user recorded (gearshot rig): theirs to vouch for
+        try:
+            old = json.loads(manifest.read_text())
+        except (OSError, ValueError) as exc:
+            raise GearshotError(f"--campaign {str(campaign)!r}: {CACHE_MANIFEST} is "
+                                f"unreadable ({exc}); delete the folder to record it again") \
+                from None
+        if old == inputs:
+            return campaign
+        diff = sorted(k for k in set(old) | set(inputs) if old.get(k) != inputs.get(k))
+        raise GearshotError(f"--campaign {str(campaign)!r} was recorded from other inputs "
+                            f"(differs in {', '.join(diff)}); pass another --campaign or "
+                            f"delete it")
+    check_writable(campaign, "--campaign", folder=True)
+    record(campaign)
+    write_json_atomic(inputs, manifest)
+    return campaign
 
 
 @app.command()
@@ -77,6 +164,7 @@ def demo(
                               "gives the mean ± std over them."),
 ) -> None:
     """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
+    _early(out, "--out", folder=True)
     from .demo import run_demo
 
     run_demo(out, seed=seed, draws=draws)
@@ -105,13 +193,19 @@ def simulate(
                                            "then the tacho shaft's speed."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
-    from ..sim import GearPair, build_database, default_database_path
+    from .._paths import data_home
 
+    _check_count(n_healthy, "--n-healthy", maximum=100_000)
+    _check_count(n_faulty, "--n-faulty", maximum=100_000)
+    _check_count(workers, "--workers", minimum=1, maximum=256)
     if machine is not None:
+        _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
                           scheduler, workers, fault_type)
         return
-    store = store or default_database_path()
+    store = store or data_home(create=False) / "databases" / "sim-db"  # default_database_path
+    _early(store, "--store", folder=True)
+    from ..sim import GearPair, build_database
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
     n_blocks = len(speeds) * len(loads) * len(grade) * len(fault_type)
     client = _client(scheduler, workers, needed=n_blocks > 1)
@@ -171,6 +265,10 @@ def rig(
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
     if frf_folder is not None and not frf_folder.is_dir():
         raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_duration(duration, speed)
+    _check_count(healthy, "--healthy")
+    _check_count(repetitions, "--repetitions")
+    _early(folder, "FOLDER", folder=True)
     rig_obj = _make_rig(seed, frf_folder, rig_grade)
     index = rig_obj.campaign(folder, speed=speed, load=load, duration=duration,
                              healthy=healthy, sizes=tuple(size), repetitions=repetitions)
@@ -213,11 +311,17 @@ def experiment_simulated(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _early(json_out, "--json")
+    _early(out, "--out", folder=True)
+    _early(store, "--store", folder=True)
+    _check_count(n_healthy, "--n-healthy", maximum=100_000)
+    _check_count(n_faulty, "--n-faulty", maximum=100_000)
+    _check_count(workers, "--workers", minimum=1, maximum=256)
     from ..experiments import SIMULATED_VARIANTS, simulated_experiment, summarize
     from ..sim import GearPair, build_database, default_database_path
 
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if full else (speed, load)
     tag = "paper" if full else "-".join(f"{s:g}" for s in speeds) + "rps-" + \
         "-".join(f"{ld:g}" for ld in loads) + "Nm"
@@ -270,13 +374,21 @@ def experiment_rig(
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
-    from .. import data_home
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_duration(duration, speed)
+    _check_count(repeats, "--repeats", minimum=1, maximum=1000)
+    _check_count(n_healthy, "--n-healthy", maximum=100_000)
+    _check_count(n_faulty, "--n-faulty", maximum=100_000)
+    _check_count(workers, "--workers", minimum=1, maximum=256)
+    _early(json_out, "--json")
+    _early(out, "--out", folder=True)
+    _early(store, "--store", folder=True)
+    _early(campaign, "--campaign", folder=True)
     from ..experiments import RIG_VARIANTS, rig_experiment, summarize
     from ..sim import GearPair, build_database, default_database_path, load_database
     from ..transfer import TransferFunctionBank
 
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
     store = store or default_database_path(
         f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
     client = _client(scheduler, workers, needed=True)
@@ -288,14 +400,20 @@ def experiment_rig(
         if client is not None:
             client.close()
     database = load_database(store, speed=speed, load=load)
-    if campaign is None:
-        tag = f"campaign-s{seed}-{speed:g}rps-{load:g}Nm-g{rig_grade}-a{attenuation_db}"
-        campaign = data_home() / tag
-    if not (campaign / "index.csv").is_file():
+    inputs = {"seed": seed, "speed": speed, "load": load, "rig_grade": rig_grade,
+              "attenuation_db": attenuation_db, "duration": duration,
+              "frf_sha256": _folder_digest(frf_folder), "healthy": 6,
+              "sizes": [0.32, 0.56, 0.66], "repetitions": 6, "fs": 50_000.0}
+
+    def record(folder: Path) -> None:
         rig_obj = _make_rig(seed, frf_folder, rig_grade)
         if attenuation_db is not None:
             rig_obj = rig_obj.with_reality(attenuation_db=attenuation_db)
-        rig_obj.campaign(campaign, speed=speed, load=load, duration=duration)
+        rig_obj.campaign(folder, speed=speed, load=load, duration=duration,
+                         healthy=inputs["healthy"], sizes=tuple(inputs["sizes"]),
+                         repetitions=inputs["repetitions"])
+
+    campaign = _cached_campaign(campaign, inputs, record)
     selection = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
@@ -347,6 +465,7 @@ def predict(
                                   "estimated."),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    _early(out, "--out")
     if machine is not None:
         from ..machine import Machine
         from .predict_machine import predict_from_machine
@@ -365,11 +484,11 @@ def predict(
                                    speed=speed, load=load, coverage=coverage,
                                    gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
                                    seed=seed)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    if out.suffix.lower() == ".json":
-        out.write_text(frame.to_json(orient="records", indent=2))
-    else:
-        frame.to_csv(out, index=False)
+    with atomic_path(out, make_parents=True) as tmp:
+        if out.suffix.lower() == ".json":
+            tmp.write_text(frame.to_json(orient="records", indent=2))
+        else:
+            frame.to_csv(tmp, index=False)
     by = ["recording", "role"] if "role" in frame else "recording"
     typer.echo(frame.groupby(by)["predicted"].mean().to_string())
     typer.echo(f"predictions written to {out}")
@@ -394,6 +513,8 @@ def indicators(
     from .indicators import indicator_figures, indicator_table, record_indicators
 
     mach = Machine.from_toml(machine)
+    _early(json_out, "--json")
+    _early(out, "--out", folder=True)
     payload = record_indicators(recordings, mach, shaft=shaft, sensor=sensor,
                                 baseline_paths=baseline)
     _write_json(json_out, payload)
@@ -411,6 +532,9 @@ def report(
     out: Path = typer.Option(Path("gearshot-report"), "--out"),
 ) -> None:
     """Figures and a Markdown report from a results JSON."""
+    if not results.is_file():
+        raise GearshotError(f"results file {str(results)!r} does not exist")
+    _early(out, "--out", folder=True)
     from .figures import report_from_json
 
     path = report_from_json(results, out)
@@ -424,9 +548,14 @@ def main() -> None:
     except GearshotError as exc:
         typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
         sys.exit(2)
-    except FileNotFoundError as exc:
-        typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
-        sys.exit(2)
+    except OSError as exc:  # disk full, file too large, permission, missing file
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        typer.secho(f"gearshot: error:{where} {os_error_text(exc)}", err=True, fg="red")
+        sys.exit(1)
+    except MemoryError:
+        typer.secho("gearshot: error: out of memory; try smaller sizes (counts, --duration)",
+                    err=True, fg="red")
+        sys.exit(1)
     except KeyboardInterrupt:
         typer.secho("gearshot: interrupted", err=True)
         sys.exit(130)
@@ -438,7 +567,11 @@ def main() -> None:
         if hasattr(exc, "show") and hasattr(exc, "exit_code"):
             exc.show()
             sys.exit(exc.exit_code)
-        raise
+        if os.environ.get("GEARSHOT_DEBUG"):
+            raise
+        typer.secho(f"gearshot: error: unexpected {type(exc).__name__}: {exc} (a bug: please "
+                    f"report it; GEARSHOT_DEBUG=1 shows the traceback)", err=True, fg="red")
+        sys.exit(3)
 
 
 if __name__ == "__main__":  # pragma: no cover

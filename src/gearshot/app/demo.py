@@ -8,13 +8,14 @@ averages over draws), and writes figures plus a Markdown report into a folder.
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
+
+from .._atomic import atomic_path, write_json_atomic
 
 __all__ = ["run_demo"]
 
@@ -112,9 +113,11 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
         "feature_errors": est.feature_errors_, "n_neighbors": int(est.n_neighbors_),
         "seconds": time.perf_counter() - t_start,
     }
-    (out / "results.json").write_text(json.dumps(summary, indent=2))
-    results.drop(columns=["estimator"]).to_csv(out / "ablations.csv", index=False)
-    full_pred.to_csv(out / "predictions.csv", index=False)
+    write_json_atomic(summary, out / "results.json", indent=2, sort_keys=False)
+    with atomic_path(out / "ablations.csv") as tmp:
+        results.drop(columns=["estimator"]).to_csv(tmp, index=False)
+    with atomic_path(out / "predictions.csv") as tmp:
+        full_pred.to_csv(tmp, index=False)
     from .report import write_report
 
     report = write_report(out, summary, figures)

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .._errors import GearshotError
+from .._validation import check_in_range
 
 __all__ = ["predict_from_files"]
 
@@ -46,8 +47,16 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     for p in [*healthy, faulty]:
         if not Path(p).is_file():
             raise GearshotError(f"recording {str(p)!r} does not exist")
-    db = load_database(database, speed=speed, load=load)
+    faulty_size = check_in_range(faulty_size, "faulty_size (--faulty-size)", 0.0, 1.0,
+                                 low_inclusive=False)
+    coverage = check_in_range(coverage, "coverage (--coverage)", 0.0, 1.0,
+                              low_inclusive=False, high_inclusive=False)
     kw = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
+    # every recording is read and segmented before the fit: a file too short for one SA
+    # segment (or unreadable) fails now, not after minutes of fitting
+    targets = [(path, recording_segments(path, **kw))
+               for path in _recording_files(Path(recordings))]
+    db = load_database(database, speed=speed, load=load)
     healthy_sa, long = [], None
     for i, p in enumerate(healthy):
         if i == 0:
@@ -61,8 +70,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     est = OneFaultShotEstimator(random_state=seed)
     est.fit(db, np.vstack(healthy_sa), example, faulty_size, long, selection_tf=selection_tf)
     frames = []
-    for path in _recording_files(Path(recordings)):
-        sa = recording_segments(path, **kw)
+    for path, sa in targets:
         low, high = est.predict_interval(sa, coverage=coverage)
         frames.append(pd.DataFrame(dict(recording=str(path), segment=np.arange(len(sa)),
                                         predicted=est.predict(sa), low=low, high=high)))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._atomic import write_text_atomic
+
 __all__ = ["write_report"]
 
 
@@ -36,5 +38,5 @@ def write_report(folder, summary: dict, figures: dict) -> Path:
         rel = Path(path).relative_to(folder) if Path(path).is_relative_to(folder) else path
         lines += [f"## {caption}", "", f"![{caption}]({rel})", ""]
     path = folder / "report.md"
-    path.write_text("\n".join(lines))
+    write_text_atomic(path, "\n".join(lines), make_parents=True)
     return path

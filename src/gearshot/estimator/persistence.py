@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import tempfile
 import warnings
 from pathlib import Path
 from typing import Any
@@ -12,6 +11,7 @@ import joblib
 import sklearn
 
 from .. import __version__
+from .._atomic import atomic_path
 from .._errors import GearshotError, NotFittedError
 
 __all__ = ["save_estimator", "load_estimator"]
@@ -33,15 +33,8 @@ def save_estimator(estimator: Any, path: str | os.PathLike[str]) -> None:
     path = Path(path)
     payload = {"format": _FORMAT, "gearshot_version": __version__,
                "sklearn_version": sklearn.__version__, "estimator": estimator}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path, make_parents=True) as tmp:
         joblib.dump(payload, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def load_estimator(path: str | os.PathLike[str]) -> Any:

@@ -7,18 +7,16 @@ turns that into acceleration/tacho arrays with errors that name the file and the
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
-import os
-import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._atomic import atomic_path, write_json_atomic
 from .._errors import GearshotError
 from .._validation import describe
 
@@ -61,28 +59,6 @@ class RawFile:
     time_channel: str | None = None            # a time column (never a default channel)
 
 
-@contextlib.contextmanager
-def atomic_path(path: Path) -> Iterator[Path]:
-    """Yield a temporary path in ``path``'s folder; ``os.replace`` it onto ``path`` on success.
-
-    On any exception the temporary file is removed and ``path`` is left untouched.
-    """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise GearshotError(f"cannot write {str(path)!r}: folder {str(folder)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        yield tmp_path
-        os.replace(tmp_path, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp_path.unlink()
-        raise
-
-
 def sidecar_path(path: Path) -> Path:
     """The JSON sidecar of a WAV/CSV file: ``<name>.<ext>.json`` beside it."""
     path = Path(path)
@@ -103,12 +79,6 @@ def read_sidecar(path: Path) -> dict[str, Any]:
                                     f"{type(data).__name__}")
             return data
     return {}
-
-
-def write_json_atomic(data: Mapping[str, Any], path: Path) -> None:
-    """Write ``data`` as JSON to ``path`` through a temporary file."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(data, indent=1, sort_keys=True), encoding="utf-8")
 
 
 def _lookup(channels: Mapping[str, np.ndarray], names: Sequence[str]) -> str | None:
@@ -189,8 +159,9 @@ def select_channels(raw: RawFile, *, accel: Any, tacho: Any, channels: Any
                 accel_name = names[0]
             else:
                 raise GearshotError(
-                    f"{str(raw.path)!r}: cannot tell which channel is the acceleration; pass "
-                    f"accel=<name or index>; available: {names}")
+                    f"{str(raw.path)!r}: cannot tell which channel is the acceleration; name it "
+                    f"'acceleration' in the file (API: Recording.read(path, accel=<name or "
+                    f"index>)); available: {names}")
     else:
         accel_name = _resolve(raw, "accel", accel, aliases)
 
@@ -233,8 +204,10 @@ def reconcile_fs(raw: RawFile, fs: Any) -> float:
         file_fs = float(file_fs)
     if fs is None:
         if file_fs is None:
-            raise GearshotError(f"{str(raw.path)!r} does not state its sampling rate; pass "
-                                f"fs=<Hz>")
+            side = sidecar_path(raw.path).name
+            raise GearshotError(f"{str(raw.path)!r} does not state its sampling rate: add a "
+                                f"'time' column, or a sidecar {side!r} holding "
+                                f"{{\"fs\": <Hz>}} (API: Recording.read(path, fs=<Hz>))")
         return file_fs
     if isinstance(fs, bool) or not isinstance(fs, (int, float, np.number)) or not (
             math.isfinite(fs) and fs > 0):

@@ -104,7 +104,8 @@ class Recording:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        acc = as_signal_array(self.acceleration, "acceleration", max_ndim=2, min_length=2)
+        acc = as_signal_array(self.acceleration, "acceleration", max_ndim=2, min_length=2,
+                              max_abs=None)
         set_(self, "acceleration", acc)
         names = tuple(self.channel_names)
         if not names:
@@ -117,7 +118,7 @@ class Recording:
                                 f"{describe(self.channel_names)}")
         set_(self, "channel_names", names)
         if self.tacho is not None:
-            tac = as_signal_array(self.tacho, "tacho", max_ndim=1)
+            tac = as_signal_array(self.tacho, "tacho", max_ndim=1, max_abs=None)
             if tac.shape[-1] != acc.shape[-1]:
                 raise GearshotError(f"tacho must have as many samples as acceleration "
                                     f"({acc.shape[-1]}); got {tac.size}")

@@ -46,12 +46,14 @@ def save_figure(fig, path) -> list[Path]:
     """Save ``fig`` as ``path`` with suffixes .png and .pdf; returns the written paths."""
     import matplotlib.pyplot as plt
 
+    from .._atomic import atomic_path
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     out = []
     for suffix in (".png", ".pdf"):
         target = path.with_suffix(suffix)
-        fig.savefig(target, dpi=130, bbox_inches="tight")
+        with atomic_path(target, make_parents=True) as tmp:
+            fig.savefig(tmp, dpi=130, bbox_inches="tight", format=suffix[1:])
         out.append(target)
     plt.close(fig)
     return out

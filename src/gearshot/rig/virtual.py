@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import shutil
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -38,6 +36,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._atomic import atomic_path, check_writable, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_positive
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
@@ -268,9 +267,8 @@ class VirtualRig:
                                                      for r in range(repetitions)]
         if not jobs:
             raise GearshotError("the campaign holds no recording (healthy=0 and no sizes)")
-        folder.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=".campaign-", dir=folder))
-        try:
+        check_writable(folder, "folder", folder=True)
+        with staging_dir(folder) as staging:
             rows = []
             from rich.progress import track
 
@@ -279,7 +277,11 @@ class VirtualRig:
                 rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
                                   repetition=r)
                 name = self.file_name(speed, load, y, r)
-                rec.write(staging / name, dtype=dtype)
+                try:
+                    rec.write(staging / name, dtype=dtype)
+                except GearshotError as exc:  # name the destination, not the staging copy
+                    raise GearshotError(str(exc).replace(str(staging / name),
+                                                         str(folder / name))) from None
                 rows.append({"path": name, "speed": speed, "load": load, "fault_size": y,
                              "repetition": r})
             new = pd.DataFrame(rows, columns=INDEX_COLUMNS)
@@ -293,12 +295,11 @@ class VirtualRig:
                 new_index = pd.concat([old[~same], new], ignore_index=True)
             else:
                 new_index = new
-            new_index.to_csv(staging / INDEX_NAME, index=False)
+            with atomic_path(staging / INDEX_NAME) as tmp:
+                new_index.to_csv(tmp, index=False)
             for name in new["path"]:
                 os.replace(staging / name, folder / name)
             os.replace(staging / INDEX_NAME, index_path)
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
         out = new.copy()
         out["path"] = [str((folder / p).resolve()) for p in out["path"]]
         return out

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.fft
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int
+from .._validation import as_signal_array, check_int, describe, finite_result
 
 __all__ = ["fractional_shift", "subtract_healthy"]
 
@@ -24,6 +24,7 @@ def _shift_factors(n: int, tau: np.ndarray) -> np.ndarray:
     return factors
 
 
+@finite_result
 def fractional_shift(x, delay):
     """Circularly delay signals by a (fractional) number of samples.
 
@@ -42,9 +43,23 @@ def fractional_shift(x, delay):
     ndarray, shape (..., n)
     """
     x = as_signal_array(x, "x", min_length=2)
-    delay = np.asarray(delay, dtype=float)
-    if not np.all(np.isfinite(delay)):
-        raise GearshotError(f"delay must be finite; got {delay!r}")
+    if isinstance(delay, (str, bytes)):
+        raise GearshotError(f"delay must be a number of samples; got {describe(delay)}")
+    try:
+        delay = np.asarray(delay, dtype=float)
+    except (TypeError, ValueError):
+        raise GearshotError(f"delay must be a number of samples or an array of them; got "
+                            f"{describe(delay)}") from None
+    if not np.all(np.isfinite(delay)) or np.any(np.abs(delay) > 1e12):
+        raise GearshotError(f"delay must be finite and at most 1e12 samples in magnitude; "
+                            f"got {describe(delay)}")
+    try:
+        fits = np.broadcast_shapes(delay.shape, x.shape[:-1]) == x.shape[:-1]
+    except ValueError:
+        fits = False
+    if not fits:
+        raise GearshotError(f"delay of shape {delay.shape} does not broadcast to the batch "
+                            f"shape {x.shape[:-1]} of x (shape {x.shape})")
     n = x.shape[-1]
     spectrum = scipy.fft.fft(x, axis=-1) * _shift_factors(n, -delay)
     return scipy.fft.ifft(spectrum, axis=-1).real
@@ -99,6 +114,7 @@ class _LagSearch:
         return np.where(top, fine, n_fine).min(axis=-1)  # first maximum, as argmax
 
 
+@finite_result
 def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=False):
     """Suppress the gear-mesh pattern by subtracting the best delay-aligned healthy SA.
 
@@ -131,7 +147,7 @@ def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=Fals
     signals = as_signal_array(signals, "signals", min_length=2)
     refs = as_signal_array(healthy_refs, "healthy_refs", max_ndim=2, min_length=2)
     refs = np.atleast_2d(refs)
-    upsample = check_int(upsample, "upsample", minimum=1)
+    upsample = check_int(upsample, "upsample", minimum=1, maximum=10_000)
     n = signals.shape[-1]
     if refs.shape[-1] != n:
         raise GearshotError(

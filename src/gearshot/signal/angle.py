@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 from .._errors import GearshotError
-from .._validation import check_int
+from .._validation import MAX_POINTS, check_int, finite_result
 from .angular import angle_to_time
 
 __all__ = [
@@ -59,7 +59,13 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
     ndarray
         The pulse times, with bridged dropouts filled in.
     """
-    pulses = np.asarray(pulses, dtype=np.float64).ravel()
+    pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
+    try:
+        pulses = np.asarray(pulses, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise GearshotError(f"{label}: tacho pulse times must be numbers") from None
+    if not np.all(np.isfinite(pulses)):
+        raise GearshotError(f"{label}: tacho pulse times must be finite")
     if pulses.size < 2 * pulses_per_rev + 1:
         raise GearshotError(f"{label}: the tacho shows {pulses.size} pulse(s); at least "
                             f"{2 * pulses_per_rev + 1} are needed (empty or flat tacho?)")
@@ -94,6 +100,7 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
     return pulses
 
 
+@finite_result
 def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
                      pulses_per_rev: int = 1, tacho_shaft: str = "input") -> np.ndarray:
     """Times (s) at which the driven gear completes whole revolutions.
@@ -115,12 +122,18 @@ def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
         Start time of gear revolution 0 (the first pulse), 1, ... up to the last revolution
         that ends before the last pulse.
     """
-    gear_teeth = check_int(gear_teeth, "gear_teeth", minimum=1)
-    pinion_teeth = check_int(pinion_teeth, "pinion_teeth", minimum=1)
-    pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
-    if tacho_shaft not in TACHO_SHAFTS:
+    from .angular import _check_pulses
+
+    gear_teeth = check_int(gear_teeth, "gear_teeth", minimum=1, maximum=100_000)
+    pinion_teeth = check_int(pinion_teeth, "pinion_teeth", minimum=1, maximum=100_000)
+    pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
+    if not isinstance(tacho_shaft, str) or tacho_shaft not in TACHO_SHAFTS:
         raise GearshotError(f"tacho_shaft must be one of {TACHO_SHAFTS}; got {tacho_shaft!r}")
-    pulses = np.asarray(pulses, dtype=np.float64)
+    pulses = _check_pulses(pulses, "pulses")
+    revs_total = (pulses.size - 1) / pulses_per_rev
+    if revs_total * pinion_teeth / gear_teeth > MAX_POINTS:
+        raise GearshotError(f"pulses span {revs_total:g} tacho revolutions, more than "
+                            f"{MAX_POINTS} gear cycles")
     shaft_revs = np.arange(pulses.size) / pulses_per_rev
     revs_per_cycle = gear_teeth / pinion_teeth if tacho_shaft == "input" else 1.0
     n_cycles = int(np.floor(shaft_revs[-1] / revs_per_cycle + 1e-9))

@@ -8,12 +8,13 @@ import scipy.signal
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .._errors import GearshotError
-from .._validation import (as_signal_array, check_in_range, check_increasing, check_int,
-                           check_positive)
+from .._validation import (MAX_POINTS, as_signal_array, check_in_range, check_increasing,
+                           check_int, check_positive, describe, finite_result)
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 
 
+@finite_result
 def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1):
     """Times of the rising edges of a tacho signal, interpolated between samples.
 
@@ -42,10 +43,14 @@ def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1):
     fs = check_positive(fs, "fs")
     hysteresis = check_in_range(hysteresis, "hysteresis", 0.0, 1.0)
     low, high = np.percentile(tacho, [1, 99])
+    if high <= low:  # fewer than 1 % of the samples away from the baseline: a lone pulse?
+        low, high = float(tacho.min()), float(tacho.max())
     if threshold is None:
         if high <= low:
             raise GearshotError("tacho is constant; it holds no pulses")
         threshold = 0.5 * (low + high)
+    if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.number)):
+        raise GearshotError(f"threshold must be a number; got {describe(threshold)}")
     threshold = float(threshold)
     if not np.isfinite(threshold):
         raise GearshotError(f"threshold must be finite; got {threshold}")
@@ -74,6 +79,7 @@ def _check_pulses(pulse_times, name="pulse_times"):
     return check_increasing(pulses, name, unit=" s")
 
 
+@finite_result
 def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
     """Time at which the shaft reaches given angles, from its tacho pulses.
 
@@ -96,17 +102,27 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
         Times, s.
     """
     pulses = _check_pulses(pulse_times)
-    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     revs = np.arange(pulses.size) / ppr
+    angles = as_signal_array(angles, "angles", min_ndim=0)
+    span = revs[-1]
+    outside = (angles < -1e-6) | (angles > span + 1e-6)   # rounding slack: 1e-6 rev
+    if np.any(outside):
+        first = float(angles.ravel()[np.flatnonzero(outside.ravel())[0]])
+        raise GearshotError(
+            f"angles must lie within the pulsed span 0 … {span:g} revolutions "
+            f"({pulses.size} pulses at pulses_per_rev={ppr}); got {first!r} "
+            f"({int(outside.sum())} value(s) outside)")
     if pulses.size >= 4:
         curve = CubicSpline(revs, pulses)
         if np.any(curve(revs[:-1] + 0.5 / ppr, 1) <= 0) or np.any(curve(revs, 1) <= 0):
             curve = PchipInterpolator(revs, pulses)
     else:
         curve = PchipInterpolator(revs, pulses)
-    return curve(np.asarray(angles, dtype=float))
+    return curve(np.clip(angles, 0.0, span))
 
 
+@finite_result
 def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2,
                      antialias=True, passband=0.9):
     """Resample a time signal at equal steps of shaft angle.
@@ -151,9 +167,12 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
     x = as_signal_array(x, "x", min_length=4)
     fs = check_positive(fs, "fs")
     pulses = _check_pulses(pulse_times)
-    spr = check_int(samples_per_rev, "samples_per_rev", minimum=1)
-    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
-    upsample = check_int(upsample, "upsample", minimum=1)
+    spr = check_int(samples_per_rev, "samples_per_rev", minimum=1, maximum=MAX_POINTS)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
+    upsample = check_int(upsample, "upsample", minimum=1, maximum=64)
+    if x.size * upsample > 16 * MAX_POINTS:
+        raise GearshotError(f"x ({x.size} samples) × upsample={upsample} exceeds "
+                            f"{16 * MAX_POINTS} samples; resample shorter pieces")
     duration = x.shape[-1] / fs
     if pulses[0] < 0 or pulses[-1] > (x.shape[-1] - 1) / fs:
         raise GearshotError(
@@ -164,6 +183,9 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
         raise GearshotError(
             f"pulse_times hold {pulses.size} pulses, less than one revolution at "
             f"pulses_per_rev={ppr}")
+    if n_revs * spr * max(1, x.size // x.shape[-1]) > 16 * MAX_POINTS:
+        raise GearshotError(f"the output would hold {n_revs} revolutions × samples_per_rev="
+                            f"{spr} points per signal, more than {16 * MAX_POINTS} in all")
     angles = np.arange(n_revs * spr) / spr
     times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
     if antialias:

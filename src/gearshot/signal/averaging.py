@@ -4,11 +4,12 @@ from __future__ import annotations
 
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int
+from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
 __all__ = ["synchronous_average"]
 
 
+@finite_result
 def synchronous_average(x, samples_per_cycle, *, n_cycles=None):
     """Synchronous average of an angle-domain signal.
 
@@ -32,7 +33,7 @@ def synchronous_average(x, samples_per_cycle, *, n_cycles=None):
     GearshotError
         If ``x`` holds fewer samples than one cycle or than the cycles requested.
     """
-    spc = check_int(samples_per_cycle, "samples_per_cycle", minimum=1)
+    spc = check_int(samples_per_cycle, "samples_per_cycle", minimum=1, maximum=MAX_POINTS)
     x = as_signal_array(x, "x")
     available = x.shape[-1] // spc
     if available < 1:

@@ -6,11 +6,12 @@ import numpy as np
 import scipy.fft
 
 from .._errors import GearshotError
-from .._validation import as_signal_array
+from .._validation import as_signal_array, finite_result
 
 __all__ = ["real_cepstrum", "minimum_phase"]
 
 
+@finite_result
 def real_cepstrum(magnitude):
     """Real cepstrum ``IDFT(log |H|)`` of a two-sided magnitude, along the last axis."""
     magnitude = _checked_magnitude(magnitude)
@@ -27,6 +28,7 @@ def _checked_magnitude(magnitude):
     return np.maximum(magnitude, peak * 1e-12)
 
 
+@finite_result
 def minimum_phase(magnitude):
     """Minimum-phase frequency response with a given magnitude (real-cepstrum method).
 

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import scipy.signal
 
-from .._validation import as_signal_array
+from .._validation import as_signal_array, finite_result
 
 __all__ = ["envelope"]
 
 
+@finite_result
 def envelope(x):
     """Envelope ``|hilbert(x)|`` along the last axis.
 

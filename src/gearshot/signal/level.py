@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import as_signal_array
+from .._validation import as_signal_array, finite_result
 
 __all__ = ["rms", "mean_rms"]
 
 
+@finite_result
 def rms(x):
     """Root mean square along the last axis.
 
@@ -25,6 +26,7 @@ def rms(x):
     return np.sqrt(np.mean(x * x, axis=-1))
 
 
+@finite_result
 def mean_rms(signals) -> float:
     """Mean over signals of the RMS along the last axis: the RMS-normalization scale."""
     return float(np.mean(rms(signals)))

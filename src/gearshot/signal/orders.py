@@ -6,7 +6,7 @@ import numpy as np
 import scipy.fft
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int
+from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
 __all__ = ["harmonic_signal", "difference_signal", "order_mask", "mesh_band_orders",
            "check_mesh_order", "check_mesh_orders"]
@@ -31,7 +31,8 @@ def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tu
         The distinct orders, in the given order.
     """
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
-        orders = list(np.asarray(mesh_order).ravel().tolist())
+        orders = (mesh_order.ravel().tolist() if isinstance(mesh_order, np.ndarray)
+                  else list(mesh_order))
         if not orders:
             raise GearshotError(f"{name} must name at least one mesh order; got {mesh_order!r}")
         out = []
@@ -54,9 +55,13 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     their mirror, as zeroing both halves of a two-sided spectrum would do. DC (order 0) is
     not a mesh harmonic and is kept unless a sideband folds onto it.
     """
+    n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
-        return np.unique(np.concatenate([mesh_band_orders(n_points, int(m), n_sidebands)
-                                         for m in np.asarray(mesh_order).ravel()]))
+        return np.unique(np.concatenate([
+            mesh_band_orders(n_points, m, n_sidebands)
+            for m in check_mesh_orders(mesh_order, n_points)]))
+    mesh_order = check_mesh_order(mesh_order, n_points)
     k = np.arange(1, (n_points // 2) // mesh_order + 1)
     s = np.arange(-n_sidebands, n_sidebands + 1)
     idx = (k[:, None] * mesh_order + s[None, :]).ravel() % n_points
@@ -81,9 +86,9 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2):
     -------
     mask : ndarray of bool, shape (n_points // 2 + 1,)
     """
-    n_points = check_int(n_points, "n_points", minimum=2)
+    n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     mesh_order = list(check_mesh_orders(mesh_order, n_points))
-    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
     mask = np.zeros(n_points // 2 + 1, dtype=bool)
     mask[mesh_band_orders(n_points, mesh_order, n_sidebands)] = True
     return mask
@@ -98,6 +103,7 @@ def _split(sa, mesh_order, n_sidebands, keep_mesh: bool):
     return scipy.fft.irfft(spectrum, n=n, axis=-1)
 
 
+@finite_result
 def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
     """The mesh harmonics of a synchronous average and their sidebands.
 
@@ -121,6 +127,7 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
     return _split(sa, mesh_order, n_sidebands, keep_mesh=True)
 
 
+@finite_result
 def difference_signal(sa, mesh_order, *, n_sidebands=2):
     """A synchronous average with its mesh harmonics and sidebands removed.
 

@@ -8,11 +8,12 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy.interpolate import PchipInterpolator
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range, check_int
+from .._validation import MAX_POINTS, as_signal_array, check_in_range, check_int, finite_result
 
 __all__ = ["amplitude_spectrum", "acs_background"]
 
 
+@finite_result
 def amplitude_spectrum(x, *, nfft=2**15):
     """Averaged amplitude spectrum over non-overlapping rectangular segments.
 
@@ -31,7 +32,7 @@ def amplitude_spectrum(x, *, nfft=2**15):
     ndarray, shape (..., nfft)
         Two-sided amplitude spectrum (index k ↔ k/nfft of the sampling rate).
     """
-    nfft = check_int(nfft, "nfft", minimum=2)
+    nfft = check_int(nfft, "nfft", minimum=2, maximum=MAX_POINTS)
     x = as_signal_array(x, "x")
     n_seg = x.shape[-1] // nfft
     if n_seg < 1:
@@ -42,6 +43,7 @@ def amplitude_spectrum(x, *, nfft=2**15):
     return np.sqrt(power.sum(axis=-2) / (n_seg * nfft))
 
 
+@finite_result
 def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
                    symmetric=True):
     """Background of a spectrum by segment percentiles (the reference's ACS).

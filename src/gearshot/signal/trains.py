@@ -23,7 +23,8 @@ import numpy as np
 import scipy.fft
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range, check_int, check_positive
+from .._validation import (MAX_POINTS, as_signal_array, check_in_range, check_int,
+                           check_positive, finite_result)
 from .angular import angle_to_time
 
 __all__ = ["shaft_cycle_times", "as_ratio", "antialias_filter", "bandlimited_resynthesis",
@@ -57,6 +58,7 @@ def as_ratio(value, name: str = "revs_per_cycle") -> Fraction:
     return frac
 
 
+@finite_result
 def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1):
     """Times (s) at which a shaft completes whole revolutions, from a tacho on another shaft.
 
@@ -78,12 +80,17 @@ def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1):
     """
     pulses = as_signal_array(pulse_times, "pulse_times", max_ndim=1)
     ratio = as_ratio(revs_per_cycle)
-    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     if pulses.size < 2:
         raise GearshotError(f"pulse_times must hold at least 2 pulses; got {pulses.size}")
+    if np.any(np.diff(pulses) <= 0):
+        raise GearshotError("pulse_times must be strictly increasing")
     # cycle m ends at tacho pulse index m * p * ppr / q: count whole cycles exactly
     p, q = ratio.numerator, ratio.denominator
     n_cycles = ((pulses.size - 1) * q) // (p * ppr)
+    if n_cycles > MAX_POINTS:
+        raise GearshotError(f"revs_per_cycle={ratio} gives {n_cycles} cycles from "
+                            f"{pulses.size} pulses, more than {MAX_POINTS}")
     m = np.arange(n_cycles + 1, dtype=np.int64)
     targets = (m * p) / q  # exact integers times p, one rounding in the division
     return angle_to_time(pulses, targets, pulses_per_rev=ppr)
@@ -92,7 +99,7 @@ def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1):
 def min_shaft_rate(pulse_times, *, pulses_per_rev=1, revs_per_cycle=1):
     """Lowest speed (revolutions/s of the target shaft) between consecutive tacho pulses."""
     pulses = as_signal_array(pulse_times, "pulse_times", max_ndim=1)
-    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     ratio = as_ratio(revs_per_cycle)
     if pulses.size < 2:
         raise GearshotError(f"pulse_times must hold at least 2 pulses; got {pulses.size}")
@@ -140,6 +147,9 @@ def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
     fs = check_positive(fs, "fs")
     cutoff = check_positive(cutoff, "cutoff")
     rate = check_positive(rate, "rate")
+    if x.shape[-1] * rate / fs > 16 * MAX_POINTS:
+        raise GearshotError(f"rate={rate:g} Hz would re-synthesize {x.shape[-1]} samples at "
+                            f"fs={fs:g} Hz into more than {16 * MAX_POINTS} points")
     passband = check_in_range(passband, "passband", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
     spec, n_fft, pad = _lowpass_spectrum(x, fs, min(cutoff, fs / 2), passband)
@@ -154,6 +164,7 @@ def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
     return y, fs * n_out / n_fft, -pad / fs
 
 
+@finite_result
 def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1):
     """Zero-phase low-pass (and up-sampling) of a time signal, flat to ``passband * cutoff``.
 
@@ -184,7 +195,10 @@ def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1):
     cutoff = check_positive(cutoff, "cutoff")
     passband = check_in_range(passband, "passband", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
-    up = check_int(upsample, "upsample", minimum=1)
+    up = check_int(upsample, "upsample", minimum=1, maximum=64)
+    if x.size * up > 16 * MAX_POINTS:
+        raise GearshotError(f"x ({x.size} samples) × upsample={up} exceeds {16 * MAX_POINTS} "
+                            f"samples")
     n = x.shape[-1]
     if passband * cutoff >= fs / 2 and up == 1:
         return x.copy()

@@ -7,13 +7,18 @@ Layout of a store (a folder)::
       blocks/s{i}_l{j}_g{k}.zarr    one (speed, load, grade) block, an xarray Dataset
       blocks/s{i}_l{j}_g{k}_{type}.zarr   ... of a fault type other than "ftff"
 
-A block is written to a temporary folder beside its final name and renamed when complete,
-so a block is either absent or whole; an interrupted build resumes by skipping the blocks
-present. Each block's random stream derives from ``SeedSequence(seed, spawn_key=(i, j, k))``
-(``(i, j, k, code)`` for a fault type other than the FTFF, ``code`` its position in
-:data:`~gearshot.sim.FAULT_TYPES`) and each signal's from the block's, so contents do not
-depend on order or interruption. A build of FTFFs only keeps the layout and manifest of
-stores built before fault types existed.
+A block is written to a temporary folder beside its final name and renamed when complete
+(:func:`gearshot._atomic.atomic_dir`), so a block is either absent or whole; an interrupted
+build resumes by skipping the blocks present. Each block carries a checksum list: the size
+and CRC-32 of every other file in it and the build's manifest (the attribute
+``gearshot_block`` of the block's root ``zarr.json``). Every read checks a block
+against it (a missing or overwritten chunk is named, never read as NaN), and a build
+rebuilds exactly the blocks found damaged, reusing the rest; a lost ``manifest.json`` is
+restored from the blocks' copies. Each block's random stream derives from
+``SeedSequence(seed, spawn_key=(i, j, k))`` (``(i, j, k, code)`` for a fault type other
+than the FTFF, ``code`` its position in :data:`~gearshot.sim.FAULT_TYPES`) and each
+signal's from the block's, so contents do not depend on order or interruption. A build of
+FTFFs only keeps the layout and manifest of stores built before fault types existed.
 """
 
 from __future__ import annotations
@@ -21,11 +26,13 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import uuid
+import sys
+import zlib
 from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, describe
@@ -106,10 +113,121 @@ def _check_fault_types(fault_types):
     return types
 
 
-def _write_json_atomic(path: Path, obj) -> None:
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    tmp.write_text(json.dumps(obj, indent=1))
-    os.replace(tmp, path)
+_ROOT = "zarr.json"           # the block group's metadata; holds the checksum list
+_ATTR = "gearshot_block"
+_MAX_POINTS = 1 << 20          # SA length bound (a block row is 8 MiB at this length)
+_MAX_SIGNALS = 1_000_000       # signals per block
+
+
+def _file_digest(path: Path) -> tuple[int, int]:
+    crc = 0
+    size = 0
+    with open(path, "rb") as fh:
+        while chunk := fh.read(1 << 22):
+            crc = zlib.crc32(chunk, crc)
+            size += len(chunk)
+    return size, crc
+
+
+def _write_checksums(folder: Path, manifest: dict) -> None:
+    files = {}
+    for root, _dirs, names in os.walk(folder):
+        for name in names:
+            full = Path(root) / name
+            rel = full.relative_to(folder).as_posix()
+            if rel != _ROOT and not name.startswith("."):
+                files[rel] = list(_file_digest(full))
+    meta = json.loads((folder / _ROOT).read_text())
+    meta.setdefault("attributes", {})[_ATTR] = {"files": files, "manifest": manifest}
+    write_json_atomic(meta, folder / _ROOT, indent=2, sort_keys=False)
+
+
+def _block_record(path: Path) -> dict:
+    """The checksum list of a block; ``{}`` for a block from before checksum lists."""
+    meta = json.loads((path / _ROOT).read_text())
+    record = meta.get("attributes", {}).get(_ATTR, {})
+    if not isinstance(record, dict):
+        raise ValueError(f"attribute {_ATTR!r} is not a mapping")
+    return record
+
+
+def _block_problem(path: Path) -> str | None:
+    """What is wrong with a built block (``None``: whole, every file as written)."""
+    try:
+        record = _block_record(path)
+    except FileNotFoundError:
+        return f"its metadata file {_ROOT!r} is missing"
+    except (OSError, ValueError) as exc:
+        return f"its metadata file {_ROOT!r} is unreadable ({exc})"
+    if not record:
+        return _legacy_block_problem(path)
+    files = record.get("files")
+    if not isinstance(files, dict) or not files:
+        return f"its checksum list (attribute {_ATTR!r}) is damaged"
+    for rel, want in sorted(files.items()):
+        full = path / rel
+        if not full.is_file():
+            return f"file {rel!r} is missing"
+        try:
+            got = list(_file_digest(full))
+        except OSError as exc:
+            return f"file {rel!r} cannot be read ({exc.strerror or exc})"
+        if got != list(want):
+            return f"file {rel!r} is corrupt (size/CRC-32 {got} != recorded {list(want)})"
+    return None
+
+
+def _legacy_block_problem(path: Path) -> str | None:
+    """A block written before checksum lists: decode it and look for holes (fill values)."""
+    import xarray as xr
+
+    try:
+        ds = xr.open_zarr(path, consolidated=False).load()
+    except Exception as exc:  # a decoder's error on a damaged chunk
+        return f"it cannot be decoded ({type(exc).__name__}: {exc})"
+    for name in ("sa", "fault_size", "seed", "grade"):
+        if name not in ds.variables:
+            return f"its array {name!r} is missing"
+    if not (np.all(np.isfinite(ds["sa"].values))
+            and np.all(np.isfinite(ds["fault_size"].values))):
+        return "a chunk of it is missing (its arrays hold fill values)"
+    return None
+
+
+def _block_manifest(path: Path) -> dict | None:
+    try:
+        return _block_record(path).get("manifest")
+    except (OSError, ValueError):
+        return None
+
+
+def _rebuild_hint(store: Path, man: dict) -> str:
+    def many(opt, values, fmt):
+        return " ".join(f"{opt} {fmt(v)}" for v in values)
+
+    cmd = (f"gearshot simulate --store {str(store)} "
+           f"{many('--speed', man.get('speeds', []), lambda v: f'{v:g}')} "
+           f"{many('--load', man.get('loads', []), lambda v: f'{v:g}')} "
+           f"{many('--grade', man.get('grades', []), str)} "
+           f"--n-healthy {man.get('n_healthy')} --n-faulty {man.get('n_faulty')} "
+           f"--seed {man.get('seed')}"
+           + "".join(f" --fault-type {t}" for t in man.get("fault_types", [])))
+    return (f"run `{cmd}` (or build_database with the same arguments): it rebuilds only "
+            f"the damaged block and reuses the rest")
+
+
+def _read_manifest(store: Path) -> dict:
+    mpath = store / "manifest.json"
+    try:
+        man = json.loads(mpath.read_text())
+        if not isinstance(man, dict) or not {"speeds", "loads", "grades"} <= set(man):
+            raise ValueError("not a gearshot manifest")
+    except (OSError, ValueError) as exc:
+        raise GearshotError(
+            f"store {str(store)!r}: manifest.json is damaged ({exc}); run build_database / "
+            f"`gearshot simulate` on this store with its original arguments: the manifest "
+            f"is restored from the blocks' copies and damaged blocks are rebuilt") from None
+    return man
 
 
 def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: float,
@@ -125,6 +243,7 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     final = blocks / _block_name(i, j, k, fault_type)
     if final.exists():
         return final.name
+    manifest = json.loads((Path(store) / "manifest.json").read_text())
     code = list(FAULT_TYPES).index(fault_type)
     ss = np.random.SeedSequence(seed, spawn_key=(i, j, k) if code == 0 else (i, j, k, code))
     block_rng = np.random.default_rng(ss)
@@ -143,15 +262,10 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
                           {"units": "rad", "long_name": "driven-gear angle"})},
         attrs={"speed_units": "rev/s (input shaft)", "load_units": "N m",
                "fault_type": fault_type})
-    tmp = blocks / f".{final.name}.{uuid.uuid4().hex}.tmp"
-    ds.to_zarr(tmp, mode="w", consolidated=False)
-    try:
-        os.rename(tmp, final)
-    except OSError:
-        # another worker finished the same block first
-        shutil.rmtree(tmp, ignore_errors=True)
-        if not final.exists():
-            raise
+    # exist_ok: another worker may have finished the same block first
+    with atomic_dir(final, exist_ok=True) as tmp:
+        ds.to_zarr(tmp, mode="w", consolidated=False)
+        _write_checksums(tmp, manifest)
     return final.name
 
 
@@ -207,7 +321,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     if n_healthy + n_faulty == 0:
         raise GearshotError("n_healthy + n_faulty must be > 0; got 0")
     seed = check_int(seed, "seed", minimum=0)
-    n_points = check_int(n_points, "n_points", minimum=16)
+    n_points = check_int(n_points, "n_points", minimum=16, maximum=_MAX_POINTS)
+    if n_healthy + n_faulty > _MAX_SIGNALS:
+        raise GearshotError(f"n_healthy + n_faulty must be <= {_MAX_SIGNALS} per block; got "
+                            f"{n_healthy + n_faulty}")
     fault_types = _check_fault_types(fault_types)
     store = Path(store).expanduser()
     manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
@@ -218,7 +335,22 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
              for i, s in enumerate(speeds) for j, ld in enumerate(loads)
              for k, g in enumerate(grades) for ft in fault_types]
     blocks = store / "blocks"
-    todo = [t for t in tasks if not (blocks / _block_name(*t[:3], t[6])).exists()]
+    todo = []
+    damaged = []
+    for t in tasks:
+        path = blocks / _block_name(*t[:3], t[6])
+        if path.exists():
+            problem = _block_problem(path)
+            if problem is None:
+                if not _block_record(path):   # a block from before checksum lists
+                    _write_checksums(path, manifest)
+                continue
+            damaged.append(f"{path.name} ({problem})")
+            remove_tree(path)
+        todo.append(t)
+    if damaged and progress:
+        print(f"rebuilding {len(damaged)} damaged block(s) of {str(store)!r}: "
+              + "; ".join(damaged), file=sys.stderr)
     own_cluster = None
     if client is None and len(todo) > _SMALL_BUILD:
         from dask.distributed import Client, LocalCluster
@@ -236,27 +368,30 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
 
 
 def _prepare_store(store: Path, manifest: dict) -> None:
-    if store.exists() and not store.is_dir():
-        raise GearshotError(f"store must be a folder; {str(store)!r} is a file")
-    parent = store if store.exists() else store.parent
-    while not parent.exists():
-        parent = parent.parent
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise GearshotError(f"store {str(store)!r} is not writable "
-                            f"(no write permission on {str(parent)!r})")
+    check_writable(store, "store", folder=True)
     mpath = store / "manifest.json"
     if mpath.exists():
-        old = json.loads(mpath.read_text())
+        try:
+            old = _read_manifest(store)
+        except GearshotError:
+            # restore a damaged manifest only from blocks that say they are this build
+            copies = [_block_manifest(b) for b in (store / "blocks").glob("*.zarr")]
+            if not copies or any(c != manifest for c in copies):
+                raise
+            old = manifest
+            write_json_atomic(manifest, mpath, sort_keys=False)
         if old != manifest:
             diff = sorted(k for k in manifest if old.get(k) != manifest[k])
             raise GearshotError(f"store {str(store)!r} holds a different build "
-                                f"(differs in {', '.join(diff)}); use a new store")
+                                f"(differs in {', '.join(diff)}); use a new store "
+                                f"(--store / store=)")
     try:
         (store / "blocks").mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise GearshotError(f"store {str(store)!r} is not writable ({exc})") from None
+        raise GearshotError(f"store {str(store)!r} is not writable ({exc.strerror or exc})") \
+            from None
     if not mpath.exists():
-        _write_json_atomic(mpath, manifest)
+        write_json_atomic(manifest, mpath, sort_keys=False)
     for leftover in (store / "blocks").glob(".*.tmp"):   # from interrupted runs
         shutil.rmtree(leftover, ignore_errors=True)
 
@@ -313,7 +448,7 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
     if not mpath.exists():
         raise GearshotError(f"store {str(store)!r} holds no gearshot database "
                             f"(no manifest.json)")
-    man = json.loads(mpath.read_text())
+    man = _read_manifest(store)
 
     def index(values, want, name):
         hits = np.flatnonzero(np.isclose(values, want, rtol=1e-9, atol=1e-12))
@@ -335,12 +470,23 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
     for k in ks:
         for ft in types:
             path = store / "blocks" / _block_name(i, j, k, ft)
+            where = (f"block {path.name} (speed={speed!r}, load={load!r}, "
+                     f"grade={man['grades'][k]!r}, fault_type={ft!r}) of store {str(store)!r}")
             if not path.exists():
-                raise GearshotError(f"block speed={speed!r}, load={load!r}, "
-                                    f"grade={man['grades'][k]!r}, fault_type={ft!r} of "
-                                    f"{str(store)!r} is not built yet; run build_database "
-                                    f"again to finish it")
-            part = xr.open_zarr(path, consolidated=False).load()
+                raise GearshotError(f"{where} is not built yet; {_rebuild_hint(store, man)}")
+            problem = _block_problem(path)
+            if problem is None:
+                try:
+                    part = xr.open_zarr(path, consolidated=False).load()
+                except Exception as exc:  # a decoder's error on a damaged chunk
+                    problem = f"it cannot be decoded ({type(exc).__name__}: {exc})"
+                else:
+                    if "sa" not in part or not np.all(np.isfinite(part["sa"].values)):
+                        problem = "its SA array is incomplete (non-finite values)"
+            if problem is not None:
+                raise GearshotError(f"{where} is damaged: {problem}; "
+                                    f"{_rebuild_hint(store, man)}")
+            part.attrs.pop(_ATTR, None)
             part.attrs.pop("fault_type", None)
             parts.append(part.assign_coords(
                 fault_type=("signal", np.full(part.sizes["signal"], ft, dtype=object))))

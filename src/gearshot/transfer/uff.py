@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import io
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 from .._validation import check_int
 from .function import TransferFunction
@@ -293,18 +293,9 @@ def _read_csv(path: Path) -> TransferFunction:
 
 # ---------------------------------------------------------------------------- FRF write
 def _atomic_write(path: Path, writer) -> None:
-    """Write via a temporary file in the same folder, then ``os.replace`` onto ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
-                               dir=path.parent)
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    """Write through :func:`gearshot._atomic.atomic_path` (folders created)."""
+    with atomic_path(path, make_parents=True) as tmp:
+        writer(tmp)
 
 
 def _ascii_lossless(tf: TransferFunction) -> bool:
