@@ -18,8 +18,15 @@ from pathlib import Path
 import numpy as np
 
 from gearshot.signal import difference_signal
-from gearshot.sim import (GearPair, PartialFaceFault, ToothBreakage, ToothDestruction,
-                          build_database, mesh_stiffness, simulate_sa)
+from gearshot.sim import (
+    GearPair,
+    PartialFaceFault,
+    ToothBreakage,
+    ToothDestruction,
+    build_database,
+    mesh_stiffness,
+    simulate_sa,
+)
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "bgu_fault_types.npz"
 

@@ -7,8 +7,17 @@ from scipy.stats import spearmanr
 
 from gearshot import GearshotError
 from gearshot.signal import difference_signal
-from gearshot.sim import (FAULT_TYPES, Fault, GearPair, PartialFaceFault, ToothBreakage,
-                          ToothDestruction, fault_of_type, mesh_stiffness, simulate_sa)
+from gearshot.sim import (
+    FAULT_TYPES,
+    Fault,
+    GearPair,
+    PartialFaceFault,
+    ToothBreakage,
+    ToothDestruction,
+    fault_of_type,
+    mesh_stiffness,
+    simulate_sa,
+)
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 PAIR = GearPair.paper()
