@@ -19,6 +19,7 @@ from .paper import (
     plot_tuning_curve,
     save_figure,
 )
+from .fault_types import plot_fault_signatures
 from .transfer import plot_transfer_function, plot_transfer_functions
 
 __all__ = [
@@ -34,4 +35,5 @@ __all__ = [
     "plot_error_vs",
     "plot_transfer_function",
     "plot_transfer_functions",
+    "plot_fault_signatures",
 ]
