@@ -31,7 +31,8 @@ def main():
     sa = simulate_sa(pair, speed=15, load=10, grade=7, faults=faults, same_gear=True, rng=3)
     sig = {n: sa[i + 1] - sa[0] for i, n in enumerate(names)}
     for n in names:
-        print(f"{n:13s} size {args.size}: RMS of faulty - healthy {np.sqrt(np.mean(sig[n] ** 2)):8.2f} g, "
+        level = np.sqrt(np.mean(sig[n] ** 2))
+        print(f"{n:13s} size {args.size}: RMS of faulty - healthy {level:8.2f} g, "
               f"peak {np.abs(sig[n]).max():8.1f} g")
     lines = plot_fault_signatures(sig, 38, n_mesh=4)
     fig = lines[0][0].figure

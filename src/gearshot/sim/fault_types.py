@@ -32,9 +32,10 @@ slice's contact away where the gear contact would lie above the break
 (:meth:`~gearshot.sim.ToothFault.stiffness_scale` = 0, so the neighbouring pairs carry
 the load) and the break edge, where contact re-enters, falls short of the involute by
 ``edge_relief`` times the lost height (the excitation that makes a broken tooth loud,
-:meth:`_TipLoss.displacement`); the destroyed band lowers the pair stiffness by the lost contact share and adds
-a displacement excitation of its craters (raised-cosine pits 5 % of the active profile
-wide), tapered at the band's edges where the mating flank bridges onto the intact surface.
+:meth:`_TipLoss.displacement`); the destroyed band lowers the pair stiffness by the lost
+contact share and adds a displacement excitation of its craters (raised-cosine pits 5 % of
+the active profile wide), tapered at the band's edges where the mating flank bridges onto
+the intact surface.
 """
 
 from __future__ import annotations
