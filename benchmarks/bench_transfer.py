@@ -21,9 +21,16 @@ from pathlib import Path
 
 import numpy as np
 
-from gearshot.transfer import (TransferFunctionBank, antiresonances, attenuation_db,
-                               estimate_transfer_function, frf_from_impacts, impact_arrays,
-                               read_uff_records, synthetic_bank)
+from gearshot.transfer import (
+    TransferFunctionBank,
+    antiresonances,
+    attenuation_db,
+    estimate_transfer_function,
+    frf_from_impacts,
+    impact_arrays,
+    read_uff_records,
+    synthetic_bank,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"

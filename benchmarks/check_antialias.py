@@ -47,7 +47,8 @@ def analytic():
     for aa in (True, False):
         sa = synchronous_average(angular_resample(x, fs, cyc, samples_per_rev=SPR,
                                                   antialias=aa), SPR)
-        print(f"analytic, antialias={aa}: SA error {np.linalg.norm(sa - ref) / np.linalg.norm(ref):.2e}")
+        err = np.linalg.norm(sa - ref) / np.linalg.norm(ref)
+        print(f"analytic, antialias={aa}: SA error {err:.2e}")
 
 
 def rig():

@@ -44,9 +44,10 @@ def main():
     pair = GearPair.paper()
     k = mesh_stiffness(pair, theta)
     kf = mesh_stiffness(pair, theta, fault=Fault.ftff(0.5))
-    print("mesh stiffness: mean ours %.4g ref %.4g (%.1f %%), RMS diff %.1f %% of mean"
-          % (k.mean(), data[:, 1].mean(), 100 * (k.mean() / data[:, 1].mean() - 1),
-             100 * rms(k - data[:, 1]) / data[:, 1].mean()))
+    ref = data[:, 1].mean()
+    print(f"mesh stiffness: mean ours {k.mean():.4g} ref {ref:.4g} "
+          f"({100 * (k.mean() / ref - 1):.1f} %), RMS diff "
+          f"{100 * rms(k - data[:, 1]) / ref:.1f} % of mean")
 
     ref = np.load(REF / "bgu_sa.npz")
     cases = [("y000_din7", 0.0, 7), ("y010_din7", 0.1, 7), ("y030_din7", 0.3, 7),

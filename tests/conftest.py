@@ -1,8 +1,7 @@
 """Shared fixtures: the ../shared folder beside the repository."""
 
-from pathlib import Path
-
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from estimator_data import N, synthetic_database, synthetic_sa, synthetic_target
 from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.base import clone
 from sklearn.model_selection import GridSearchCV, ShuffleSplit
@@ -9,7 +10,6 @@ from sklearn.neighbors import KNeighborsRegressor
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 
-from estimator_data import N, synthetic_database, synthetic_sa, synthetic_target
 from gearshot import GearshotError
 from gearshot.estimator import OneFaultShotEstimator, signature_weights, steps, uncertainty
 from gearshot.transfer import resample_transfer_function

@@ -3,13 +3,20 @@
 import numpy as np
 import pandas as pd
 import pytest
+from estimator_data import N, synthetic_sa
 from numpy.testing import assert_allclose
 
-from estimator_data import N, synthetic_sa
 from gearshot import GearshotError
-from gearshot.experiments import (RIG_VARIANTS, SIMULATED_VARIANTS, evaluate_variants,
-                                  rig_dataset, rig_experiment, simulated_dataset, summarize,
-                                  variant_params)
+from gearshot.experiments import (
+    RIG_VARIANTS,
+    SIMULATED_VARIANTS,
+    evaluate_variants,
+    rig_dataset,
+    rig_experiment,
+    simulated_dataset,
+    summarize,
+    variant_params,
+)
 
 
 @pytest.fixture(scope="module")
@@ -131,8 +138,8 @@ def test_figures_and_report(tmp_path, sim_data):
 
 
 def test_rig_figures_include_fig11_and_the_tuning_curve(tmp_path, sim_data):
-    from gearshot.estimator import OneFaultShotEstimator
     from gearshot.app.figures import rig_figures
+    from gearshot.estimator import OneFaultShotEstimator
 
     sa, y = sim_data
     tf = np.ones(N, complex)

@@ -7,10 +7,10 @@ import json
 import h5py
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 import scipy.io
 import scipy.io.wavfile
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from gearshot import GearshotError
 from gearshot.io import Recording

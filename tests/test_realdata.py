@@ -14,8 +14,7 @@ from numpy.testing import assert_allclose
 from gearshot import GearshotError, Machine
 from gearshot.features import available_features, extract_features
 from gearshot.io import Recording
-from gearshot.signal import (angular_resample, difference_signal, pulse_times,
-                             synchronous_average)
+from gearshot.signal import angular_resample, difference_signal, pulse_times, synchronous_average
 from gearshot.signal.trains import antialias_filter, as_ratio, shaft_cycle_times
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -27,8 +27,14 @@ from hypothesis import strategies as st
 
 import gearshot.signal as gs
 from gearshot import GearshotError
-from gearshot._atomic import (atomic_dir, atomic_path, check_writable, staging_dir,
-                              write_json_atomic, write_text_atomic)
+from gearshot._atomic import (
+    atomic_dir,
+    atomic_path,
+    check_writable,
+    staging_dir,
+    write_json_atomic,
+    write_text_atomic,
+)
 from gearshot.features import available_features, extract_features, na4_baseline_variance
 
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -48,7 +54,7 @@ def test_atomic_path_replaces_whole_or_not_at_all(tmp_path):
     with pytest.raises(ZeroDivisionError):
         with atomic_path(target) as tmp:
             tmp.write_text("half")
-            1 / 0
+            raise ZeroDivisionError
     assert json.loads(target.read_text()) == {"x": 1}
     assert not leftovers(tmp_path)
     with pytest.raises(TypeError):  # not serialisable: nothing written

@@ -7,8 +7,17 @@ from scipy.stats import spearmanr
 
 from gearshot import GearshotError
 from gearshot.signal import difference_signal
-from gearshot.sim import (FAULT_TYPES, Fault, GearPair, PartialFaceFault, ToothBreakage,
-                          ToothDestruction, fault_of_type, mesh_stiffness, simulate_sa)
+from gearshot.sim import (
+    FAULT_TYPES,
+    Fault,
+    GearPair,
+    PartialFaceFault,
+    ToothBreakage,
+    ToothDestruction,
+    fault_of_type,
+    mesh_stiffness,
+    simulate_sa,
+)
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 PAIR = GearPair.paper()
@@ -62,7 +71,15 @@ def test_missing_tooth_loses_its_contact():
     assert np.all(km <= k + 1e-6)
 
 
-@pytest.mark.parametrize("name", ["partial_face", "breakage", "destruction"])
+_BREAKAGE_NOT_MONOTONIC = pytest.mark.xfail(
+    strict=False, reason="breakage (lab geometry: tip loss over the whole face) peaks at "
+    "y ~ 0.7, where contact re-enters abruptly in the single-contact zone, above the "
+    "missing tooth (Spearman ~0.89); benchmarks/RESULTS.md")
+
+
+@pytest.mark.parametrize("name", ["partial_face",
+                                  pytest.param("breakage", marks=_BREAKAGE_NOT_MONOTONIC),
+                                  "destruction"])
 def test_signature_grows_with_size_and_small_faults_are_buried(name):
     sizes = np.linspace(0.0, 1.0, 11)
     sa = simulate_sa(PAIR, speed=15, load=10, grade=7, fault_sizes=sizes, same_gear=True,
@@ -83,17 +100,39 @@ def test_helical_pairs_take_every_fault_type(name):
     assert np.all(np.isfinite(sa)) and r[1] > r[0]
 
 
+def test_breakage_small_is_buried_and_missing_tooth_is_loud():
+    sizes = [0.0, 0.1, 0.3, 1.0]
+    r = _diff_rms(simulate_sa(PAIR, speed=15, load=10, grade=7, fault_sizes=sizes,
+                              same_gear=True, rng=3, fault_type="breakage"))
+    assert r[1] < 1.25 * r[0] and r[2] < 1.25 * r[0]
+    assert r[3] > 2.5 * r[0]
+
+
+def test_breakage_geometry():
+    """Tip loss y H over the whole face, a corner chip (1 + c) y H deep at face 0."""
+    f = ToothBreakage(size=0.3)
+    h = ToothBreakage.active_height(PAIR)
+    np.testing.assert_allclose(f.lost_height(PAIR, [1.0, 0.8, 0.0]),
+                               [0.3 * h, 0.3 * h, 0.5 * h], rtol=1e-12)
+    np.testing.assert_allclose(ToothBreakage(size=1.0).lost_height(PAIR, [0, 1]), [h, h])
+    with pytest.raises(GearshotError, match="edge_relief"):
+        ToothBreakage(size=0.3, edge_relief=-1.0)
+
+
 def test_against_lab_model_fault_types():
     """Ratio faulty/healthy of the difference-signal RMS against the lab's model on
     the same geometry (one gear, shared profile errors): partial face buried,
-    destruction within a factor 2 (breakage: see benchmarks/RESULTS.md)."""
+    destruction and breakage within a factor 2."""
     ref = SHARED / "reference" / "bgu_fault_types.npz"
     if not ref.exists():
         pytest.skip(f"{ref} not found")
     d = np.load(ref)
-    r_ref = {k: _diff_rms(d[k]) for k in ("healthy", "PartialFaceFault", "ToothDestruction")}
+    r_ref = {k: _diff_rms(d[k]) for k in ("healthy", "PartialFaceFault", "ToothDestruction",
+                                          "ToothBreakage")}
+    # the lab's breakage: 3 mm tip loss over the face, a 5 mm x 12 mm corner chip
+    y_break = 3e-3 / ToothBreakage.active_height(PAIR)
     faults = [None, PartialFaceFault(size=2 / 15, profile_size=0.6, center=0.5, depth=0.5),
-              ToothDestruction(size=10 / 14, center=8 / 14)]
+              ToothDestruction(size=10 / 14, center=8 / 14), ToothBreakage(size=y_break)]
     ratios = []
     for seed in range(2):
         r = _diff_rms(simulate_sa(PAIR, speed=15, load=10, grade=7, faults=faults,
@@ -103,3 +142,5 @@ def test_against_lab_model_fault_types():
     assert ratio[1] < 1.3                                    # buried, as in the lab's
     want = r_ref["ToothDestruction"] / r_ref["healthy"]
     assert want / 2 <= ratio[2] <= 2 * want
+    want = r_ref["ToothBreakage"] / r_ref["healthy"]
+    assert want / 2 <= ratio[3] <= 2 * want

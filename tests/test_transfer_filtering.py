@@ -5,8 +5,13 @@ import pytest
 from numpy.testing import assert_allclose
 
 from gearshot import GearshotError
-from gearshot.transfer import (Mode, TransferFunction, filter_signal,
-                               fir_from_transfer_function, modal_frf)
+from gearshot.transfer import (
+    Mode,
+    TransferFunction,
+    filter_signal,
+    fir_from_transfer_function,
+    modal_frf,
+)
 
 FS = 2000.0
 

@@ -5,8 +5,14 @@ import pytest
 from numpy.testing import assert_allclose
 
 from gearshot import GearshotError
-from gearshot.transfer import (Mode, TransferFunction, antiresonances, attenuation_db,
-                               modal_frf, synthetic_bank)
+from gearshot.transfer import (
+    Mode,
+    TransferFunction,
+    antiresonances,
+    attenuation_db,
+    modal_frf,
+    synthetic_bank,
+)
 
 
 def test_single_mode_accelerance_analytic():

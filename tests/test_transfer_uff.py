@@ -8,7 +8,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from gearshot import GearshotError
-from gearshot.transfer import (TransferFunction, read_frf, read_uff_records, write_frf)
+from gearshot.transfer import TransferFunction, read_frf, read_uff_records, write_frf
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 FRF_DIR = SHARED / "data" / "frf"

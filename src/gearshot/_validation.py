@@ -37,7 +37,8 @@ def describe(value: Any) -> str:
     """Short, readable rendering of a (possibly large) value for error messages."""
     if isinstance(value, np.ndarray):
         if value.size <= 6:
-            return f"array({np.array2string(value, precision=4, separator=', ')}, shape={value.shape})"
+            text = np.array2string(value, precision=4, separator=", ")
+            return f"array({text}, shape={value.shape})"
         return f"array(shape={value.shape}, dtype={value.dtype})"
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
@@ -150,7 +151,7 @@ def check_int(value: Any, name: str, *, minimum: int | None = None,
     """Validate an integer parameter (bools are rejected)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         if isinstance(value, numbers.Real) and float(value).is_integer():
-            value = int(value)
+            value = int(float(value))
         else:
             raise GearshotError(f"{name} must be an integer; got {describe(value)}")
     value = int(value)

@@ -25,9 +25,9 @@ Moment ratios of signals whose RMS is below ``1e-10`` are 0 (the reference's con
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from types import MappingProxyType
-from typing import Callable
 
 import numpy as np
 import scipy.fft

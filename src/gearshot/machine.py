@@ -56,10 +56,11 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from ._errors import GearshotError
 from ._validation import describe
@@ -328,7 +329,8 @@ class Machine:
     shaft_orders: tuple[int, ...] = (1, 2)
     n_sidebands: int = 2
     antialias: bool = True
-    _ratios: dict = field(default=None, init=False, repr=False, compare=False)
+    _ratios: dict[str, Fraction] = field(default_factory=dict, init=False, repr=False,
+                                         compare=False)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -364,10 +366,10 @@ class Machine:
             raise GearshotError(f"sensor names must be unique; got {names}")
         if self.layout is not None:
             cols = set(self.layout.columns)
-            for s in self.sensors:
-                if s.channel not in cols:
-                    raise GearshotError(f"sensor {s.name!r}: channel={s.channel!r} is not one "
-                                        f"of file.columns {list(self.layout.columns)}")
+            for sensor in self.sensors:
+                if sensor.channel not in cols:
+                    raise GearshotError(f"sensor {sensor.name!r}: channel={sensor.channel!r} is "
+                                        f"not one of file.columns {list(self.layout.columns)}")
             if self.tacho.channel not in cols:
                 raise GearshotError(f"tacho.channel={self.tacho.channel!r} is not one of "
                                     f"file.columns {list(self.layout.columns)}")
@@ -460,19 +462,23 @@ class Machine:
         raise GearshotError(f"sensor={name!r} is not a sensor of machine {self.name!r}; "
                             f"sensors: {[s.name for s in self.sensors]}")
 
-    def monitored_stage(self) -> GearStage:
-        """The stage of the monitored gear."""
+    def _monitored(self) -> MonitoredGear:
         if self.monitored is None:
             raise GearshotError(f"machine {self.name!r} names no [monitored] gear")
+        return self.monitored
+
+    def monitored_stage(self) -> GearStage:
+        """The stage of the monitored gear."""
+        mon = self._monitored()
         for st in self.stages:
-            if st.teeth_on(self.monitored.shaft) == self.monitored.teeth:
+            if st.teeth_on(mon.shaft) == mon.teeth:
                 return st
-        raise GearshotError(f"no stage holds the monitored gear")  # pragma: no cover
+        raise GearshotError("no stage holds the monitored gear")  # pragma: no cover
 
     def mate(self) -> tuple[str, int]:
         """Shaft and tooth count of the gear that meshes with the monitored gear."""
         st = self.monitored_stage()
-        if st.driver == self.monitored.shaft:
+        if st.driver == self._monitored().shaft:
             return st.driven, st.driven_teeth
         return st.driver, st.driver_teeth
 
@@ -491,8 +497,9 @@ class Machine:
         st = self.monitored_stage()
         _, mate_teeth = self.mate()
         base = GearPair.paper()
-        kwargs: dict[str, Any] = dict(z_pinion=mate_teeth, z_gear=self.monitored.teeth)
-        if mate_teeth != base.z_pinion or self.monitored.teeth != base.z_gear:
+        teeth = self._monitored().teeth
+        kwargs: dict[str, Any] = dict(z_pinion=mate_teeth, z_gear=teeth)
+        if mate_teeth != base.z_pinion or teeth != base.z_gear:
             kwargs.update(mass_pinion=None, mass_gear=None)  # from density and size
         if st.module is not None:
             kwargs["module"] = st.module
@@ -589,7 +596,7 @@ class Machine:
             except GearshotError as exc:
                 raise GearshotError(f"stage[{i}]: {exc}") from None
 
-        tt = _table(data, "tacho", required=True)
+        tt = _table(data, "tacho", required=True) or {}
         _check_keys(tt, {"channel", "shaft", "pulses_per_rev", "threshold"}, "[tacho]")
         for key in ("channel", "shaft", "pulses_per_rev"):
             if key not in tt:

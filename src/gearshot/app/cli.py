@@ -7,7 +7,7 @@ import json
 import os
 import sys
 from pathlib import Path
-from typing import List, Optional
+from typing import Any
 
 import typer
 
@@ -44,7 +44,7 @@ def _root(
     """One-fault-shot gear tooth-fault size estimation."""
 
 
-def _client(scheduler: Optional[str], workers: int, *, needed: bool):
+def _client(scheduler: str | None, workers: int, *, needed: bool):
     """A Dask client: the given scheduler, a LocalCluster when useful, or None."""
     if scheduler:
         from dask.distributed import Client
@@ -62,14 +62,14 @@ def _client(scheduler: Optional[str], workers: int, *, needed: bool):
     return None
 
 
-def _write_json(path: Optional[Path], payload: dict) -> None:
+def _write_json(path: Path | None, payload: dict) -> None:
     if path is None:
         return
     write_json_atomic(payload, path, make_parents=True, indent=2, sort_keys=False,
                       default=float)
 
 
-def _early(path: Optional[Path], option: str, *, folder: bool = False) -> None:
+def _early(path: Path | None, option: str, *, folder: bool = False) -> None:
     """Fail now, before the long work, if an output cannot be written."""
     if path is not None:
         check_writable(path, option, folder=folder)
@@ -103,7 +103,7 @@ def _check_count(value: int, option: str, *, minimum: int = 0,
         raise GearshotError(f"{option} must lie in {minimum} … {maximum}; got {value}")
 
 
-def _folder_digest(folder: Optional[Path]) -> Optional[str]:
+def _folder_digest(folder: Path | None) -> str | None:
     """Content hash of every file of an FRF folder (names and bytes), or None."""
     if folder is None:
         return None
@@ -120,7 +120,7 @@ def _folder_digest(folder: Optional[Path]) -> Optional[str]:
 CACHE_MANIFEST = "gearshot-cache.json"
 
 
-def _cached_campaign(campaign: Optional[Path], inputs: dict, record) -> Path:
+def _cached_campaign(campaign: Path | None, inputs: dict, record) -> Path:
     """The campaign for ``inputs``: reuse one recorded from exactly these inputs, else record.
 
     The default folder's name carries a hash of every input (seed, condition, grade,
@@ -172,23 +172,23 @@ def demo(
 
 @app.command()
 def simulate(
-    store: Optional[Path] = typer.Option(None, "--store", help="Zarr store (default under "
+    store: Path | None = typer.Option(None, "--store", help="Zarr store (default under "
                                          "gearshot's data home)."),
-    speed: List[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps."),
-    load: List[float] = typer.Option([10.0], "--load", help="Load(s), Nm."),
-    grade: List[int] = typer.Option(list(range(1, 13)), "--grade", help="DIN grade(s)."),
+    speed: list[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps."),
+    load: list[float] = typer.Option([10.0], "--load", help="Load(s), Nm."),
+    grade: list[int] = typer.Option(list(range(1, 13)), "--grade", help="DIN grade(s)."),
     n_healthy: int = typer.Option(100, "--n-healthy"),
     n_faulty: int = typer.Option(700, "--n-faulty"),
     seed: int = typer.Option(0, "--seed"),
     paper: bool = typer.Option(False, "--paper", help="All paper speeds (10–35 rps) and "
                                "loads (5–20 Nm)."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of a "
+    scheduler: str | None = typer.Option(None, "--scheduler", help="Address of a "
                                             "running Dask scheduler."),
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
                                 "--scheduler is given."),
-    fault_type: List[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
+    fault_type: list[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
                                          "ftff, partial_face, breakage, destruction."),
-    machine: Optional[Path] = typer.Option(None, "--machine", help="Machine description "
+    machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
 ) -> None:
@@ -254,12 +254,12 @@ def rig(
     load: float = typer.Option(10.0, "--load"),
     duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
     healthy: int = typer.Option(6, "--healthy"),
-    size: List[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
+    size: list[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
     repetitions: int = typer.Option(6, "--repetitions"),
     seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
-    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder", help="Measured FRFs "
+    frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "for the transfer path (default synthetic)."),
-    rig_grade: Optional[int] = typer.Option(None, "--rig-grade", help="Force the rig's true "
+    rig_grade: int | None = typer.Option(None, "--rig-grade", help="Force the rig's true "
                                             "surface grade (default: hidden, drawn)."),
 ) -> None:
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
@@ -290,24 +290,24 @@ def _make_rig(seed, frf_folder, rig_grade):
 
 @experiment_app.command("simulated")
 def experiment_simulated(
-    store: Optional[Path] = typer.Option(None, "--store", help="Database store (built if "
+    store: Path | None = typer.Option(None, "--store", help="Database store (built if "
                                          "missing)."),
-    speed: List[float] = typer.Option([15.0], "--speed"),
-    load: List[float] = typer.Option([10.0], "--load"),
+    speed: list[float] = typer.Option([15.0], "--speed"),
+    load: list[float] = typer.Option([10.0], "--load"),
     grade: int = typer.Option(7, "--grade", help="Grade of the simulated signals."),
-    attenuation_db: List[float] = typer.Option([10.0], "--attenuation-db"),
-    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder", help="Measured FRFs "
+    attenuation_db: list[float] = typer.Option([10.0], "--attenuation-db"),
+    frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "(default: a synthetic bank of 24)."),
-    selection_tf: Optional[str] = typer.Option(None, "--selection-tf", help="Name of the "
+    selection_tf: str | None = typer.Option(None, "--selection-tf", help="Name of the "
                                                "held-out TF (default the bank's last)."),
     seed: int = typer.Option(0, "--seed"),
     full: bool = typer.Option(False, "--full", help="The paper's sweep: 26 speeds × 4 loads "
                               "× 23 TFs."),
     n_healthy: int = typer.Option(100, "--n-healthy"),
     n_faulty: int = typer.Option(700, "--n-faulty"),
-    json_out: Optional[Path] = typer.Option(None, "--json", help="Write results as JSON."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Folder for figures and report."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler"),
+    json_out: Path | None = typer.Option(None, "--json", help="Write results as JSON."),
+    out: Path | None = typer.Option(None, "--out", help="Folder for figures and report."),
+    scheduler: str | None = typer.Option(None, "--scheduler"),
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
@@ -353,24 +353,24 @@ def experiment_simulated(
 
 @experiment_app.command("rig")
 def experiment_rig(
-    campaign: Optional[Path] = typer.Option(None, "--campaign", help="Campaign folder "
+    campaign: Path | None = typer.Option(None, "--campaign", help="Campaign folder "
                                             "(recorded if missing)."),
-    store: Optional[Path] = typer.Option(None, "--store"),
+    store: Path | None = typer.Option(None, "--store"),
     speed: float = typer.Option(15.0, "--speed"),
     load: float = typer.Option(10.0, "--load"),
     seed: int = typer.Option(0, "--seed"),
-    frf_folder: Optional[Path] = typer.Option(None, "--frf-folder"),
-    rig_grade: Optional[int] = typer.Option(None, "--rig-grade"),
-    attenuation_db: Optional[float] = typer.Option(None, "--attenuation-db",
+    frf_folder: Path | None = typer.Option(None, "--frf-folder"),
+    rig_grade: int | None = typer.Option(None, "--rig-grade"),
+    attenuation_db: float | None = typer.Option(None, "--attenuation-db",
                                                    help="Rig path attenuation (default "
                                                    "hidden, 10–30 dB)."),
     duration: float = typer.Option(60.0, "--duration"),
     repeats: int = typer.Option(5, "--repeats", help="Random example draws."),
     n_healthy: int = typer.Option(100, "--n-healthy"),
     n_faulty: int = typer.Option(700, "--n-faulty"),
-    json_out: Optional[Path] = typer.Option(None, "--json"),
-    out: Optional[Path] = typer.Option(None, "--out"),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler"),
+    json_out: Path | None = typer.Option(None, "--json"),
+    out: Path | None = typer.Option(None, "--out"),
+    scheduler: str | None = typer.Option(None, "--scheduler"),
     workers: int = typer.Option(2, "--workers"),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
@@ -400,7 +400,7 @@ def experiment_rig(
         if client is not None:
             client.close()
     database = load_database(store, speed=speed, load=load)
-    inputs = {"seed": seed, "speed": speed, "load": load, "rig_grade": rig_grade,
+    inputs: dict[str, Any] = {"seed": seed, "speed": speed, "load": load, "rig_grade": rig_grade,
               "attenuation_db": attenuation_db, "duration": duration,
               "frf_sha256": _folder_digest(frf_folder), "healthy": 6,
               "sizes": [0.32, 0.56, 0.66], "repetitions": 6, "fs": 50_000.0}
@@ -414,7 +414,9 @@ def experiment_rig(
                          repetitions=inputs["repetitions"])
 
     campaign = _cached_campaign(campaign, inputs, record)
-    selection = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
+    import numpy as np
+
+    selection = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
                                           n_repeats=repeats, seed=seed,
@@ -439,10 +441,10 @@ def experiment_rig(
 @app.command()
 def predict(
     database: Path = typer.Option(..., "--database", help="Simulated database store."),
-    healthy: List[Path] = typer.Option(..., "--healthy", help="Healthy recording file(s)."),
+    healthy: list[Path] = typer.Option(..., "--healthy", help="Healthy recording file(s)."),
     faulty: Path = typer.Option(..., "--faulty", help="The one faulty recording."),
     faulty_size: float = typer.Option(..., "--faulty-size", help="Its fault size in (0, 1]."),
-    recordings: List[Path] = typer.Option([], "--recordings", help="Folder (or file) of "
+    recordings: list[Path] = typer.Option([], "--recordings", help="Folder (or file) of "
                                           "recordings to estimate; with --machine, any "
                                           "number of files."),
     speed: float = typer.Option(..., "--speed", help="Condition of the database slice, rps."),
@@ -452,13 +454,13 @@ def predict(
     gear_teeth: int = typer.Option(38, "--gear-teeth"),
     pinion_teeth: int = typer.Option(17, "--pinion-teeth"),
     seed: int = typer.Option(0, "--seed"),
-    machine: Optional[Path] = typer.Option(None, "--machine", help="Machine description "
+    machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): SAs of the monitored gear's shaft through "
                                            "its gear train; --speed is the tacho shaft's."),
-    cycles_per_segment: Optional[int] = typer.Option(None, "--cycles-per-segment",
+    cycles_per_segment: int | None = typer.Option(None, "--cycles-per-segment",
                                                      help="With --machine: revolutions per "
                                                      "SA segment (default: the machine's)."),
-    sensor: Optional[str] = typer.Option(None, "--sensor", help="With --machine: sensor "
+    sensor: str | None = typer.Option(None, "--sensor", help="With --machine: sensor "
                                          "name (default the first)."),
     holdout: float = typer.Option(0.25, "--holdout", help="With --machine: fraction of each "
                                   "healthy recording's segments kept out of the fit and "
@@ -496,16 +498,16 @@ def predict(
 
 @app.command()
 def indicators(
-    recordings: List[Path] = typer.Argument(..., help="Recording files (the original zips "
+    recordings: list[Path] = typer.Argument(..., help="Recording files (the original zips "
                                             "are fine)."),
     machine: Path = typer.Option(..., "--machine", help="Machine description (TOML)."),
     shaft: str = typer.Option(..., "--shaft", help="Shaft whose revolution is the SA cycle."),
-    sensor: Optional[str] = typer.Option(None, "--sensor", help="Sensor name (default: the "
+    sensor: str | None = typer.Option(None, "--sensor", help="Sensor name (default: the "
                                          "machine file's first)."),
     json_out: Path = typer.Option(..., "--json", help="Write the indicators as JSON."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Folder for one figure per "
+    out: Path | None = typer.Option(None, "--out", help="Folder for one figure per "
                                        "indicator."),
-    baseline: List[Path] = typer.Option([], "--baseline", help="Healthy recording(s): NA4 "
+    baseline: list[Path] = typer.Option([], "--baseline", help="Healthy recording(s): NA4 "
                                         "against their residual variance."),
 ) -> None:
     """Condition indicators of one shaft per recording, through a machine description."""

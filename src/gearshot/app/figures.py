@@ -86,8 +86,8 @@ def estimator_figures(estimator, out) -> dict:
     out = Path(out)
     figs = {}
     if getattr(estimator, "selection_features_", None) is not None:
-        plotting.plot_feature_invariance(*estimator.selection_features_,
-                                         estimator.candidate_features_,
+        train, test = estimator.selection_features_
+        plotting.plot_feature_invariance(train, test, estimator.candidate_features_,
                                          estimator.feature_errors_)
         figs["Feature invariance (step 1): estimated vs held-out TF, Fig. 11"] = \
             plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]

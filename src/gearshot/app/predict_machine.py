@@ -140,7 +140,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
         rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
     est = OneFaultShotEstimator(random_state=seed, mesh_order=machine.monitored.teeth)
-    selection_tf = TransferFunctionBank.synthetic(1, rng=[seed, 99])[0]
+    selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
     est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
             selection_tf=selection_tf)
     frame = pd.DataFrame([r[:4] for r in rows],

@@ -15,6 +15,7 @@ import re
 import zipfile
 from collections.abc import Sequence
 from pathlib import Path
+from types import EllipsisType
 
 import numpy as np
 import pandas as pd
@@ -78,7 +79,7 @@ def _split(row: str, delimiter: str | None) -> list[str]:
     return [c.strip() for c in (row.split() if delimiter is None else row.split(delimiter))]
 
 
-def read_text(path: Path, *, delimiter: str | None | type(...) = ..., header: bool | None = None,
+def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header: bool | None = None,
               columns: Sequence[str] | None = None, skip_rows: int = 0) -> RawFile:
     """Read a delimited text recording into named channels.
 

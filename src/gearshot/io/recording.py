@@ -14,13 +14,13 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_int, check_positive, describe
+from ..signal.angle import TACHO_SHAFTS, check_pulse_train, uniform_cycle_times
 from ._fileio import METADATA_KEYS, RawFile, reconcile_fs, select_channels
 from ._format_csv import read_csv, write_csv
 from ._format_hdf5 import read_hdf5, write_hdf5
 from ._format_matlab import read_mat, write_mat
 from ._format_text import TEXT_SUFFIXES, read_text
 from ._format_wav import read_wav, write_wav
-from ..signal.angle import TACHO_SHAFTS, check_pulse_train, uniform_cycle_times
 
 __all__ = ["Recording", "FORMATS"]
 

@@ -7,6 +7,7 @@ application's choice (the ``gearshot`` command line uses the non-interactive Agg
 
 from __future__ import annotations
 
+from .fault_types import plot_fault_signatures
 from .paper import (
     VARIANT_LABELS,
     plot_ablation,
@@ -34,4 +35,5 @@ __all__ = [
     "plot_error_vs",
     "plot_transfer_function",
     "plot_transfer_functions",
+    "plot_fault_signatures",
 ]

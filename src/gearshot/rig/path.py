@@ -22,8 +22,13 @@ import scipy.signal
 
 from .._errors import GearshotError
 from .._validation import check_int, check_positive
-from ..transfer import (Mode, TransferFunction, TransferFunctionBank,
-                        fir_from_transfer_function, modal_frf)
+from ..transfer import (
+    Mode,
+    TransferFunction,
+    TransferFunctionBank,
+    fir_from_transfer_function,
+    modal_frf,
+)
 from ..transfer import attenuation_db as tf_attenuation_db
 
 __all__ = ["synthetic_path_tfs", "as_tf_list", "path_fir", "apply_path"]

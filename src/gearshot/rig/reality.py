@@ -105,6 +105,16 @@ class RigReality:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
 
 
+def _pair(values: Any) -> tuple[float, float]:
+    a, b = values
+    return float(a), float(b)
+
+
+def _triple(values: Any) -> tuple[float, float, float]:
+    a, b, c = values
+    return float(a), float(b), float(c)
+
+
 def _factor(rng: np.random.Generator, size: int | None = None):
     """A factor 10-30 % away from 1, random sign."""
     mag = rng.uniform(0.10, 0.30, size)
@@ -134,16 +144,16 @@ def draw_reality(rng: np.random.Generator, *, n_tfs: int = 1, gear_teeth: int = 
     return RigReality(
         grade=grade,
         profile_seed=int(rng.integers(2**31)),
-        mass_factor=tuple(float(v) for v in _factor(rng, 2)),
-        inertia_factor=tuple(float(v) for v in _factor(rng, 2)),
+        mass_factor=_pair(_factor(rng, 2)),
+        inertia_factor=_pair(_factor(rng, 2)),
         bearing_stiffness_factor=float(_factor(rng)),
         shaft_stiffness_factor=float(_factor(rng)),
         mesh_stiffness_factor=float(_factor(rng)),
         damping_factor=float(_factor(rng)),
         fault_center=float(rng.uniform(0.42, 0.58)),
         fault_depth=float(rng.uniform(0.35, 0.65)),
-        fault_edges=tuple(float(v) for v in rng.uniform(-0.12, 0.12, 2)),
-        fault_roughness=tuple(float(v) for v in rng.uniform(-0.25, 0.25, 3)),
+        fault_edges=_pair(rng.uniform(-0.12, 0.12, 2)),
+        fault_roughness=_triple(rng.uniform(-0.25, 0.25, 3)),
         speed_drift=float(rng.uniform(0.005, 0.01)),
         speed_ripple=float(rng.uniform(0.002, 0.008)),
         load_ripple=float(rng.uniform(0.02, 0.08)),

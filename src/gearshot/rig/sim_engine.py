@@ -18,6 +18,7 @@ How the hidden reality reaches the simulator:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -59,7 +60,10 @@ class IrregularFaceFault(FullToothFaceFault):
         if s1 <= s0:
             return np.ones_like(s)
         x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
-        return 1.0 + sum(r * np.cos((k + 1) * np.pi * x) for k, r in enumerate(self.roughness))
+        profile = np.ones_like(x)
+        for k, r in enumerate(self.roughness):
+            profile = profile + r * np.cos((k + 1) * np.pi * x)
+        return profile
 
     def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
         base = super().section_loss(pair, x)
@@ -136,6 +140,7 @@ class SimulatorEngine:
             grade, prng = self.nominal_grade, rng
         else:
             grade, prng = reality.grade, np.random.default_rng(reality.profile_seed)
+        fault: dict[str, Any]
         if reality is not None and size > 0 and any(reality.fault_roughness):
             fault = dict(faults=[IrregularFaceFault(size=size, center=center, depth=depth,
                                                     roughness=reality.fault_roughness)])

@@ -26,9 +26,8 @@ import numpy as np
 import scipy.signal
 
 from .._validation import check_in_range, check_int
-from .reality import RigReality
-
 from ..sim.profile_errors import DIN_PROFILE_TOLERANCES
+from .reality import RigReality
 
 __all__ = ["SurrogateEngine", "DIN_PROFILE_TOLERANCES_UM"]
 

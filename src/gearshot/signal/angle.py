@@ -27,6 +27,7 @@ shifted against each other (by whole teeth and fractions); SAs of one recording 
 from __future__ import annotations
 
 import numpy as np
+
 from .._errors import GearshotError
 from .._validation import MAX_POINTS, check_int, finite_result
 from .angular import angle_to_time
@@ -91,11 +92,11 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
                 f"{pulses_per_rev}) after the pulse at t={pulses[i]:.4g} s; {bad.size} such "
                 f"gap(s)")
         pieces = [pulses[: long[0] + 1]]
-        for j, (i, k) in enumerate(zip(long, spans)):
-            a, b = pulses[i], pulses[i + 1]
+        for j, (at, k) in enumerate(zip(long, spans)):
+            a, b = pulses[at], pulses[at + 1]
             pieces.append(a + (b - a) * np.arange(1, k) / k)
             stop = long[j + 1] + 1 if j + 1 < long.size else pulses.size
-            pieces.append(pulses[i + 1: stop])
+            pieces.append(pulses[at + 1: stop])
         pulses = np.concatenate(pieces)
     return pulses
 

@@ -8,8 +8,16 @@ import scipy.signal
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .._errors import GearshotError
-from .._validation import (MAX_POINTS, as_signal_array, check_in_range, check_increasing,
-                           check_int, check_positive, describe, finite_result)
+from .._validation import (
+    MAX_POINTS,
+    as_signal_array,
+    check_in_range,
+    check_increasing,
+    check_int,
+    check_positive,
+    describe,
+    finite_result,
+)
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 

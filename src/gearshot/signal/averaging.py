@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 from .._errors import GearshotError
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 

@@ -23,8 +23,14 @@ import numpy as np
 import scipy.fft
 
 from .._errors import GearshotError
-from .._validation import (MAX_POINTS, as_signal_array, check_in_range, check_int,
-                           check_positive, finite_result)
+from .._validation import (
+    MAX_POINTS,
+    as_signal_array,
+    check_in_range,
+    check_int,
+    check_positive,
+    finite_result,
+)
 from .angular import angle_to_time
 
 __all__ = ["shaft_cycle_times", "as_ratio", "antialias_filter", "bandlimited_resynthesis",

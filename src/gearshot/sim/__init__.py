@@ -24,8 +24,13 @@ Example
 
 from .database import build_database, default_database_path, load_database
 from .dynamics import DEFAULT_MIN_FS, SimulationResult, simulate, simulate_sa, system_matrices
-from .fault_types import (FAULT_TYPES, PartialFaceFault, ToothBreakage, ToothDestruction,
-                          fault_of_type)
+from .fault_types import (
+                          FAULT_TYPES,
+                          PartialFaceFault,
+                          ToothBreakage,
+                          ToothDestruction,
+                          fault_of_type,
+)
 from .faults import Fault, FullToothFaceFault, ToothFault
 from .geometry import GearPair
 from .profile_errors import DIN_PROFILE_TOLERANCES, ToothProfileErrors, draw_profile_errors

@@ -43,7 +43,7 @@ class StreamingDecimator:
         self.half = fir_half_length(self.up)
         self.h = (firwin(2 * self.half + 1, 1.0 / self.up, window=("kaiser", 5.0))
                   if self.up > 1 else np.ones(1))
-        self._tail = None
+        self._tail: np.ndarray | None = None
         self._g0 = -self.half        # fine index of the tail's first sample
         self._k_next = 0
 
@@ -57,6 +57,8 @@ class StreamingDecimator:
         """The next fine samples, shape (n_signals, n)."""
         from scipy.signal import oaconvolve
 
+        if self._tail is None:
+            raise RuntimeError("push() before start()")
         n_out, up, half = self.out.shape[1], self.up, self.half
         zz = np.concatenate([self._tail, block], axis=1)
         if up == 1:

@@ -398,8 +398,14 @@ def _prepare_store(store: Path, manifest: dict) -> None:
 
 def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
                progress):
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                               TimeElapsedColumn, TimeRemainingColumn)
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     columns = (TextColumn("simulating blocks"), BarColumn(), MofNCompleteColumn(),
                TimeElapsedColumn(), TimeRemainingColumn())

@@ -23,15 +23,14 @@ import scipy.fft as sp_fft
 from .._errors import GearshotError
 from .._validation import check_int, check_positive
 from ._decimate import StreamingDecimator, fir_half_length
-from ._inputs import (as_rng, check_grade, check_pair, draw_errors, profile_fn,
-                      resolve_faults)
+from ._inputs import as_rng, check_grade, check_pair, draw_errors, profile_fn, resolve_faults
 from ._system import integrator, make_batch, system_matrices, warmup_time
 from .geometry import GearPair
 
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
            "DEFAULT_MIN_FS"]
 
-#: internal integration rate floor, Hz (see benchmarks/RESULTS.md, gearshot.sim section: dt convergence)
+#: internal integration rate floor, Hz (benchmarks/RESULTS.md, gearshot.sim: dt convergence)
 DEFAULT_MIN_FS = 100e3
 _BATCH_CHUNK = 64
 

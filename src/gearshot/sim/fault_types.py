@@ -9,14 +9,14 @@ name               geometry (size y: 0 = healthy ... 1)
 ``"partial_face"`` :class:`PartialFaceFault`: the same arc cut (``profile_size`` of the
                    active profile, default 0.6) over part of the face width; y = the cut
                    band's width / the face width (1: an FTFF of size ``profile_size``).
-``"breakage"``     :class:`ToothBreakage`: a chipped corner: the tooth above a break line is
-                   lost; the lost height at face position zeta (0 ... 1) is
-                   ``H clip(y (1 + c) - c zeta, 0, 1)`` (H: height of the tooth above
-                   its lowest contact point, c: ``obliqueness``), so a small y is a corner
-                   chip at one face end, y = 0.5 the full height at that end tapering to
-                   nothing at the other, and y = 1 the whole tooth lost down to the lowest
-                   contact point; what lies below never touches the mating tooth, so y = 1
-                   acts as a missing tooth.
+``"breakage"``     :class:`ToothBreakage`: a broken tip with a chipped corner (the lab's
+                   geometry): the tooth above a break line is lost; the lost height at
+                   face position zeta (0 ... 1) is ``H min(1, y (1 + c (1 - zeta)))``
+                   (H: height of the tooth above its lowest contact point, c:
+                   ``corner``): a tip loss ``y H`` over the whole face, deepening to
+                   ``(1 + c) y H`` at the chipped face end. y = 1: the whole tooth lost down
+                   to the lowest contact point; what lies below never touches the mating
+                   tooth, so y = 1 acts as a missing tooth.
 ``"destruction"``  :class:`ToothDestruction`: surface destruction (pitting / wear): a band
                    of the active profile, centred at ``center``, over the whole face,
                    pitted with craters ``y depth`` deep (the damage deepens as it
@@ -30,9 +30,12 @@ fault and the breakage change only the slices of their face band
 (:meth:`~gearshot.sim.ToothFault.face_bands`, the slice method); a lost tip takes the
 slice's contact away where the gear contact would lie above the break
 (:meth:`~gearshot.sim.ToothFault.stiffness_scale` = 0, so the neighbouring pairs carry
-the load); the destroyed band lowers the pair stiffness by the lost contact share and adds
-a displacement excitation of its craters (raised-cosine pits 5 % of the active profile
-wide), tapered at the band's edges where the mating flank bridges onto the intact surface.
+the load) and the break edge, where contact re-enters, falls short of the involute by
+``edge_relief`` times the lost height (the excitation that makes a broken tooth loud,
+:meth:`_TipLoss.displacement`); the destroyed band lowers the pair stiffness by the lost
+contact share and adds a displacement excitation of its craters (raised-cosine pits 5 % of
+the active profile wide), tapered at the band's edges where the mating flank bridges onto
+the intact surface.
 """
 
 from __future__ import annotations
@@ -109,6 +112,8 @@ class _TipLoss(ToothFault):
     down from the tip circle) is gone."""
 
     height: float = 0.0
+    edge_relief: float = 0.0
+    edge_width: float = 0.1
 
     scales_contact = True
 
@@ -135,20 +140,41 @@ class _TipLoss(ToothFault):
             return np.ones_like(s)
         return np.where(s <= self.cut_fraction(pair), 1.0, 0.0)
 
+    def displacement(self, pair: GearPair, s: np.ndarray) -> np.ndarray:
+        """The break edge met by the mating flank: the fracture leaves no sharp involute
+        corner, so the intact flank just below the break line falls short of the
+        involute by ``edge_relief x height`` at the line, tapering linearly to nothing
+        ``edge_width`` (fraction of the active profile) further down. The pair takes
+        over its load abruptly and short of its place when the contact re-enters at the
+        break line."""
+        s = np.asarray(s, dtype=float)
+        if self.is_healthy or self.edge_relief <= 0:
+            return np.zeros_like(s)
+        sc = self.cut_fraction(pair)
+        ramp = np.clip(1.0 - (sc - s) / self.edge_width, 0.0, 1.0)
+        return np.where(s <= sc, -self.edge_relief * self.height * ramp, 0.0)
+
 
 @dataclass(frozen=True)
 class ToothBreakage(ToothFault):
-    """Tooth breakage / chipped tip: a corner of the tooth lost above an oblique break
-    line (module docstring for the geometry).
+    """Tooth breakage: a broken tip with a chipped corner (module docstring for the
+    geometry).
 
     Parameters
     ----------
     size : float
-        y in [0, 1]; 1 = the whole tooth lost down to the lowest contact point (acts as a
-        missing tooth).
-    obliqueness : float
-        c > 0: how fast the lost height falls across the face (per face width, in tooth
-        heights); the break reaches across the face at y >= c / (1 + c).
+        y in [0, 1]: the tip loss over the whole face as a fraction of the tooth height
+        above the lowest contact point; 1 = the whole tooth lost down to the lowest contact
+        point (acts as a missing tooth).
+    corner : float
+        c >= 0: the chipped corner at face position 0 goes ``1 + c`` times deeper than the
+        tip loss, tapering linearly across the face (default 2/3: the lab model's example,
+        a 3 mm tip loss and a 5 mm corner chip, is ``size = 3 mm / H = 0.61``).
+    edge_relief : float
+        Shortfall of the flank at the break edge per lost height (default 0.01: 30 um
+        for a 3 mm tip loss), :meth:`_TipLoss.displacement`.
+    edge_width : float
+        Length of the edge's relief along the active profile, (0, 1].
     n_bands : int
         Face bands the break is resolved into (piecewise-constant height).
     tooth : int
@@ -156,13 +182,19 @@ class ToothBreakage(ToothFault):
     """
 
     size: float = 0.0
-    obliqueness: float = 1.0
+    corner: float = 2.0 / 3.0
+    corner_width: float = 0.8
+    edge_relief: float = 0.01
+    edge_width: float = 0.1
     n_bands: int = 16
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check_in_range(self.size, "size", 0.0, 1.0)
-        check_in_range(self.obliqueness, "obliqueness", 0.0, 100.0, low_inclusive=False)
+        check_in_range(self.corner, "corner", 0.0, 100.0)
+        check_in_range(self.corner_width, "corner_width", 0.0, 1.0, low_inclusive=False)
+        check_in_range(self.edge_relief, "edge_relief", 0.0, 0.1)
+        check_in_range(self.edge_width, "edge_width", 0.0, 1.0, low_inclusive=False)
         check_int(self.n_bands, "n_bands", minimum=1, maximum=256)
 
     @property
@@ -171,12 +203,17 @@ class ToothBreakage(ToothFault):
 
     def lost_height(self, pair: GearPair, zeta) -> np.ndarray:
         """Lost height (m, from the tip) at face positions ``zeta`` (0 ... 1)."""
-        c = self.obliqueness
+        zeta = np.asarray(zeta, dtype=float)
+        chip = (1 + self.corner) * np.clip(1 - zeta / self.corner_width, 0.0, None)
+        return self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip),
+                                                  0.0, 1.0)
+
+    @staticmethod
+    def active_height(pair: GearPair) -> float:
+        """H: height (m) of the gear tooth above its lowest contact point."""
         z = pair.z_gear
         _, (l_lo, _) = pair.roll_limits
-        height = pair.tip_radius(z) - math.hypot(pair.base_radius(z), l_lo)
-        frac = np.clip(self.size * (1 + c) - c * np.asarray(zeta, dtype=float), 0.0, 1.0)
-        return height * frac
+        return pair.tip_radius(z) - math.hypot(pair.base_radius(z), l_lo)
 
     def face_bands(self, pair: GearPair) -> tuple:
         if self.is_healthy:
@@ -188,8 +225,9 @@ class ToothBreakage(ToothFault):
         out = []
         for z0, z1, hb in zip(edges[:-1], edges[1:], h.mean(axis=1)):
             if hb > 0:
-                out.append((float(z0), float(z1), _TipLoss(tooth=self.tooth,
-                                                           height=float(hb))))
+                out.append((float(z0), float(z1), _TipLoss(
+                    tooth=self.tooth, height=float(hb), edge_relief=self.edge_relief,
+                    edge_width=self.edge_width)))
         return tuple(out)
 
 

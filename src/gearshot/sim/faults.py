@@ -14,8 +14,8 @@ hashable and their tables can be cached) and override ``is_healthy`` and these h
 :meth:`ToothFault.stiffness_scale` where contact is lost and
 :meth:`ToothFault.face_bands` when the fault is not uniform across the face width; the
 stiffness and dynamics code only calls the hooks (:mod:`gearshot.sim.fault_types` holds
-the partial-face, breakage and surface-destruction faults). Pass such faults to :func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate`
-with ``faults=[...]``.
+the partial-face, breakage and surface-destruction faults). Pass such faults to
+:func:`~gearshot.sim.simulate_sa` / :func:`~gearshot.sim.simulate` with ``faults=[...]``.
 """
 
 from __future__ import annotations

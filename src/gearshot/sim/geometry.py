@@ -13,11 +13,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import check_int, check_positive, check_in_range
+from .._validation import check_in_range, check_int, check_positive
 
 __all__ = ["GearPair"]
 
@@ -126,21 +127,21 @@ class GearPair:
 
     # ------------------------------------------------------------------ constructors
     @classmethod
-    def paper(cls, **overrides) -> "GearPair":
+    def paper(cls, **overrides) -> GearPair:
         """The pair of Matania et al. (2023): 17/38 teeth, m 3 mm, b 15 mm, 20 deg, steel,
         wheel masses 0.8 / 3.2 kg, 5 % modal damping. Keyword overrides are applied."""
-        base = dict(z_pinion=17, z_gear=38, module=3e-3, face_width=15e-3,
+        base: dict[str, Any] = dict(z_pinion=17, z_gear=38, module=3e-3, face_width=15e-3,
                     pressure_angle=math.radians(20.0), youngs_modulus=210e9, poisson=0.3,
                     mass_pinion=0.8, mass_gear=3.2, damping_ratio=0.05)
         base.update(overrides)
         return cls(**base)
 
-    def replace(self, **changes) -> "GearPair":
+    def replace(self, **changes) -> GearPair:
         """A copy with some fields changed (validated)."""
         return dataclasses.replace(self, **changes)
 
     @classmethod
-    def helical(cls, helix_angle: float, **overrides) -> "GearPair":
+    def helical(cls, helix_angle: float, **overrides) -> GearPair:
         """The paper's pair (:meth:`paper`) cut with helical teeth of ``helix_angle``
         (rad; normal module and pressure angle kept). Keyword overrides are applied."""
         return cls.paper(helix_angle=helix_angle, **overrides)

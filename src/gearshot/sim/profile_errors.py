@@ -72,7 +72,7 @@ class ToothProfileErrors:
                                                       + self.phase[tooth])
                 + noise)
 
-    def mean_tooth(self) -> "ToothProfileErrors":
+    def mean_tooth(self) -> ToothProfileErrors:
         """The average over teeth as a one-tooth wheel (exact: the sine terms share one
         frequency, so their mean is a sine)."""
         phasor = np.mean(self.waviness * np.exp(1j * self.phase))

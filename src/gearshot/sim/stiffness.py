@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Any
 
 import numpy as np
 
@@ -268,7 +269,7 @@ def helical_tables(pair: GearPair, fault: ToothFault | None = None):
     span = float(tau[-1])
     healthy = _pair_table(pair, None)
     k = _helical_healthy(pair)
-    bands = ()
+    bands: tuple[tuple[Any, Any, Any, Any], ...] = ()
     if fault is not None and not fault.is_healthy:
         bands = tuple((z0 * eb, z1 * eb, kb - healthy, kb * d)
                       for z0, z1, kb, d in _band_tables(pair, fault))
@@ -321,7 +322,7 @@ def mesh_stiffness(pair: GearPair, pinion_angle, *, fault: ToothFault | None = N
         u = (t_mesh - n) / eps
         inside = (u >= 0) & (u < 1)
         k = np.interp(u, u_grid, k_healthy)
-        if k_fault is not None:
+        if k_fault is not None and fault is not None:
             faulty = np.mod(n, pair.z_gear) == fault.tooth % pair.z_gear
             k = np.where(faulty, np.interp(u, u_grid, k_fault), k)
         total += np.where(inside, k, 0.0)

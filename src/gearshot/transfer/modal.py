@@ -249,7 +249,8 @@ def synthetic_tfs(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines:
         signs = np.concatenate([[1.0], np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)])
         modes = [Mode(float(a), float(b), float(c)) for a, b, c in zip(fr, zeta, signs * mags)]
         rigid = float(rng.uniform(0.2, 1.0) * mags.mean())
-        delay, allp = 0.0, ()
+        delay = 0.0
+        allp: tuple[tuple[float, float], ...] = ()
         if nmp_flags[i]:
             delay = float(rng.uniform(0.2e-3, 2e-3))
             if rng.random() < 0.5:
