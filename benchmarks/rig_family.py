@@ -80,8 +80,9 @@ def main(argv=None):
         from dask.distributed import Client, LocalCluster
 
         os.environ.setdefault("NUMBA_NUM_THREADS", "1")
-        client = Client(LocalCluster(n_workers=args.workers, threads_per_worker=1,
-                                     processes=True))
+        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1,
+                               processes=True)
+        client = Client(cluster)
     try:
         frame = family.rig_family_experiment(
             store, seeds, results=data / "family" / f"{tag}.jsonl", frf_folder=frf,
@@ -91,6 +92,7 @@ def main(argv=None):
     finally:
         if client is not None:
             client.close()
+            cluster.close()
     print(f"{len(seeds)} rigs, {args.draws} draws, {len(frame)} rows, "
           f"{time.perf_counter() - t0:.0f} s this run; params {params}")
     report(frame, rigs_table=args.rigs_table)

@@ -102,3 +102,17 @@ def test_results_resume_and_tables(tmp_path, monkeypatch, paths):
     assert_allclose(tables["condition"].loc["rms_only", "mean"], 20.0)
     assert_allclose(tables["coverage"].loc["full", "pooled"], 90.0)
     assert json.loads(out.read_text().splitlines()[0])["variant"] == "full"
+
+
+def test_matched_noise_has_the_measured_power():
+    from gearshot.estimator.matching import add_matched_noise, residual_noise_power
+
+    rng = np.random.default_rng(0)
+    n = 256
+    shape = 1.0 + np.arange(n // 2 + 1) / 10.0  # a coloured residue
+    base = np.zeros((4000, n))
+    one = add_matched_noise(base, shape, rng)  # residues of single SAs
+    res = one[:2000] - one[2000:]  # step-6 residuals hold two residues
+    assert_allclose(residual_noise_power(res)[1:-1], shape[1:-1], rtol=0.1)
+    with pytest.raises(GearshotError, match="noise_power"):
+        add_matched_noise(base[:2], shape[:-1], rng)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numbers
+import zlib
 from typing import Any
 
 import numpy as np
@@ -15,6 +16,7 @@ from .._validation import as_signal_array, check_in_range, check_int
 from ..features import PAPER_FEATURES, available_features
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
+from .matching import add_matched_noise, residual_noise_power
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = ["OneFaultShotEstimator"]
@@ -90,6 +92,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         likelihood whose width is half the 90 % validation-residual quantile of the best
         grade): one example cannot pin the grade down, and averaging over the grades it
         leaves plausible is steadier (see :func:`steps.grade_weights`).
+    noise_matching : bool, default False
+        Add to the simulated SAs (after RMS normalization) noise with the per-order power
+        of the target's non-synchronous residue, measured from its healthy SAs after
+        harmonic suppression (:mod:`gearshot.estimator.matching`). Needs
+        ``rms_normalization``.
     model_discrepancy : float >= 0, default 0.08
         Standard deviation (fault-size units) of the simulation-to-reality error that
         :meth:`predict_interval` adds to the simulated validation residuals. Conformal
@@ -120,7 +127,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  rms_normalization=True, transfer_function="estimate",
                  n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
                  zero_shot=False, upsample=100, tuning_smoothing="isotonic",
-                 grade_weighting="soft", model_discrepancy=0.08, random_state=None):
+                 grade_weighting="soft", model_discrepancy=0.08, noise_matching=False,
+                 random_state=None):
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -137,6 +145,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.tuning_smoothing = tuning_smoothing
         self.grade_weighting = grade_weighting
         self.model_discrepancy = model_discrepancy
+        self.noise_matching = noise_matching
         self.random_state = random_state
 
     # ------------------------------------------------------------------ validation
@@ -183,6 +192,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         sim = steps.propagate_simulated(sa, self.transfer_function_)
         if self.rms_normalization:
             sim = steps.normalize_rms(sim, sim[healthy])
+        if self.noise_power_ is not None:
+            sim = add_matched_noise(sim, self.noise_power_, np.random.default_rng(
+                [self.noise_seed_, len(y)]))
         sim = steps.suppress_harmonics_simulated(sim, healthy)
         feats, _ = steps.centred_features(sim, mesh_order=self.mesh_order, names=names,
                                           healthy_mask=healthy)
@@ -281,6 +293,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             sub_h, mesh_order=self.mesh_order, names=names,
             healthy_mask=np.ones(len(sub_h), bool))
         self.target_healthy_features_ = feats_h
+        # tuning beyond the grade: the target's non-synchronous residue, measured
+        self.noise_power_ = (residual_noise_power(sub_h)
+                             if self.noise_matching and self.rms_normalization else None)
+        # its seed comes from the data, so the other steps' random draws are unchanged
+        self.noise_seed_ = zlib.crc32(np.ascontiguousarray(sub_h).tobytes())
 
         # step 1: feature selection on the nominal grade
         if self.select_features:

@@ -263,17 +263,18 @@ def _family_task(spec: dict) -> list[dict]:
         if plain:
             out += evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=plain, selection_tf=selection,
-                                     random_state=[rig.seed, draw], **spec["params"])
+                                     random_state=1000 * rig.seed + draw, **spec["params"])
         for name in (v for v in todo if v in DIAGNOSTIC_VARIANTS):
             extra = _diagnostic_params(name, rig, paths)
             row, = evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=["full"], selection_tf=selection,
-                                     random_state=[rig.seed, draw],
+                                     random_state=1000 * rig.seed + draw,
                                      **{**spec["params"], **extra})
             row["variant"] = name
             out.append(row)
         for row in out:
             pred = row.pop("prediction")
+            row["fitted_grade"] = row.pop("grade")  # "grade" is the rig's true grade
             by_size = {f"{y:.2f}": float(np.mean(pred[ds.test_size == y]))
                        for y in np.unique(ds.test_size)}
             rows.append(dict(config=spec["config"], **asdict(rig), draw=draw,
