@@ -116,3 +116,17 @@ def test_matched_noise_has_the_measured_power():
     assert_allclose(residual_noise_power(res)[1:-1], shape[1:-1], rtol=0.1)
     with pytest.raises(GearshotError, match="noise_power"):
         add_matched_noise(base[:2], shape[:-1], rng)
+
+
+def test_shrink_tf_interpolates_between_flat_and_the_estimate():
+    from gearshot.estimator.matching import shrink_tf
+    from gearshot.signal import minimum_phase
+
+    k = np.arange(64)
+    mag = np.exp(0.5 * np.cos(2 * np.pi * k / 64) + 0.2 * np.cos(6 * np.pi * k / 64))
+    tf = minimum_phase(mag)
+    assert shrink_tf(tf, 1.0) is tf
+    assert_allclose(np.abs(shrink_tf(tf, 0.0)), 1.0)
+    assert_allclose(np.abs(shrink_tf(tf, 0.5)), np.sqrt(mag), rtol=1e-9)
+    with pytest.raises(GearshotError, match="tf_exponent"):
+        shrink_tf(tf, 1.5)

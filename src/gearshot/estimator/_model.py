@@ -16,7 +16,7 @@ from .._validation import as_signal_array, check_in_range, check_int
 from ..features import PAPER_FEATURES, available_features
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
-from .matching import add_matched_noise, residual_noise_power
+from .matching import add_matched_noise, residual_noise_power, shrink_tf
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = ["OneFaultShotEstimator"]
@@ -97,6 +97,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         of the target's non-synchronous residue, measured from its healthy SAs after
         harmonic suppression (:mod:`gearshot.estimator.matching`). Needs
         ``rms_normalization``.
+    tf_exponent : float in [0, 1], default 1.0
+        Trust in the blind TF estimate (step 3): the simulated SAs go through the minimum-
+        phase TF of magnitude ``|TF|**tf_exponent`` (0: flat, i.e. RMS normalization only;
+        1: the paper's estimate); see :func:`gearshot.estimator.matching.shrink_tf`.
     model_discrepancy : float >= 0, default 0.08
         Standard deviation (fault-size units) of the simulation-to-reality error that
         :meth:`predict_interval` adds to the simulated validation residuals. Conformal
@@ -128,7 +132,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  n_neighbors=range(1, 101), validation_fraction=0.3, mesh_order=38,
                  zero_shot=False, upsample=100, tuning_smoothing="isotonic",
                  grade_weighting="soft", model_discrepancy=0.08, noise_matching=False,
-                 random_state=None):
+                 tf_exponent=1.0, random_state=None):
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -146,6 +150,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.grade_weighting = grade_weighting
         self.model_discrepancy = model_discrepancy
         self.noise_matching = noise_matching
+        self.tf_exponent = tf_exponent
         self.random_state = random_state
 
     # ------------------------------------------------------------------ validation
@@ -182,7 +187,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             if healthy_long is None:
                 raise GearshotError("healthy_long is required with "
                                     "transfer_function='estimate'")
-            return steps.estimate_tf(healthy_long, n_points)
+            return shrink_tf(steps.estimate_tf(healthy_long, n_points), self.tf_exponent)
         return _on_grid(tf, n_points, "transfer_function")
 
     # ------------------------------------------------------------------ the simulated side

@@ -19,7 +19,7 @@ import numpy as np
 
 from .._errors import GearshotError
 
-__all__ = ["residual_noise_power", "add_matched_noise"]
+__all__ = ["residual_noise_power", "add_matched_noise", "shrink_tf"]
 
 
 def residual_noise_power(residuals):
@@ -68,3 +68,16 @@ def add_matched_noise(signals, noise_power, rng):
     if n % 2 == 0:
         z[:, -1] = z[:, -1].real * np.sqrt(2)
     return x + np.fft.irfft(z * np.sqrt(p), n, axis=-1)
+
+
+def shrink_tf(tf, exponent):
+    """Minimum-phase TF of magnitude ``|tf| ** exponent``: the blind estimate shrunk
+    towards a flat path (log-magnitude scaled by ``exponent``; 1 returns ``tf``)."""
+    from .._validation import check_in_range
+    from ..signal import minimum_phase
+
+    exponent = check_in_range(exponent, "tf_exponent", 0, 1)
+    if exponent == 1:
+        return tf
+    mag = np.abs(np.asarray(tf))
+    return minimum_phase(np.maximum(mag, 1e-300) ** exponent)

@@ -237,6 +237,30 @@ def _diagnostic_params(name, rig, paths):
     raise GearshotError(f"unknown diagnostic variant {name!r}")
 
 
+DISCREPANCIES = (0.0, 0.04, 0.06, 0.08, 0.10, 0.12, 0.16)
+
+
+def _interval_sweep(est, test_sa, test_size, coverage=0.9):
+    """Coverage and mean width of the ``coverage`` intervals at several model
+    discrepancies (one feature extraction; for choosing the discrepancy on the dev range),
+    plus the grade weights."""
+    from ..estimator import steps
+
+    X = est.features_of(test_sa)
+    preds = {g: est.grade_models_[g].predict(X) for g in est.grade_weights_}
+    residuals = {g: est.grade_models_[g].validation_residuals for g in est.grade_weights_}
+    cov, width = {}, {}
+    for d in DISCREPANCIES:
+        low, high = steps.mixture_interval(preds, est.grade_weights_, residuals, coverage,
+                                           discrepancy=d)
+        low, high = np.clip(low, 0, 1), np.clip(high, 0, 1)
+        cov[f"{d:g}"] = float(np.mean((test_size >= low - 1e-12) & (test_size <= high + 1e-12)))
+        width[f"{d:g}"] = float(np.mean(high - low))
+    return {"coverage_by_discrepancy": cov, "width_by_discrepancy": width,
+            "grade_weights": {str(g): round(float(w), 4) for g, w in est.grade_weights_.items()},
+            "n_selected": len(est.selected_features_)}
+
+
 def _family_task(spec: dict) -> list[dict]:
     """Every (draw, variant) of one rig; runs on a Dask worker or in-process."""
     from ..sim import load_database
@@ -263,18 +287,20 @@ def _family_task(spec: dict) -> list[dict]:
         if plain:
             out += evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=plain, selection_tf=selection,
-                                     random_state=1000 * rig.seed + draw, **spec["params"])
+                                     random_state=1000 * rig.seed + draw,
+                                     keep_estimators=True, **spec["params"])
         for name in (v for v in todo if v in DIAGNOSTIC_VARIANTS):
             extra = _diagnostic_params(name, rig, paths)
             row, = evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=["full"], selection_tf=selection,
                                      random_state=1000 * rig.seed + draw,
-                                     **{**spec["params"], **extra})
+                                     keep_estimators=True, **{**spec["params"], **extra})
             row["variant"] = name
             out.append(row)
         for row in out:
             pred = row.pop("prediction")
             row["fitted_grade"] = row.pop("grade")  # "grade" is the rig's true grade
+            row.update(_interval_sweep(row.pop("estimator"), ds.test_sa, ds.test_size))
             by_size = {f"{y:.2f}": float(np.mean(pred[ds.test_size == y]))
                        for y in np.unique(ds.test_size)}
             rows.append(dict(config=spec["config"], **asdict(rig), draw=draw,
