@@ -263,6 +263,15 @@ def _interval_sweep(est, test_sa, test_size, coverage=0.9):
 
 def _family_task(spec: dict) -> list[dict]:
     """Every (draw, variant) of one rig; runs on a Dask worker or in-process."""
+    import dask
+
+    # the database's Zarr blocks are loaded here, not as tasks of the cluster whose
+    # every worker thread is busy with a rig (that waits forever)
+    with dask.config.set(scheduler="synchronous"):
+        return _family_rows(spec)
+
+
+def _family_rows(spec: dict) -> list[dict]:
     from ..sim import load_database
     from ..transfer import TransferFunctionBank
     from .rig import rig_dataset
