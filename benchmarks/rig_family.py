@@ -107,6 +107,10 @@ def report(frame: pd.DataFrame, *, rigs_table=False):
     print(tables["condition"].to_string())
     print("\nMAE % by path type:")
     print(tables["kind"].to_string())
+    print("\nMAE % by the rig's true grade:")
+    print(tables["grade"].to_string())
+    print("\nMAE % by path attenuation:")
+    print(tables["attenuation"].to_string())
     print("\n90 % interval coverage %:")
     print(tables["coverage"].to_string())
     full = frame[frame["variant"] == "full"]

@@ -466,7 +466,8 @@ def family_tables(frame: pd.DataFrame) -> dict:
     -------
     dict of pandas.DataFrame
         ``condition`` (variant × condition MAE, plus mean, rig-level p90 and max),
-        ``kind`` (variant × path type), ``coverage`` (full variant by condition),
+        ``kind`` (variant × path type), ``grade`` (× true-grade band), ``attenuation``
+        (× path-attenuation band), ``coverage`` (90 % intervals, by condition),
         ``rigs`` (per-rig MAE of each variant, mean over draws).
     """
     if frame.empty:
@@ -482,9 +483,16 @@ def family_tables(frame: pd.DataFrame) -> dict:
     cond["max rig"] = rigs.groupby("variant")["mae"].max()
     cond["n rigs"] = rigs.groupby("variant")["seed"].nunique()
     kind = rigs.pivot_table(index="variant", columns="kind", values="mae", aggfunc="mean")
+    rigs["grades"] = pd.cut(rigs["grade"], [0, 3, 6, 9, 12],
+                            labels=["1-3", "4-6", "7-9", "10-12"]).astype(str)
+    rigs["attenuation"] = pd.cut(rigs["attenuation_db"], [0, 17, 24, 99],
+                                 labels=["<17 dB", "17-24 dB", ">24 dB"]).astype(str)
+    grade = rigs.pivot_table(index="variant", columns="grades", values="mae", aggfunc="mean")
+    att = rigs.pivot_table(index="variant", columns="attenuation", values="mae",
+                           aggfunc="mean")
     cov = f.pivot_table(index="variant", columns="condition", values="coverage",
                         aggfunc="mean").mul(100)
     cov["pooled"] = f.groupby("variant").apply(
         lambda g: np.average(g["coverage"], weights=g["n_test"])).mul(100)
-    return {"condition": cond.round(2), "kind": kind.round(2), "coverage": cov.round(1),
-            "rigs": rigs}
+    return {"condition": cond.round(2), "kind": kind.round(2), "grade": grade.round(2),
+            "attenuation": att.round(2), "coverage": cov.round(1), "rigs": rigs}
