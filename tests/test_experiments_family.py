@@ -1,0 +1,104 @@
+"""The rig family of issue #12: its draw, its path bank, its resumable result store."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from numpy.testing import assert_allclose
+
+from gearshot import GearshotError
+from gearshot.experiments import family
+
+
+@pytest.fixture(scope="module")
+def paths():
+    return family.family_paths(None, n_synthetic=3, seed=1)
+
+
+def test_paths_are_named_by_kind(paths):
+    names = [p.name for p in paths]
+    assert names == [f"synthetic_rig_{i}" for i in range(3)] + \
+        [f"synthetic_bank_{i}" for i in range(3)]
+    assert {family.path_kind(n) for n in names} == {"synthetic_rig", "synthetic_bank"}
+    assert family.path_kind("beam_h7") == "beam"
+    assert family.path_kind("structure_b_h2") == "structure_b"
+    assert family.path_kind("machine_tool") == "measured"
+    with pytest.raises(GearshotError, match="at least one path"):
+        family.family_paths(None, n_synthetic=0)
+
+
+def test_draw_depends_on_the_seed_only_and_is_balanced(paths):
+    rigs = family.draw_family(range(50, 74), paths)
+    again = family.draw_family([60, 51], paths)
+    assert again[0] == rigs[10] and again[1] == rigs[1]
+    assert {r.path_index for r in rigs} == set(range(len(paths)))
+    conditions = pd.Series([(r.speed, r.load) for r in rigs]).value_counts()
+    assert set(conditions.index) == set(family.PAPER_CONDITIONS)
+    assert conditions.min() == conditions.max() == 6
+    assert all(1 <= r.grade <= 12 for r in rigs)
+    assert len({r.grade for r in rigs}) > 6
+    assert all(10 <= r.attenuation_db <= 30 for r in rigs)
+
+
+def test_dev_and_heldout_ranges_are_disjoint():
+    assert not set(family.DEV_SEEDS) & set(family.HELDOUT_SEEDS)
+
+
+def test_duration_gives_the_wanted_segments():
+    camp = dict(duration=None, segments=4)
+    # 4 SAs of 50 gear revolutions (+1 for the resampling edge), 2 % speed margin
+    assert family._duration(camp, 15.0) == pytest.approx(1.02 * 201 / (15 * 17 / 38))
+    assert family._duration(camp, 30.0) == pytest.approx(family._duration(camp, 15.0) / 2)
+    assert family._duration(dict(duration=12.0, segments=4), 15.0) == 12.0
+
+
+def test_true_path_on_grid_is_hermitian(paths):
+    rig = family.draw_family([55], paths)[0]
+    tf = family.true_path_on_grid(rig, paths, n_points=64)
+    assert_allclose(tf[1:][::-1], np.conj(tf[1:]), atol=1e-15)
+    assert tf[32].imag == 0 and tf[0].imag == pytest.approx(0, abs=1e-15)
+
+
+def test_results_resume_and_tables(tmp_path, monkeypatch, paths):
+    calls = []
+
+    def fake_task(spec):
+        calls.append((spec["rig"]["seed"], tuple(spec["draws"]), frozenset(spec["done"])))
+        rows = []
+        for d in spec["draws"]:
+            for v in spec["variants"]:
+                if (d, v) in spec["done"]:
+                    continue
+                rows.append(dict(config=spec["config"], **spec["rig"], draw=d, variant=v,
+                                 mae=0.1 if v == "full" else 0.2, coverage=0.9, n_test=10,
+                                 seconds=1.0, record_seconds=2.0))
+        return rows
+
+    monkeypatch.setattr(family, "family_paths", lambda *a, **k: paths)
+    monkeypatch.setattr(family, "_family_task", fake_task)
+    out = tmp_path / "r.jsonl"
+    kw = dict(results=out, n_draws=2, progress=False)
+    frame = family.rig_family_experiment("db", range(50, 54), variants=["full"], **kw)
+    assert len(frame) == 8 and len(calls) == 4
+    frame = family.rig_family_experiment("db", range(50, 54), variants=["full"], **kw)
+    assert len(frame) == 8 and len(calls) == 4  # nothing recomputed
+    frame = family.rig_family_experiment("db", range(50, 54), variants=["full", "rms_only"],
+                                         **kw)
+    assert len(frame) == 16 and len(calls) == 8
+    assert all(done == {(0, "full"), (1, "full")} for _, _, done in calls[4:])
+    # another estimator configuration is a new set of rows
+    frame = family.rig_family_experiment("db", range(50, 52), variants=["full"],
+                                         params={"selection_threshold": 0.2}, **kw)
+    assert len(frame) == 4 and len(calls) == 10
+    with open(out, "a") as fh:  # an interrupted write leaves a cut line: skipped
+        fh.write('{"config": "x", "se')
+    rows = family.read_family_results(out)
+    assert len(rows) == 20
+    tables = family.family_tables(family.rig_family_experiment("db", range(50, 54),
+                                                               variants=["full", "rms_only"],
+                                                               **kw))
+    assert_allclose(tables["condition"].loc["full", "mean"], 10.0)
+    assert_allclose(tables["condition"].loc["rms_only", "mean"], 20.0)
+    assert_allclose(tables["coverage"].loc["full", "pooled"], 90.0)
+    assert json.loads(out.read_text().splitlines()[0])["variant"] == "full"
