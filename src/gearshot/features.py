@@ -203,7 +203,7 @@ FEATURES = MappingProxyType(_REGISTRY)
 """Read-only mapping of feature name → function of the shared decomposition."""
 
 
-def available_features():
+def available_features() -> tuple[str, ...]:
     """Names of every registered feature, in registry order."""
     return tuple(_REGISTRY)
 
@@ -246,7 +246,7 @@ def _mesh_arg(mesh_order, n):
 
 
 @finite_result
-def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS):
+def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS) -> float:
     """Mean variance of the residual signal of healthy SAs: NA4's baseline.
 
     Parameters
@@ -271,7 +271,7 @@ def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS)
 
 @finite_result
 def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None,
-                     shaft_orders=_SHAFT_ORDERS):
+                     shaft_orders=_SHAFT_ORDERS) -> np.ndarray:
     """Condition indicators of synchronous averages.
 
     Parameters

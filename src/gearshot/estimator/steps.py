@@ -235,7 +235,7 @@ def split_target_healthy(target_healthy: FloatArray, *, ref_fraction: float = 0.
 def suppress_harmonics_target(signals: ArrayLike, references: ArrayLike, *,
                               upsample: int = 100) -> FloatArray:
     """Step 6, target side: subtract the best delay-aligned healthy reference."""
-    return subtract_healthy(signals, references, upsample=upsample)
+    return np.asarray(subtract_healthy(signals, references, upsample=upsample), dtype=np.float64)
 
 
 # ---------------------------------------------------------------- step 7
@@ -259,7 +259,8 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *, me
             raise GearshotError("centred_features needs healthy_mean or a non-empty "
                                 "healthy_mask")
         healthy_mean = feats[np.asarray(healthy_mask)].mean(axis=0)
-    return feats - healthy_mean, np.asarray(healthy_mean)
+    return (np.asarray(feats - healthy_mean, dtype=np.float64),
+            np.asarray(healthy_mean, dtype=np.float64))
 
 
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,

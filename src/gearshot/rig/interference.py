@@ -30,7 +30,7 @@ def motor_harmonics(t: np.ndarray, *, speed: float, pole_pairs: int, slip: float
     x = np.zeros_like(np.asarray(t, dtype=np.float64))
     for a, h, p in zip(amp, k, phase):
         x += a * np.cos(2 * np.pi * 2 * h * f_e * t + p)
-    return x / max(rms(x), 1e-300)
+    return x / max(float(rms(x)), 1e-300)
 
 
 def extra_shaft(input_revs: np.ndarray, *, order: float, rng: np.random.Generator
@@ -41,7 +41,7 @@ def extra_shaft(input_revs: np.ndarray, *, order: float, rng: np.random.Generato
     a2 = rng.uniform(0.2, 0.6)
     ang = 2 * np.pi * order * np.asarray(input_revs, dtype=np.float64)
     x = np.cos(ang + p1) + a2 * np.cos(2 * ang + p2)
-    return x / max(rms(x), 1e-300)
+    return x / max(float(rms(x)), 1e-300)
 
 
 def bearing_impacts(input_revs: np.ndarray, fs: float, *, order: float, frequency: float,
@@ -67,7 +67,7 @@ def bearing_impacts(input_revs: np.ndarray, fs: float, *, order: float, frequenc
     # resonance s*w0 / (s^2 + 2 zeta w0 s + w0^2), discretized (bilinear, prewarped)
     b, a = scipy.signal.bilinear([w0, 0.0], [1.0, 2 * damping * w0, w0 ** 2], fs=fs)
     x = scipy.signal.lfilter(b, a, pulses)
-    return x / max(rms(x), 1e-300)
+    return x / max(float(rms(x)), 1e-300)
 
 
 def add_noise(x: np.ndarray, *, snr_db: float, rng: np.random.Generator) -> np.ndarray:

@@ -25,7 +25,7 @@ def _shift_factors(n: int, tau: np.ndarray) -> np.ndarray:
 
 
 @finite_result
-def fractional_shift(x, delay):
+def fractional_shift(x, delay) -> np.ndarray:
     """Circularly delay signals by a (fractional) number of samples.
 
     Band-limited (Fourier) interpolation: ``y(t) = x(t - delay)`` for the periodic,
@@ -115,7 +115,8 @@ class _LagSearch:
 
 
 @finite_result
-def subtract_healthy(signals, healthy_refs, *, upsample=100, return_details=False):
+def subtract_healthy(signals, healthy_refs, *, upsample=100,
+                     return_details=False) -> np.ndarray | tuple[np.ndarray, ...]:
     """Suppress the gear-mesh pattern by subtracting the best delay-aligned healthy SA.
 
     For every signal and every healthy reference, the circular delay that maximizes

@@ -23,7 +23,7 @@ __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 
 
 @finite_result
-def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1):
+def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1) -> np.ndarray:
     """Times of the rising edges of a tacho signal, interpolated between samples.
 
     An edge is where the signal crosses ``threshold`` upwards after having been below
@@ -88,7 +88,7 @@ def _check_pulses(pulse_times, name="pulse_times"):
 
 
 @finite_result
-def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
+def angle_to_time(pulse_times, angles, *, pulses_per_rev=1) -> np.ndarray:
     """Time at which the shaft reaches given angles, from its tacho pulses.
 
     The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
@@ -132,7 +132,7 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1):
 
 @finite_result
 def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2,
-                     antialias=True, passband=0.9):
+                     antialias=True, passband=0.9) -> np.ndarray:
     """Resample a time signal at equal steps of shaft angle.
 
     The signal is over-sampled ×``upsample`` and then read at the instants the shaft passes

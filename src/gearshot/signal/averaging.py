@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from .._errors import GearshotError
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
@@ -9,7 +11,7 @@ __all__ = ["synchronous_average"]
 
 
 @finite_result
-def synchronous_average(x, samples_per_cycle, *, n_cycles=None):
+def synchronous_average(x, samples_per_cycle, *, n_cycles=None) -> np.ndarray:
     """Synchronous average of an angle-domain signal.
 
     Parameters

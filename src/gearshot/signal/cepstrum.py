@@ -12,7 +12,7 @@ __all__ = ["real_cepstrum", "minimum_phase"]
 
 
 @finite_result
-def real_cepstrum(magnitude):
+def real_cepstrum(magnitude) -> np.ndarray:
     """Real cepstrum ``IDFT(log |H|)`` of a two-sided magnitude, along the last axis."""
     magnitude = _checked_magnitude(magnitude)
     return scipy.fft.ifft(np.log(magnitude), axis=-1).real
@@ -29,7 +29,7 @@ def _checked_magnitude(magnitude):
 
 
 @finite_result
-def minimum_phase(magnitude):
+def minimum_phase(magnitude) -> np.ndarray:
     """Minimum-phase frequency response with a given magnitude (real-cepstrum method).
 
     ``c = IDFT(log|H|)``; keep ``c[0]``, double ``c[1 … ceil((L-1)/2) - 1]``, zero the rest

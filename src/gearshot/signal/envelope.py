@@ -11,7 +11,7 @@ __all__ = ["envelope"]
 
 
 @finite_result
-def envelope(x):
+def envelope(x) -> np.ndarray:
     """Envelope ``|hilbert(x)|`` along the last axis.
 
     Parameters

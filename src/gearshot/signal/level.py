@@ -10,7 +10,7 @@ __all__ = ["rms", "mean_rms"]
 
 
 @finite_result
-def rms(x):
+def rms(x) -> np.ndarray:
     """Root mean square along the last axis.
 
     Parameters

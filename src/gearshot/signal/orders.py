@@ -69,7 +69,7 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     return np.unique(folded)
 
 
-def order_mask(n_points, mesh_order, *, n_sidebands=2):
+def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     """Boolean mask over one-sided orders ``0 … n_points//2``; True on mesh bands.
 
     Parameters
@@ -104,7 +104,7 @@ def _split(sa, mesh_order, n_sidebands, keep_mesh: bool):
 
 
 @finite_result
-def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
+def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
     """The mesh harmonics of a synchronous average and their sidebands.
 
     Keeps orders ``k * mesh_order + s`` (``k >= 1``, ``|s| <= n_sidebands``) in both halves of
@@ -128,7 +128,7 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2):
 
 
 @finite_result
-def difference_signal(sa, mesh_order, *, n_sidebands=2):
+def difference_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
     """A synchronous average with its mesh harmonics and sidebands removed.
 
     Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and

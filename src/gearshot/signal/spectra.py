@@ -14,7 +14,7 @@ __all__ = ["amplitude_spectrum", "acs_background"]
 
 
 @finite_result
-def amplitude_spectrum(x, *, nfft=2**15):
+def amplitude_spectrum(x, *, nfft=2**15) -> np.ndarray:
     """Averaged amplitude spectrum over non-overlapping rectangular segments.
 
     ``sqrt(sum_s |FFT(x_s)|^2 / (n_segments * nfft))`` over the ``n_segments = len(x) // nfft``
@@ -45,7 +45,7 @@ def amplitude_spectrum(x, *, nfft=2**15):
 
 @finite_result
 def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
-                   symmetric=True):
+                   symmetric=True) -> np.ndarray:
     """Background of a spectrum by segment percentiles (the reference's ACS).
 
     The spectrum is cut into segments of ``segment_size`` bins advancing by

@@ -65,7 +65,7 @@ def as_ratio(value, name: str = "revs_per_cycle") -> Fraction:
 
 
 @finite_result
-def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1):
+def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1) -> np.ndarray:
     """Times (s) at which a shaft completes whole revolutions, from a tacho on another shaft.
 
     Parameters
@@ -171,7 +171,7 @@ def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
 
 
 @finite_result
-def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1):
+def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1) -> np.ndarray:
     """Zero-phase low-pass (and up-sampling) of a time signal, flat to ``passband * cutoff``.
 
     The gain is exactly 1 up to ``passband * cutoff`` Hz, falls as a raised cosine to 0 at

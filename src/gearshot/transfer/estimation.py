@@ -22,7 +22,7 @@ __all__ = [
 ]
 
 
-def resample_transfer_function(tf_one_sided, n_out):
+def resample_transfer_function(tf_one_sided, n_out) -> np.ndarray:
     """Resample a one-sided frequency response to the DFT grid of an ``n_out``-point signal.
 
     The reference implementation's normalized-axis resampling: the one-sided response
@@ -68,7 +68,7 @@ def resample_transfer_function(tf_one_sided, n_out):
 
 
 def estimate_transfer_function(healthy_signal, n_out, *, nfft=2**15, segment_size=200,
-                               overlap=0.75, percentile=50):
+                               overlap=0.75, percentile=50) -> np.ndarray:
     """Estimate the transfer path from one long healthy signal (paper step 3).
 
     Amplitude spectrum (rectangular segments of ``nfft``) → ACS background →
@@ -105,7 +105,7 @@ def estimate_transfer_function(healthy_signal, n_out, *, nfft=2**15, segment_siz
     return resample_transfer_function(tf_mp[: tf_mp.size // 2 + 1], n_out)
 
 
-def propagate(signals, tf):
+def propagate(signals, tf) -> np.ndarray:
     """Pass one-cycle periodic signals through a transfer function: ``real(IDFT(tf · DFT(x)))``.
 
     Parameters
@@ -127,7 +127,7 @@ def propagate(signals, tf):
     return scipy.fft.ifft(scipy.fft.fft(signals, axis=-1) * tf, axis=-1).real
 
 
-def rms_normalize(signals, reference):
+def rms_normalize(signals, reference) -> np.ndarray:
     """Divide signals by the mean RMS of reference signals (paper step 5).
 
     Parameters
