@@ -54,3 +54,13 @@ def synthetic_target(grade, tf, *, sizes=(0.32, 0.56, 0.66), n_healthy=30, n_eac
     long = clean[n_healthy] + noise * 7 * rng.normal(size=(128, N))  # 50-cycle SAs: /7
     return (propagate(noisy[:n_healthy], tf), propagate(long, tf).ravel(),
             propagate(noisy[n_healthy + 1:], tf), y[n_healthy + 1:])
+
+
+def tf_pair():
+    """A resonant target path and a different one held out for selection, on the SA grid."""
+    from gearshot.transfer import resample_transfer_function
+
+    f = np.linspace(0, 1, 513)
+    path = 0.3 / (1 - (f / 0.3) ** 2 + 0.1j * f / 0.3) + 0.05
+    held_out = 0.5 / (1 - (f / 0.6) ** 2 + 0.2j * f / 0.6) + 0.1
+    return resample_transfer_function(path, N), resample_transfer_function(held_out, N)

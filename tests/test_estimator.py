@@ -1,5 +1,6 @@
 """OneFaultShotEstimator and its eight steps (mechanics on fast synthetic data)."""
 
+import estimator_data
 import numpy as np
 import pytest
 from estimator_data import N, synthetic_database, synthetic_sa, synthetic_target
@@ -22,10 +23,7 @@ NOMINAL = 3
 @pytest.fixture(scope="module")
 def tf_pair():
     """A resonant path for the target and a different one held out for selection."""
-    f = np.linspace(0, 1, 513)
-    path = 0.3 / (1 - (f / 0.3) ** 2 + 0.1j * f / 0.3) + 0.05
-    held_out = 0.5 / (1 - (f / 0.6) ** 2 + 0.2j * f / 0.6) + 0.1
-    return resample_transfer_function(path, N), resample_transfer_function(held_out, N)
+    return estimator_data.tf_pair()
 
 
 @pytest.fixture(scope="module")

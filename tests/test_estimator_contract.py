@@ -8,7 +8,7 @@ run one by one, and the rest of the contract is tested here directly.
 import numpy as np
 import pytest
 import sklearn.exceptions
-from estimator_data import N, synthetic_database, synthetic_target
+from estimator_data import N, synthetic_database, synthetic_target, tf_pair
 from numpy.testing import assert_array_equal
 from sklearn.base import clone
 from sklearn.utils import estimator_checks
@@ -17,7 +17,6 @@ from sklearn.utils.validation import check_is_fitted
 from gearshot import GearshotError
 from gearshot.estimator import STEP_SEEDS, NotFittedError, OneFaultShotEstimator, steps
 from gearshot.estimator._params import validate_params
-from gearshot.transfer import resample_transfer_function
 
 # The synthetic database holds grades 3, 6, 9: quick settings that still run every step.
 FAST = dict(nominal_grade=3, grades=[3, 6], grade_weighting="best", random_state=0)
@@ -25,10 +24,7 @@ FAST = dict(nominal_grade=3, grades=[3, 6], grade_weighting="best", random_state
 
 @pytest.fixture(scope="module")
 def tfs():
-    f = np.linspace(0, 1, 513)
-    path = 0.3 / (1 - (f / 0.3) ** 2 + 0.1j * f / 0.3) + 0.05
-    held_out = 0.5 / (1 - (f / 0.6) ** 2 + 0.2j * f / 0.6) + 0.1
-    return resample_transfer_function(path, N), resample_transfer_function(held_out, N)
+    return tf_pair()
 
 
 @pytest.fixture(scope="module")
