@@ -151,6 +151,17 @@ def _table(data: Mapping[str, Any], key: str, *, required: bool) -> dict[str, An
     return dict(value)
 
 
+def _tables(data: Mapping[str, Any], key: str) -> list[Mapping[str, Any]]:
+    """The non-empty array of tables ``[[key]]``, each checked to be a table."""
+    value = data.get(key)
+    if not isinstance(value, list) or not value:
+        raise GearshotError(f"the machine needs at least one [[{key}]]; got {describe(value)}")
+    for i, item in enumerate(value):
+        if not isinstance(item, Mapping):
+            raise GearshotError(f"{key}[{i}] must be a table; got {describe(item)}")
+    return value
+
+
 # --------------------------------------------------------------------------- parts
 @dataclass(frozen=True)
 class GearStage:
@@ -563,14 +574,8 @@ class Machine:
         shafts = data.get("shafts")
         if not isinstance(shafts, list) or not shafts:
             raise GearshotError(f"shafts must be a list of shaft names; got {describe(shafts)}")
-        raw_stages = data.get("stage")
-        if not isinstance(raw_stages, list) or not raw_stages:
-            raise GearshotError(f"the machine needs at least one [[stage]]; got "
-                                f"{describe(raw_stages)}")
         stages = []
-        for i, st in enumerate(raw_stages):
-            if not isinstance(st, Mapping):
-                raise GearshotError(f"stage[{i}] must be a table; got {describe(st)}")
+        for i, st in enumerate(_tables(data, "stage")):
             _check_keys(st, {"driver", "driver_teeth", "driven", "driven_teeth", "module_mm",
                              "face_width_mm", "pressure_angle_deg", "helix_angle_deg"},
                         f"[[stage]] {i}")
@@ -606,14 +611,8 @@ class Machine:
                       None if tt.get("threshold") is None
                       else _float(tt["threshold"], "tacho.threshold", positive=False))
 
-        raw_sensors = data.get("sensor")
-        if not isinstance(raw_sensors, list) or not raw_sensors:
-            raise GearshotError(f"the machine needs at least one [[sensor]]; got "
-                                f"{describe(raw_sensors)}")
         sensors = []
-        for i, s in enumerate(raw_sensors):
-            if not isinstance(s, Mapping):
-                raise GearshotError(f"sensor[{i}] must be a table; got {describe(s)}")
+        for i, s in enumerate(_tables(data, "sensor")):
             _check_keys(s, {"name", "channel", "sensitivity", "unit", "ac_coupled"},
                         f"[[sensor]] {i}")
             ac = s.get("ac_coupled", True)
