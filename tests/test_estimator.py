@@ -121,6 +121,31 @@ def test_selection_rejects_features_a_sharp_path_distorts(tf_pair):
     _, errors = steps.select_features(sa, y, sharp, mesh_order=38, names=names,
                                       random_state=0)
     assert max(errors.values()) > 0.1
+    # with a threshold nothing passes, the fallback keeps the least-bad one or all of them
+    tiny = min(errors.values()) / 2
+    kw = dict(mesh_order=38, names=names, random_state=0, threshold=tiny)
+    best, errs = steps.select_features(sa, y, sharp, **kw)
+    assert best == (min(errs, key=errs.__getitem__),) and errs == errors
+    every, _ = steps.select_features(sa, y, sharp, fallback="all", **kw)
+    assert every == names
+    with pytest.raises(GearshotError, match="fallback"):
+        steps.select_features(sa, y, sharp, fallback="some", **kw)
+
+
+def test_a_second_mesh_order_removes_its_bands_from_the_features():
+    # an SA with a strong tone at order 16 beside the order-38 mesh: with [38, 16] the
+    # difference signal and its RMS ignore the tone, with 38 alone it dominates
+    t = np.arange(N) / N
+    base = synthetic_sa(np.zeros(4), 3, np.random.default_rng(5))
+    tone = 5 * np.cos(2 * np.pi * 16 * t)
+    one = steps.centred_features(base + tone, mesh_order=38, names=("rms_diff",),
+                                 healthy_mask=np.ones(4, bool))
+    two = steps.centred_features(base + tone, mesh_order=[38, 16], names=("rms_diff",),
+                                 healthy_mask=np.ones(4, bool))
+    plain = steps.centred_features(base, mesh_order=[38, 16], names=("rms_diff",),
+                                   healthy_mask=np.ones(4, bool))
+    assert one[1][0] > 3          # the tone's RMS, 5 / sqrt(2), sits in the mean feature
+    assert two[1][0] == pytest.approx(plain[1][0], rel=1e-9)
 
 
 # ------------------------------------------------------------------------- estimator

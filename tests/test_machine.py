@@ -73,7 +73,10 @@ def test_minimal_toml_ratios_orders_and_units(tmp_path):
     assert m.speed_ratio("mid") == Fraction(35, 25)
     assert m.speed_ratio("in") == Fraction(35, 25) * Fraction(50, 20)
     assert m.tacho_revs_per_cycle("in") == Fraction(2, 7)
-    assert m.mesh_orders("mid") == (50, 25)
+    assert m.mesh_orders("mid") == (50, 25) and m.gear_teeth("mid") == (50, 25)
+    # other stages' meshes in a shaft's orders when whole: 25 * 20/50 = 10, 20 * 50/20 * 35/25 = 70
+    assert m.gear_teeth("in") == (20,) and m.mesh_orders("in") == (20, 10)
+    assert m.gear_teeth("out") == (35,) and m.mesh_orders("out") == (35, 70)
     assert m.sensors[0].sensitivity == pytest.approx(0.1) and m.sensors[0].unit == "g"
     assert m.layout.delimiter == "," and m.layout.header is True and m.layout.fs == 25600
     assert m.cycles_per_segment == 10 and m.shaft_orders == (1, 2, 3)
@@ -97,6 +100,9 @@ def test_examples_follow_the_data_readme():
         assert m.tacho_revs_per_cycle("idler") == 3
     assert spur.monitored.teeth == 32 and helical.monitored == type(helical.monitored)("idler", 24)
     assert spur.mesh_orders("idler") == (96, 48) and helical.mesh_orders("idler") == (48, 24)
+    # the second stage's mesh is synchronous with the input shaft: 48 / 3 = 16, 24 / 3 = 8
+    assert spur.mesh_orders("input") == (32, 16) and helical.mesh_orders("input") == (16, 8)
+    assert spur.mesh_orders("output") == (80, 160) and helical.mesh_orders("output") == (40, 80)
 
 
 def test_paper_machine_gives_the_paper_pair():

@@ -208,6 +208,23 @@ def test_7_a_shaft_with_two_meshes():
         extract_features(meshes[None], 96, names=["fm4"], shaft_orders=3)
 
 
+def test_7_meshes_of_other_stages_that_are_synchronous_leave_the_difference_signal(spur,
+                                                                                    spur_rec):
+    # The input shaft carries only the 32T gear, but the idler's 48T -> 80T mesh turns
+    # 48 / 3 = 16 times per input revolution: in the real input-shaft SA it is the
+    # largest order, larger than the 32T mesh itself.
+    assert spur.gear_teeth("input") == (32,) and spur.mesh_orders("input") == (32, 16)
+    sa = spur_rec.to_sa_segments(shaft="input", sensor="acc_input", cycles_per_segment=None)[0]
+    amp = np.abs(np.fft.rfft(sa))
+    assert int(np.argmax(amp[1:200])) + 1 == 16 and amp[16] > amp[32]
+    d_one = difference_signal(sa, 32)
+    d_all = difference_signal(sa, list(spur.mesh_orders("input")))
+    amp_all = np.abs(np.fft.rfft(d_all))
+    assert_allclose(amp_all[[16, 48, 80, 15, 17, 46, 50]], 0.0, atol=1e-9)
+    # the second mesh's bands hold most of what the single-order difference signal keeps
+    assert np.sqrt(np.mean(d_all ** 2)) < 0.7 * np.sqrt(np.mean(d_one ** 2))
+
+
 # ----------------------------------------------------------------------------- 8
 def _shaft_signal(orders, *, f0=30.0, duration=4.0, ratio=3):
     """Input speed ~f0 (±1 %), a smooth 10-pulse tacho, a signal with given idler orders."""

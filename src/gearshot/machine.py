@@ -388,11 +388,11 @@ class Machine:
             if self.monitored.shaft not in known:
                 raise GearshotError(f"monitored.shaft={self.monitored.shaft!r} is not one of "
                                     f"the shafts {list(self.shafts)}")
-            if self.monitored.teeth not in self.mesh_orders(self.monitored.shaft):
+            if self.monitored.teeth not in self.gear_teeth(self.monitored.shaft):
                 raise GearshotError(
                     f"monitored.teeth={self.monitored.teeth}: shaft "
                     f"{self.monitored.shaft!r} carries gears of "
-                    f"{list(self.mesh_orders(self.monitored.shaft))} teeth")
+                    f"{list(self.gear_teeth(self.monitored.shaft))} teeth")
         _int(self.samples_per_cycle, "analysis.samples_per_cycle", minimum=16)
         if self.cycles_per_segment is not None:
             _int(self.cycles_per_segment, "analysis.cycles_per_segment")
@@ -453,14 +453,32 @@ class Machine:
         """Tacho-shaft revolutions per revolution of ``shaft`` (exact)."""
         return 1 / self.speed_ratio(shaft)
 
-    def mesh_orders(self, shaft: str) -> tuple[int, ...]:
-        """Mesh orders in one revolution of ``shaft``: the tooth counts of its gears."""
+    def gear_teeth(self, shaft: str) -> tuple[int, ...]:
+        """Tooth counts of the gears that ``shaft`` carries (in stage order)."""
         self.check_shaft(shaft)
-        orders = []
+        teeth: list[int] = []
         for st in self.stages:
             z = st.teeth_on(shaft)
-            if z is not None and z not in orders:
-                orders.append(z)
+            if z is not None and z not in teeth:
+                teeth.append(z)
+        return tuple(teeth)
+
+    def mesh_orders(self, shaft: str) -> tuple[int, ...]:
+        """Every gear mesh that is synchronous with ``shaft``, in orders of its revolution.
+
+        First the meshes of the gears ``shaft`` carries (their tooth counts), then the
+        mesh of every other stage whose frequency is a whole multiple of the shaft's speed:
+        a stage's mesh is ``driver_teeth`` times its driver's speed, i.e. order
+        ``driver_teeth * speed_ratio(driver, shaft)``. Such a mesh repeats identically
+        every revolution of ``shaft`` and so stays in its synchronous average (e.g. the
+        PHM09 spur input shaft: its own 32T mesh and the idler 48T → 80T mesh at order
+        48 / 3 = 16). Meshes at fractional orders average out and are not listed.
+        """
+        orders = list(self.gear_teeth(shaft))
+        for st in self.stages:
+            order = st.driver_teeth * self.speed_ratio(st.driver, relative_to=shaft)
+            if order.denominator == 1 and int(order) not in orders:
+                orders.append(int(order))
         return tuple(orders)
 
     def sensor(self, name: str | None = None) -> Sensor:

@@ -139,7 +139,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     for p in recordings:
         sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
         rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
-    est = OneFaultShotEstimator(random_state=seed, mesh_order=machine.monitored.teeth)
+    # every mesh synchronous with the shaft leaves the difference signal (the second stage's
+    # too), on the simulated side as on the recorded one
+    est = OneFaultShotEstimator(random_state=seed,
+                                mesh_order=list(machine.mesh_orders(machine.monitored.shaft)))
     selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
     est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
             selection_tf=selection_tf)

@@ -210,6 +210,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         Candidate features (default the paper's four).
     selection_threshold : float > 0, default 0.10
         Keep features whose invariance error is below this (step 1).
+    selection_fallback : {"best", "all"}, default "best"
+        What step 1 keeps when no feature passes the threshold: the one with the smallest
+        error, or every candidate (the invariance test then tells the features apart by
+        how badly each fails, and "all" does not stake the estimate on one of them).
     grades : iterable of int in [1, 12], default range(1, 13)
         DIN grades tried by simulation tuning (step 2); those absent from the database
         are skipped.
@@ -228,7 +232,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     n_neighbors : iterable of int >= 1, default range(1, 101)
         Candidate K of step 8.
     validation_fraction : float in (0, 1), default 0.3
-    mesh_order : int >= 1, default 38
+    mesh_order : int >= 1 or sequence of int >= 1, default 38
+        Gear-mesh order(s) in the SA cycle whose harmonics and sidebands the difference
+        signal removes (step 7). Several for a shaft whose SA holds several synchronous
+        meshes, e.g. ``[32, 16]`` for the PHM09 spur input shaft, where the second stage's
+        mesh falls at order 16 (:meth:`gearshot.Machine.mesh_orders`); the simulated and
+        target signals are treated alike.
     zero_shot : bool, default False
         No faulty example: choose the grade by matching healthy-signal statistics
         (:func:`~gearshot.estimator.match_grade`). With soft weighting the grades are
@@ -295,6 +304,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
         "features": [NoneValue(), NameSequence(available_features)],
         "selection_threshold": [Interval(float, 0, None, closed="neither")],
+        "selection_fallback": [Options(("best", "all"))],
         "grades": [IntegerSequence(1, 12)],
         "select_features": [Boolean()],
         "tune_simulation": [Boolean()],
@@ -303,7 +313,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "transfer_function": [Options(("estimate", "none")), ArrayOrObject("to_signal_grid")],
         "n_neighbors": [IntegerSequence(1, None)],
         "validation_fraction": [Interval(float, 0, 1, closed="neither")],
-        "mesh_order": [Interval(int, 1, None)],
+        "mesh_order": [Interval(int, 1, None), IntegerSequence(1, None)],
         "zero_shot": [Boolean()],
         "upsample": [Interval(int, 1, None)],
         "tuning_smoothing": [Options(("isotonic", "none"))],
@@ -314,18 +324,20 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     }
 
     def __init__(self, *, features: Sequence[str] | None = None,
-                 selection_threshold: float = 0.10, grades: Iterable[int] = range(1, 13),
+                 selection_threshold: float = 0.10, selection_fallback: str = "best",
+                 grades: Iterable[int] = range(1, 13),
                  select_features: bool = True, tune_simulation: bool = True,
                  nominal_grade: int = 7, rms_normalization: bool = True,
                  transfer_function: str | ArrayLike | Any = "estimate",
                  n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
-                 mesh_order: int = 38, zero_shot: bool = False, upsample: int = 100,
+                 mesh_order: int | Sequence[int] = 38, zero_shot: bool = False, upsample: int = 100,
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
                  model_discrepancy: float = 0.08, random_state: Any = None,
                  fault_type: str | None = None) -> None:
         self.fault_type = fault_type
         self.features = features
         self.selection_threshold = selection_threshold
+        self.selection_fallback = selection_fallback
         self.grades = grades
         self.select_features = select_features
         self.tune_simulation = tune_simulation
@@ -341,6 +353,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.grade_weighting = grade_weighting
         self.model_discrepancy = model_discrepancy
         self.random_state = random_state
+
+    def _mesh_orders(self) -> int | list[int]:
+        """``mesh_order`` as the signal functions take it (an int or a list of ints)."""
+        m = self.mesh_order
+        return int(m) if isinstance(m, (int, np.integer)) else [int(v) for v in m]
 
     # ------------------------------------------------------------------ fit
     def fit(self, database: Any, target_healthy: ArrayLike,
@@ -486,7 +503,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             else inputs.target_healthy
         train_h, references = steps.split_target_healthy(scaled)
         sub_h = steps.suppress_harmonics_target(train_h, references, upsample=self.upsample)
-        feats_h, mean_h = steps.centred_features(sub_h, mesh_order=self.mesh_order,
+        feats_h, mean_h = steps.centred_features(sub_h, mesh_order=self._mesh_orders(),
                                                  names=names,
                                                  healthy_mask=np.ones(len(sub_h), bool))
         return _TargetSide(tf, scale, scaled, references, mean_h, feats_h)
@@ -510,8 +527,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             return _Selection(names, {}, None)
         sa, y = by_grade[nominal]
         selected, errors, features = steps.select_features(
-            sa, y, inputs.selection_tf, mesh_order=self.mesh_order, names=names,
-            threshold=self.selection_threshold, random_state=seed, return_features=True)
+            sa, y, inputs.selection_tf, mesh_order=self._mesh_orders(), names=names,
+            threshold=self.selection_threshold, fallback=self.selection_fallback,
+            random_state=seed, return_features=True)
         return _Selection(tuple(selected), errors, features)
 
     # ------------------------------------------------------------------ fit: grade models
@@ -541,7 +559,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         """Steps 4–8 for one grade: its simulated features with the target healthy, KNN."""
         sa, y = grade_data
         X_sim = steps.simulated_features(sa, y == 0, target.transfer_function,
-                                         mesh_order=self.mesh_order, names=names,
+                                         mesh_order=self._mesh_orders(), names=names,
                                          rms_normalization=self.rms_normalization)
         X = np.vstack([X_sim[:, cols], target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
@@ -583,10 +601,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
 
     def _grade_zero_shot(self, ctx: _FitContext) -> _GradeChoice:
         """No example: match healthy-signal statistics of target and simulation."""
-        target_sig = healthy_signature(ctx.target.scaled_healthy, self.mesh_order)
+        target_sig = healthy_signature(ctx.target.scaled_healthy, self._mesh_orders())
         sims = {g: healthy_signature(
             steps.propagate_simulated(sa[y == 0], ctx.target.transfer_function),
-            self.mesh_order) for g, (sa, y) in ctx.by_grade.items() if g in ctx.grades}
+            self._mesh_orders()) for g, (sa, y) in ctx.by_grade.items() if g in ctx.grades}
         grade, curve = match_grade(target_sig, sims)
         tuning_curve: dict[str, Any] = dict(curve)
         weights = {grade: 1.0}
@@ -610,7 +628,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         if self.rms_normalization:
             x = x / scale
         sub = steps.suppress_harmonics_target(x, references, upsample=self.upsample)
-        feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=self.mesh_order,
+        feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=self._mesh_orders(),
                                           names=names)
         return feats
 

@@ -58,7 +58,8 @@ RandomStateLike = int | np.random.RandomState | None
 
 # ---------------------------------------------------------------- step 1
 def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: ArrayLike, *,
-                    mesh_order: int, names: Sequence[str], threshold: float = 0.10,
+                    mesh_order: int | Sequence[int], names: Sequence[str],
+                    threshold: float = 0.10, fallback: str = "best",
                     noise_fraction: float = 0.10, n_long_cycles: int = 128,
                     random_state: RandomStateLike = None, return_features: bool = False,
                     ) -> Any:
@@ -79,10 +80,12 @@ def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: Arra
         Their sizes (0 healthy).
     selection_tf : ndarray of complex (n_points,)
         The held-out TF on the SA grid.
-    mesh_order : int
+    mesh_order : int or sequence of int
     names : sequence of str
         Candidate features.
     threshold : float
+    fallback : {"best", "all"}
+        When no feature passes: keep the one with the smallest error, or all of them.
     noise_fraction : float
     n_long_cycles : int
         Cycles in the long healthy test signal used for the TF estimate.
@@ -94,7 +97,8 @@ def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: Arra
     Returns
     -------
     selected : tuple of str
-        At least one name: when no feature passes, the one with the smallest error.
+        At least one name: when no feature passes, the one with the smallest error
+        (``fallback="best"``) or every candidate (``fallback="all"``).
     errors : dict name → error
     (train, test) : tuple of ndarray (n_signals - 1, n_features)
         Only with ``return_features``: the features through the estimated and the true TF.
@@ -117,7 +121,9 @@ def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: Arra
     errors = dict(zip(names, err.tolist()))
     selected = tuple(n for n, e in errors.items() if e < threshold)
     if not selected:
-        selected = (min(errors, key=errors.__getitem__),)
+        if fallback not in ("best", "all"):
+            raise GearshotError(f"fallback must be 'best' or 'all'; got {fallback!r}")
+        selected = (min(errors, key=errors.__getitem__),) if fallback == "best" else tuple(names)
     if return_features:
         return selected, errors, (f_train[keep], f_test[keep])
     return selected, errors
@@ -239,8 +245,9 @@ def suppress_harmonics_target(signals: ArrayLike, references: ArrayLike, *,
 
 
 # ---------------------------------------------------------------- step 7
-def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *, mesh_order: int,
-                     names: Sequence[str], healthy_mask: ArrayLike | None = None,
+def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
+                     mesh_order: int | Sequence[int], names: Sequence[str],
+                     healthy_mask: ArrayLike | None = None,
                      ) -> tuple[FloatArray, FloatArray]:
     """Step 7: features of (suppressed) SAs minus a healthy mean.
 
@@ -264,7 +271,7 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *, me
 
 
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
-                       mesh_order: int, names: Sequence[str],
+                       mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
 
@@ -275,7 +282,7 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         The healthy SAs (the RMS reference, the subtracted SA and the centring mean).
     tf : ndarray of complex (n_points,) or None
         Transfer function of step 4 (None: no propagation).
-    mesh_order : int
+    mesh_order : int or sequence of int
     names : sequence of str
     rms_normalization : bool, default True
         Apply step 5.

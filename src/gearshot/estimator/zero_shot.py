@@ -16,7 +16,7 @@ grade models, not a guess driven by that foreign content.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,7 +27,7 @@ from .uncertainty import prune_weights
 __all__ = ["healthy_signature", "match_grade", "signature_weights"]
 
 
-def healthy_signature(sa: ArrayLike, mesh_order: int, *,
+def healthy_signature(sa: ArrayLike, mesh_order: int | Sequence[int], *,
                       n_sidebands: int = 2) -> NDArray[np.float64]:
     """``log(RMS(diff) / RMS(harmonic))`` of each SA (scale-free)."""
     diff = difference_signal(sa, mesh_order, n_sidebands=n_sidebands)
