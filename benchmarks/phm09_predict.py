@@ -14,6 +14,7 @@ no spur2 test segment). Database: ``gearshot simulate --machine`` (see RESULTS.m
 from __future__ import annotations
 
 import argparse
+import json
 import time
 from pathlib import Path
 
@@ -31,9 +32,18 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data" / "phm09")
     ap.add_argument("--load", type=float, default=10.0)
     ap.add_argument("--size", type=float, default=0.5)
+    ap.add_argument("--param", action="append", default=[],
+                    help="estimator parameter NAME=VALUE (JSON value), repeatable")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results"
                     / "phm09_predict.csv")
     args = ap.parse_args()
+    params = {}
+    for item in args.param:
+        name, _, value = item.partition("=")
+        try:
+            params[name] = json.loads(value)
+        except json.JSONDecodeError:
+            params[name] = value
     machine = Machine.from_toml(ROOT / "examples" / "machines" / "phm09_spur.toml")
     frames = []
     for speed in (30, 40):
@@ -43,7 +53,8 @@ def main() -> None:
             f = predict_from_machine(machine, args.database, [args.data / f"spur3_{cell}"],
                                      args.data / f"spur2_{cell}", args.size,
                                      [args.data / f"spur1_{cell}"], speed=float(speed),
-                                     load=args.load, cycles_per_segment=10, seed=0)
+                                     load=args.load, cycles_per_segment=10, seed=0,
+                                     params=params)
             f.insert(0, "cell", f"{speed}hz_{load}")
             f["grade"] = f.attrs.get("grade")
             f["seconds"] = time.perf_counter() - t0

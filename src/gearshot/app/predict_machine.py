@@ -60,7 +60,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                          recordings: Sequence[str | Path] = (), *, speed: float, load: float,
                          cycles_per_segment: int | None = None, sensor: str | None = None,
                          holdout: float = 0.25, example_segment: int = 0,
-                         coverage: float = 0.9, seed: int = 0) -> pd.DataFrame:
+                         coverage: float = 0.9, seed: int = 0,
+                         params: dict | None = None) -> pd.DataFrame:
     """Fit on healthy recordings + one faulty recording; estimate segments of a machine.
 
     Parameters
@@ -93,6 +94,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         are estimated too (``role="faulty_rest"``; they come from the example's record).
     example_segment, coverage, seed
         Which faulty segment is the example; interval coverage; random state.
+    params : dict, optional
+        Further :class:`~gearshot.estimator.OneFaultShotEstimator` parameters (its
+        ``mesh_order`` and ``random_state`` come from the machine and ``seed``).
 
     Returns
     -------
@@ -141,8 +145,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
     # too), on the simulated side as on the recorded one
-    est = OneFaultShotEstimator(random_state=seed,
-                                mesh_order=list(machine.mesh_orders(machine.monitored.shaft)))
+    meshes = list(machine.mesh_orders(machine.monitored.shaft))
+    est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
+                                   "mesh_order": meshes})
     selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
     est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
             selection_tf=selection_tf)
