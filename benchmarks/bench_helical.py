@@ -2,6 +2,7 @@
 
     PYTHONPATH=src python benchmarks/bench_helical.py            # speed + comparison
     PYTHONPATH=src python benchmarks/bench_helical.py --full     # + 12 grades x 800 helical
+    PYTHONPATH=src python benchmarks/bench_helical.py --growth   # RMS growth per fault type
 
 Prints numbers (no asserts); the load average is printed with each timing.
 """
@@ -59,13 +60,32 @@ def iso_c_gamma_alpha(pair):
     return c_ga * pair.face_width * 1e3 * 1e6                     # N/m
 
 
+def growth(pair, seeds=(3, 4, 5, 6)):
+    """Ratio faulty/healthy of the difference-signal RMS at sizes 0, 0.1 ... 1 on one gear
+    (per seed), and its Spearman correlation with the size."""
+    from scipy.stats import spearmanr
+    sizes = np.linspace(0.0, 1.0, 11)
+    print("difference-signal RMS / healthy at sizes 0, 0.1 ... 1, 15 rps 10 Nm DIN 7")
+    for ft in ("ftff", "partial_face", "breakage", "destruction"):
+        for seed in seeds:
+            r = _diff_rms(simulate_sa(pair, speed=15, load=10, grade=7, fault_sizes=sizes,
+                                      same_gear=True, rng=seed, fault_type=ft))
+            print(f"  {ft:12s} seed {seed}: {' '.join(f'{v:.2f}' for v in r / r[0])}  "
+                  f"Spearman {spearmanr(sizes, r).statistic:.3f}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--full", action="store_true")
     ap.add_argument("--compare-only", action="store_true",
                     help="only the lab-model comparison")
+    ap.add_argument("--growth", action="store_true",
+                    help="only the difference-signal RMS growth with size per fault type")
     args = ap.parse_args()
     spur, hel = GearPair.paper(), GearPair.helical(math.radians(20))
+    if args.growth:
+        growth(spur)
+        return
     theta = np.linspace(0, 2 * np.pi * 38 / 17, 20000, endpoint=False)
     print("mesh stiffness: mean, (max-min)/mean, ISO 6336-1 c_gamma_alpha")
     for name, p in (("spur", spur), ("helical 20 deg", hel)):
@@ -84,7 +104,8 @@ def main():
         ref = {k: float(_diff_rms(d[k])) for k in
                ("healthy", "PartialFaceFault", "ToothBreakage", "ToothDestruction")}
         faults = [None, PartialFaceFault(size=2 / 15, profile_size=0.6),
-                  ToothBreakage(size=3e-3 / ToothBreakage.active_height(spur)),
+                  ToothBreakage(size=3e-3 / ToothBreakage.active_height(spur),
+                                face_share=1.0),
                   ToothDestruction(size=10 / 14, center=8 / 14),
                   ToothBreakage(size=1.0)]
         names = ["healthy", "PartialFaceFault", "ToothBreakage", "ToothDestruction",
