@@ -41,12 +41,14 @@ def main():
     args = parser.parse_args()
     data = Path(args.data)
     ft = args.fault_type
+    # the FTFF at the paper's settings keeps its old folder names
     tag = "" if ft == "ftff" else f"-{ft}"
-    default_campaign = (args.n_faulty, args.duration, args.sizes) == (350, 60.0,
-                                                                       [0.32, 0.56, 0.66])
-    if not default_campaign:
-        tag += f"-n{args.n_faulty}-d{args.duration:g}-y{'_'.join(f'{y:g}' for y in args.sizes)}"
-    store = data / f"db-4conditions{tag}"
+    db_tag = tag + ("" if args.n_faulty == 350 else f"-n{args.n_faulty}")
+    if args.duration != 60.0:
+        tag += f"-d{args.duration:g}"
+    if args.sizes != [0.32, 0.56, 0.66]:
+        tag += f"-y{'_'.join(f'{y:g}' for y in args.sizes)}"
+    store = data / f"db-4conditions{db_tag}"
     t0 = time.perf_counter()
     build_database(store, GearPair.paper(), speeds=[15, 30], loads=[5, 10],
                    grades=range(1, 13), n_healthy=50, n_faulty=args.n_faulty, seed=0,
