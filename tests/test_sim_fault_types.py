@@ -149,3 +149,17 @@ def test_against_lab_model_fault_types():
     assert want / 2 <= ratio[2] <= 2 * want
     want = r_ref["ToothBreakage"] / r_ref["healthy"]
     assert want / 2 <= ratio[3] <= 2 * want
+
+
+def test_breakage_growth_path_opens_the_contact_gap_only_at_the_missing_tooth():
+    """The growth path's physics: the mesh stiffness at its lowest (the faulty tooth's
+    single-contact zone) falls with the size, and no instant is left without contact
+    until the whole tooth is lost (a whole-face break opens that gap from y ~ 0.45)."""
+    theta = np.linspace(0, 2 * np.pi * 38 / 17, 40000, endpoint=False)
+    k0 = mesh_stiffness(PAIR, theta)
+    lows = [mesh_stiffness(PAIR, theta, fault=ToothBreakage(size=y)).min()
+            for y in np.linspace(0.1, 1.0, 10)]
+    assert np.all(np.diff(lows) <= 1e-9 * k0.mean())
+    assert lows[-2] > 0.05 * k0.min() and lows[-1] < 1e-9 * k0.mean()
+    whole = mesh_stiffness(PAIR, theta, fault=ToothBreakage(size=0.6, face_share=1.0))
+    assert whole.min() < 1e-9 * k0.mean()
