@@ -356,6 +356,12 @@ FAULT_TYPES = {
 }
 
 
+#: name -> version of the type's model; bump it when a type's geometry or physics changes,
+#: so that databases built with the older model are refused (``load_database``) instead of
+#: silently mixed with new SAs. breakage 2: the growth path over the face share (session 5).
+FAULT_MODEL_VERSIONS = {"ftff": 1, "partial_face": 1, "breakage": 2, "destruction": 1}
+
+
 def check_fault_type(name) -> str:
     """Validate a fault type name."""
     if not isinstance(name, str) or name not in FAULT_TYPES:
