@@ -52,3 +52,29 @@ def test_estimator_selects_fault_type(store):
     assert sel.sizes["signal"] == 5
     with pytest.raises(GearshotError, match="not in the database"):
         _select_fault_type(ds, "destruction")
+
+
+def test_store_of_an_older_fault_model_is_refused(tmp_path, store):
+    """A breakage store built before the breakage model changed (no or an older
+    ``fault_models`` version) is refused, naming the type and both versions; its FTFF
+    slice stays usable."""
+    import shutil
+
+    from gearshot.sim.fault_types import FAULT_MODEL_VERSIONS
+
+    man = json.loads((store / "manifest.json").read_text())
+    assert man["fault_models"] == {"ftff": 1, "breakage": FAULT_MODEL_VERSIONS["breakage"]}
+    old = tmp_path / "old"
+    shutil.copytree(store, old)
+    del man["fault_models"]                 # as written before model versions existed
+    (old / "manifest.json").write_text(json.dumps(man))
+    with pytest.raises(GearshotError, match=r"'breakage' SAs of an older model.*"
+                                            r"version None, current 2"):
+        load_database(old, speed=15, load=10, fault_type="breakage")
+    with pytest.raises(GearshotError, match="older model"):
+        load_database(old, speed=15, load=10)
+    assert load_database(old, speed=15, load=10, fault_type="ftff").sizes["signal"] == 5
+    with pytest.raises(GearshotError, match="different build.*fault_models"):
+        build_database(old, GearPair.paper(), speeds=[15], loads=[10], grades=[7],
+                       n_healthy=2, n_faulty=3, fault_types=["ftff", "breakage"],
+                       client=False, progress=False)

@@ -71,15 +71,7 @@ def test_missing_tooth_loses_its_contact():
     assert np.all(km <= k + 1e-6)
 
 
-_BREAKAGE_NOT_MONOTONIC = pytest.mark.xfail(
-    strict=False, reason="breakage (lab geometry: tip loss over the whole face) peaks at "
-    "y ~ 0.7, where contact re-enters abruptly in the single-contact zone, above the "
-    "missing tooth (Spearman ~0.89); benchmarks/RESULTS.md")
-
-
-@pytest.mark.parametrize("name", ["partial_face",
-                                  pytest.param("breakage", marks=_BREAKAGE_NOT_MONOTONIC),
-                                  "destruction"])
+@pytest.mark.parametrize("name", ["ftff", "partial_face", "breakage", "destruction"])
 def test_signature_grows_with_size_and_small_faults_are_buried(name):
     sizes = np.linspace(0.0, 1.0, 11)
     sa = simulate_sa(PAIR, speed=15, load=10, grade=7, fault_sizes=sizes, same_gear=True,
@@ -110,13 +102,25 @@ def test_breakage_small_is_buried_and_missing_tooth_is_loud():
 
 def test_breakage_geometry():
     """Tip loss y H over the whole face, a corner chip (1 + c) y H deep at face 0."""
-    f = ToothBreakage(size=0.3)
+    f = ToothBreakage(size=0.3, face_share=1.0)
     h = ToothBreakage.active_height(PAIR)
     np.testing.assert_allclose(f.lost_height(PAIR, [1.0, 0.8, 0.0]),
                                [0.3 * h, 0.3 * h, 0.5 * h], rtol=1e-12)
     np.testing.assert_allclose(ToothBreakage(size=1.0).lost_height(PAIR, [0, 1]), [h, h])
+    # the growth path (default face_share = size): the break spans the face share y
+    g = ToothBreakage(size=0.3)
+    np.testing.assert_allclose(g.lost_height(PAIR, [0.0, 0.3, 0.31, 1.0]),
+                               [0.5 * h, 0.3 * (5 / 3) * (1 - 0.3 / 0.8) * h, 0.0, 0.0],
+                               rtol=1e-12)
+    assert max(b[1] for b in g.face_bands(PAIR)) == pytest.approx(0.3)
+    # nested: a larger break contains a smaller one
+    z = np.linspace(0, 1, 201)
+    hs = [ToothBreakage(size=y).lost_height(PAIR, z) for y in np.linspace(0.05, 1, 20)]
+    assert np.all(np.diff(hs, axis=0) >= -1e-15)
     with pytest.raises(GearshotError, match="edge_relief"):
         ToothBreakage(size=0.3, edge_relief=-1.0)
+    with pytest.raises(GearshotError, match="face_share"):
+        ToothBreakage(size=0.3, face_share=0.0)
 
 
 def test_against_lab_model_fault_types():
@@ -129,10 +133,11 @@ def test_against_lab_model_fault_types():
     d = np.load(ref)
     r_ref = {k: _diff_rms(d[k]) for k in ("healthy", "PartialFaceFault", "ToothDestruction",
                                           "ToothBreakage")}
-    # the lab's breakage: 3 mm tip loss over the face, a 5 mm x 12 mm corner chip
+    # the lab's breakage: 3 mm tip loss over the whole face, a 5 mm x 12 mm corner chip
     y_break = 3e-3 / ToothBreakage.active_height(PAIR)
     faults = [None, PartialFaceFault(size=2 / 15, profile_size=0.6, center=0.5, depth=0.5),
-              ToothDestruction(size=10 / 14, center=8 / 14), ToothBreakage(size=y_break)]
+              ToothDestruction(size=10 / 14, center=8 / 14),
+              ToothBreakage(size=y_break, face_share=1.0)]
     ratios = []
     for seed in range(2):
         r = _diff_rms(simulate_sa(PAIR, speed=15, load=10, grade=7, faults=faults,
@@ -144,3 +149,17 @@ def test_against_lab_model_fault_types():
     assert want / 2 <= ratio[2] <= 2 * want
     want = r_ref["ToothBreakage"] / r_ref["healthy"]
     assert want / 2 <= ratio[3] <= 2 * want
+
+
+def test_breakage_growth_path_opens_the_contact_gap_only_at_the_missing_tooth():
+    """The growth path's physics: the mesh stiffness at its lowest (the faulty tooth's
+    single-contact zone) falls with the size, and no instant is left without contact
+    until the whole tooth is lost (a whole-face break opens that gap from y ~ 0.45)."""
+    theta = np.linspace(0, 2 * np.pi * 38 / 17, 40000, endpoint=False)
+    k0 = mesh_stiffness(PAIR, theta)
+    lows = [mesh_stiffness(PAIR, theta, fault=ToothBreakage(size=y)).min()
+            for y in np.linspace(0.1, 1.0, 10)]
+    assert np.all(np.diff(lows) <= 1e-9 * k0.mean())
+    assert lows[-2] > 0.05 * k0.min() and lows[-1] < 1e-9 * k0.mean()
+    whole = mesh_stiffness(PAIR, theta, fault=ToothBreakage(size=0.6, face_share=1.0))
+    assert whole.min() < 1e-9 * k0.mean()

@@ -12,7 +12,9 @@ How the hidden reality reaches the simulator:
 * the fault: the reality's centre and depth coefficient; its edge offsets widen/narrow and
   shift the cut, so the physical fault differs from the nominal label ``y``; the reality's
   ``fault_roughness`` makes the depth vary along the cut. The fault reaches the physics as
-  an :class:`IrregularFaceFault` through ``simulate(faults=...)``.
+  an :class:`IrregularFaceFault` through ``simulate(faults=...)``;
+* the other fault types (``fault_type``): their irregular physical fault
+  (:func:`gearshot.rig.irregular.physical_fault_of_type`), from the same reality fields.
 """
 
 from __future__ import annotations
@@ -118,13 +120,19 @@ class SimulatorEngine:
         Nominal gear pair (default :meth:`GearPair.paper`).
     nominal_grade : int
         DIN grade used when ``reality`` is None (the nominal model).
+    fault_type : str
+        The fault the rig grows (:data:`gearshot.sim.FAULT_TYPES`; default ``"ftff"``).
     """
 
     pair: object = field(default=None)
     nominal_grade: int = 7
+    fault_type: str = "ftff"
 
     def __post_init__(self) -> None:
+        from ..sim.fault_types import check_fault_type
+
         check_int(self.nominal_grade, "nominal_grade", minimum=1, maximum=12)
+        check_fault_type(self.fault_type)
 
     def __call__(self, *, motor_revs: np.ndarray, load_torque: np.ndarray, fs: float,
                  fault_size: float, reality: RigReality | None,
@@ -141,7 +149,13 @@ class SimulatorEngine:
         else:
             grade, prng = reality.grade, np.random.default_rng(reality.profile_seed)
         fault: dict[str, Any]
-        if reality is not None and size > 0 and any(reality.fault_roughness):
+        if self.fault_type != "ftff":
+            from .irregular import physical_fault_of_type
+
+            fault = (dict(faults=[physical_fault_of_type(self.fault_type, fault_size,
+                                                         reality)])
+                     if fault_size > 0 else dict(fault_sizes=[0.0]))
+        elif reality is not None and size > 0 and any(reality.fault_roughness):
             fault = dict(faults=[IrregularFaceFault(size=size, center=center, depth=depth,
                                                     roughness=reality.fault_roughness)])
         else:

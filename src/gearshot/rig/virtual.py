@@ -28,6 +28,7 @@ whole run); :class:`~gearshot.rig.surrogate.SurrogateEngine` is a fast stand-in.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -41,6 +42,7 @@ from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_positive
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
 from ..signal.level import rms
+from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
 from .motion import load_torque, motor_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
@@ -83,6 +85,13 @@ class VirtualRig:
     reality_overrides : mapping, optional
         Fields of the hidden :class:`RigReality` to set instead of drawing them (see
         :meth:`with_reality`).
+    fault_type : str
+        The fault this rig grows (``"ftff"``, default; ``"partial_face"``, ``"breakage"``,
+        ``"destruction"``: :data:`gearshot.sim.FAULT_TYPES`); ``fault_size`` of
+        :meth:`record` is its size label. The hidden reality makes each type irregular
+        (:mod:`gearshot.rig.irregular`). The ``"sim"`` engine grows every type, the
+        surrogate only the FTFF; a callable engine gets ``fault_type=`` as a keyword when
+        it is not ``"ftff"``.
 
     Notes
     -----
@@ -92,7 +101,8 @@ class VirtualRig:
     def __init__(self, seed: int = 0, *, engine: str | Callable[..., np.ndarray] | None = None,
                  tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = 38,
                  pinion_teeth: int = 17, settle: float = 0.25, grade: int | None = None,
-                 reality_overrides: Mapping[str, Any] | None = None):
+                 reality_overrides: Mapping[str, Any] | None = None,
+                 fault_type: str = "ftff"):
         self.seed = seed
         self.engine = engine
         self.tf_bank = tf_bank
@@ -102,12 +112,13 @@ class VirtualRig:
         self.settle = settle
         self.grade = grade
         self.reality_overrides = reality_overrides
+        self.fault_type = fault_type
         self._built: tuple[RigReality, np.ndarray, str] | None = None
 
     def _params(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in ("seed", "engine", "tf_bank", "fs", "gear_teeth",
                                               "pinion_teeth", "settle", "grade",
-                                              "reality_overrides")}
+                                              "reality_overrides", "fault_type")}
 
     def with_reality(self, **changes: Any) -> VirtualRig:
         """A copy of this rig whose hidden reality has some fields set (e.g.
@@ -127,6 +138,7 @@ class VirtualRig:
             check_int(self.gear_teeth, "gear_teeth", minimum=2)
             check_int(self.pinion_teeth, "pinion_teeth", minimum=2)
             check_positive(self.settle, "settle", allow_zero=True)
+            check_fault_type(self.fault_type)
             if self.tf_bank is None:
                 tfs = synthetic_path_tfs(8, rng=np.random.default_rng([seed, 3]), band=fs / 2)
             else:
@@ -154,12 +166,17 @@ class VirtualRig:
 
     def _engine(self) -> Callable[..., np.ndarray]:
         if self.engine is None or self.engine == "sim":
-            return SimulatorEngine()
+            return SimulatorEngine(fault_type=self.fault_type)
         if self.engine == "surrogate":
+            if self.fault_type != "ftff":
+                raise GearshotError(f"the surrogate engine models the FTFF only; "
+                                    f"fault_type={self.fault_type!r} needs engine='sim'")
             return SurrogateEngine(gear_teeth=self.gear_teeth, pinion_teeth=self.pinion_teeth)
         if not callable(self.engine):
             raise GearshotError(f"engine must be 'sim', 'surrogate' or a callable; got "
                                 f"{self.engine!r}")
+        if self.fault_type != "ftff":
+            return functools.partial(self.engine, fault_type=self.fault_type)
         return self.engine
 
     # ------------------------------------------------------------------ one recording
@@ -204,9 +221,10 @@ class VirtualRig:
                             ripple=reality.speed_ripple, rng=rng, start=start)
         torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
                              ripple=reality.load_ripple, rng=rng)
-        vib = np.asarray(self._engine()(motor_revs=motor, load_torque=torque, fs=fs,
-                                        fault_size=fault_size, reality=reality, rng=rng),
-                         dtype=np.float64)
+        engine = self._engine()
+        vib = np.asarray(engine(motor_revs=motor, load_torque=torque, fs=fs,
+                            fault_size=fault_size, reality=reality, rng=rng),
+                     dtype=np.float64)
         if vib.shape != motor.shape or not np.all(np.isfinite(vib)):
             raise GearshotError(f"the physics engine returned shape {vib.shape} or non-finite "
                                 f"values; expected {motor.shape} finite")
@@ -226,7 +244,8 @@ class VirtualRig:
             acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
             source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
             extras={"repetition": repetition, "rig_seed": int(self.seed),
-                    "engine": type(self._engine()).__name__})
+                    "engine": type(getattr(engine, "func", engine)).__name__,
+                    "fault_type": self.fault_type})
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod

@@ -39,7 +39,7 @@ def tau_grid(eps_alpha: float, eps_beta: float, n_table: int) -> np.ndarray:
     return np.arange(n_tau) * step
 
 
-def box(f: np.ndarray, eps_alpha: float, eps_beta: float, lo: float, hi: float,
+def box(f: np.ndarray, eps_alpha: float, eps_beta: float, lo, hi,
         tau: np.ndarray) -> np.ndarray:
     """Face integral of a spur single-pair curve over a band of delays.
 
@@ -49,9 +49,10 @@ def box(f: np.ndarray, eps_alpha: float, eps_beta: float, lo: float, hi: float,
         Curve over the spur contact position u in [0, 1] (0 outside).
     eps_alpha, eps_beta : float
         Transverse and overlap contact ratios (eps_beta > 0).
-    lo, hi : float
+    lo, hi : float or ndarray (n_bands,)
         Band of delays, mesh periods (0 <= lo <= hi <= eps_beta): face fractions times
-        eps_beta.
+        eps_beta. Arrays: one band per entry of ``f``'s first axis (``f`` of shape
+        (n_bands, ..., n_table)), each boxed over its own band in one call.
     tau : ndarray (n_tau,)
         Delays (mesh periods) at which to evaluate (:func:`tau_grid`).
 
@@ -69,13 +70,24 @@ def box(f: np.ndarray, eps_alpha: float, eps_beta: float, lo: float, hi: float,
     cum = np.zeros(f.shape[:-1] + (n + 1,))
     cum[..., 1:n] = np.cumsum(0.5 * (f[..., 1:] + f[..., :-1]), axis=-1) * step
     cum[..., n] = cum[..., n - 1]
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    banded = lo.ndim > 0
 
     def at(shift):
+        if banded:      # shift (n_bands,) against f's first axis
+            shift = shift.reshape(shift.shape + (1,) * (f.ndim - 1))
         p = np.clip((tau - shift) / step, 0.0, n - 1.0)
         i = np.minimum(p.astype(np.int64), n - 1)
         frac = p - i
-        f0 = fp[..., i]
-        df = np.where(i < n - 1, fp[..., i + 1] - f0, 0.0)
-        return cum[..., i] + step * frac * (f0 + 0.5 * df * frac)
+        if banded:
+            i = np.broadcast_to(i, f.shape[:-1] + (tau.size,))
+            f0 = np.take_along_axis(fp, i, axis=-1)
+            df = np.where(i < n - 1, np.take_along_axis(fp, i + 1, axis=-1) - f0, 0.0)
+            c0 = np.take_along_axis(cum, i, axis=-1)
+        else:
+            f0 = fp[..., i]
+            df = np.where(i < n - 1, fp[..., i + 1] - f0, 0.0)
+            c0 = cum[..., i]
+        return c0 + step * frac * (f0 + 0.5 * df * frac)
 
     return (at(lo) - at(hi)) / eps_beta

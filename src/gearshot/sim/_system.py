@@ -30,7 +30,7 @@ from ._slices import box
 from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors
-from .stiffness import _N_TABLE, _pair_table, fault_tables, helical_tables
+from .stiffness import _N_TABLE, _pair_table, band_arrays, fault_tables, helical_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
            "make_batch", "warmup_time"]
@@ -215,9 +215,14 @@ class HelicalBatch(Batch):
             t = f.tooth % pair.z_gear
             _, self.kf[i], bands = helical_tables(pair, f)
             self.tooth[i] = t
-            for lo, hi, dk, kd in bands:
-                self.fg[i, t] += box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau)
-                self.fpf[i] += box(dk * e_p[i], ea, eb, lo, hi, tau)
+            if not bands:
+                continue
+            # every band in one call each; added band by band (the order of the sums)
+            lo, hi, dk, kd = band_arrays(bands)
+            for part in box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau):
+                self.fg[i, t] += part
+            for part in box(dk[:, None, :] * e_p[i][None], ea, eb, lo, hi, tau):
+                self.fpf[i] += part
         self.X = np.tile(integ.x_static, (n, 1))
         self.V = np.zeros((n, integ.x_static.size))
         self.A = np.zeros((n, integ.x_static.size))

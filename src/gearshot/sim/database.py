@@ -37,7 +37,7 @@ from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, describe
 from .dynamics import simulate_sa
-from .fault_types import FAULT_TYPES, check_fault_type
+from .fault_types import FAULT_MODEL_VERSIONS, FAULT_TYPES, check_fault_type
 from .geometry import GearPair
 
 __all__ = ["build_database", "load_database", "default_database_path"]
@@ -93,7 +93,20 @@ def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
            "n_healthy": n_healthy, "n_faulty": n_faulty, "seed": seed, "n_points": n_points}
     if list(fault_types) != ["ftff"]:
         man["fault_types"] = list(fault_types)
+        man["fault_models"] = {t: FAULT_MODEL_VERSIONS[t] for t in fault_types}
     return man
+
+
+def _check_fault_models(store: Path, man: dict, types) -> None:
+    """Refuse SAs of a fault type simulated with an older model of that type."""
+    stored = man.get("fault_models", {"ftff": 1})
+    for t in types:
+        have, want = stored.get(t), FAULT_MODEL_VERSIONS[t]
+        if have != want:
+            raise GearshotError(f"store {str(store)!r} holds {t!r} SAs of an older model of "
+                                f"that fault type (model version {have}, current {want}); "
+                                f"rebuild them into a new store (build_database / "
+                                f"gearshot simulate --fault-type {t})")
 
 
 def _check_fault_types(fault_types):
@@ -472,6 +485,7 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
             raise GearshotError(f"fault_type {fault_type!r} is not in the database "
                                 f"(has {types})")
         types = [fault_type]
+    _check_fault_models(store, man, types)
     parts = []
     for k in ks:
         for ft in types:

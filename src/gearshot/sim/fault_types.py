@@ -9,14 +9,18 @@ name               geometry (size y: 0 = healthy ... 1)
 ``"partial_face"`` :class:`PartialFaceFault`: the same arc cut (``profile_size`` of the
                    active profile, default 0.6) over part of the face width; y = the cut
                    band's width / the face width (1: an FTFF of size ``profile_size``).
-``"breakage"``     :class:`ToothBreakage`: a broken tip with a chipped corner (the lab's
-                   geometry): the tooth above a break line is lost; the lost height at
-                   face position zeta (0 ... 1) is ``H min(1, y (1 + c (1 - zeta)))``
-                   (H: height of the tooth above its lowest contact point, c:
-                   ``corner``): a tip loss ``y H`` over the whole face, deepening to
-                   ``(1 + c) y H`` at the chipped face end. y = 1: the whole tooth lost down
-                   to the lowest contact point; what lies below never touches the mating
-                   tooth, so y = 1 acts as a missing tooth.
+``"breakage"``     :class:`ToothBreakage`: a broken tip with a chipped corner, grown from one
+                   face end: over the face share ``face_share`` (default: y) from the
+                   chipped end the tooth above a break line is lost; the lost height at
+                   face position zeta (0 ... 1) is ``H min(1, y max(1, (1 + c)
+                   (1 - zeta / w)))`` for zeta <= face_share and 0 beyond (H: height of the
+                   tooth above its lowest contact point, c: ``corner``, w:
+                   ``corner_width``): a tip loss ``y H`` deepening to ``(1 + c) y H`` at
+                   the chipped face end. The break grows across the face and down the
+                   tooth together; y = 1: the whole tooth lost down to the lowest contact
+                   point over the whole face; what lies below never touches the mating
+                   tooth, so y = 1 acts as a missing tooth. ``face_share=1`` gives the lab
+                   model's geometry (a tip loss over the whole face plus a corner chip).
 ``"destruction"``  :class:`ToothDestruction`: surface destruction (pitting / wear): a band
                    of the active profile, centred at ``center``, over the whole face,
                    pitted with craters ``y depth`` deep (the damage deepens as it
@@ -163,18 +167,24 @@ class ToothBreakage(ToothFault):
     Parameters
     ----------
     size : float
-        y in [0, 1]: the tip loss over the whole face as a fraction of the tooth height
-        above the lowest contact point; 1 = the whole tooth lost down to the lowest contact
-        point (acts as a missing tooth).
+        y in [0, 1]: the tip loss as a fraction of the tooth height above the lowest
+        contact point, over the face share ``face_share`` (default y: the break grows
+        across the face as it deepens); 1 = the whole tooth lost down to the lowest
+        contact point over the whole face (acts as a missing tooth).
     corner : float
         c >= 0: the chipped corner at face position 0 goes ``1 + c`` times deeper than the
         tip loss, tapering linearly across the face (default 2/3: the lab model's example,
-        a 3 mm tip loss and a 5 mm corner chip, is ``size = 3 mm / H = 0.61``).
+        a 3 mm tip loss and a 5 mm corner chip, is ``size = 3 mm / H = 0.61``,
+        ``face_share=1``).
     edge_relief : float
         Shortfall of the flank at the break edge per lost height (default 0.01: 30 um
         for a 3 mm tip loss), :meth:`_TipLoss.displacement`.
     edge_width : float
         Length of the edge's relief along the active profile, (0, 1].
+    face_share : float or None
+        Share of the face width (from the chipped end, zeta = 0) that the break spans,
+        (0, 1]; None (default): ``size``. ``face_share=1`` with ``size = 3 mm / H`` is the
+        lab model's example (a tip loss over the whole face).
     n_bands : int
         Face bands the break is resolved into (piecewise-constant height).
     tooth : int
@@ -187,10 +197,13 @@ class ToothBreakage(ToothFault):
     edge_relief: float = 0.01
     edge_width: float = 0.1
     n_bands: int = 16
+    face_share: float | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check_in_range(self.size, "size", 0.0, 1.0)
+        if self.face_share is not None:
+            check_in_range(self.face_share, "face_share", 0.0, 1.0, low_inclusive=False)
         check_in_range(self.corner, "corner", 0.0, 100.0)
         check_in_range(self.corner_width, "corner_width", 0.0, 1.0, low_inclusive=False)
         check_in_range(self.edge_relief, "edge_relief", 0.0, 0.1)
@@ -201,12 +214,17 @@ class ToothBreakage(ToothFault):
     def is_healthy(self) -> bool:
         return self.size <= 0.0
 
+    @property
+    def share(self) -> float:
+        """Face share spanned by the break (``face_share``, default ``size``)."""
+        return self.size if self.face_share is None else float(self.face_share)
+
     def lost_height(self, pair: GearPair, zeta) -> np.ndarray:
         """Lost height (m, from the tip) at face positions ``zeta`` (0 ... 1)."""
         zeta = np.asarray(zeta, dtype=float)
         chip = (1 + self.corner) * np.clip(1 - zeta / self.corner_width, 0.0, None)
-        return self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip),
-                                                  0.0, 1.0)
+        h = self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip), 0.0, 1.0)
+        return np.where(zeta <= self.share + 1e-12, h, 0.0)
 
     @staticmethod
     def active_height(pair: GearPair) -> float:
@@ -218,9 +236,10 @@ class ToothBreakage(ToothFault):
     def face_bands(self, pair: GearPair) -> tuple:
         if self.is_healthy:
             return ()
-        edges = np.linspace(0.0, 1.0, self.n_bands + 1)
+        # the broken face share, resolved into n_bands bands
+        edges = np.linspace(0.0, self.share, self.n_bands + 1)
         # band height: the exact mean of the lost height over the band
-        fine = np.linspace(0.0, 1.0, 32 * self.n_bands + 1)
+        fine = np.linspace(0.0, self.share, 32 * self.n_bands + 1)
         h = self.lost_height(pair, 0.5 * (fine[1:] + fine[:-1])).reshape(self.n_bands, 32)
         out = []
         for z0, z1, hb in zip(edges[:-1], edges[1:], h.mean(axis=1)):
@@ -335,6 +354,12 @@ FAULT_TYPES = {
     "breakage": lambda size, **kw: ToothBreakage(size=size, **kw),
     "destruction": lambda size, **kw: ToothDestruction(size=size, **kw),
 }
+
+
+#: name -> version of the type's model; bump it when a type's geometry or physics changes,
+#: so that databases built with the older model are refused (``load_database``) instead of
+#: silently mixed with new SAs. breakage 2: the growth path over the face share (session 5).
+FAULT_MODEL_VERSIONS = {"ftff": 1, "partial_face": 1, "breakage": 2, "destruction": 1}
 
 
 def check_fault_type(name) -> str:

@@ -274,10 +274,19 @@ def helical_tables(pair: GearPair, fault: ToothFault | None = None):
         bands = tuple((z0 * eb, z1 * eb, kb - healthy, kb * d)
                       for z0, z1, kb, d in _band_tables(pair, fault))
         k = k.copy()
-        for lo, hi, dk, _ in bands:
-            k += box(dk, ea, eb, lo, hi, tau)
+        if bands:
+            lo, hi, dk, _ = band_arrays(bands)
+            for part in box(dk, ea, eb, lo, hi, tau):   # all bands at once, added in order
+                k += part
         k = np.maximum(k, 0.0)
     return span, k, bands
+
+
+def band_arrays(bands):
+    """``helical_tables``'s bands as arrays: lo (n_bands,), hi (n_bands,), dk and kd
+    (n_bands, n_table)."""
+    lo, hi, dk, kd = zip(*bands, strict=True)
+    return np.array(lo), np.array(hi), np.stack(dk), np.stack(kd)
 
 
 @functools.lru_cache(maxsize=32)
