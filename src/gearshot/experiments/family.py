@@ -38,12 +38,18 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_int
 
-__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "FamilyRig", "family_paths",
-           "draw_family", "rig_family_experiment", "family_tables", "path_kind"]
+__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SA_PIPELINE_VERSION", "FamilyRig",
+           "family_paths", "draw_family", "rig_family_experiment", "family_tables", "path_kind"]
 
 PAPER_CONDITIONS = ((15.0, 10.0), (15.0, 5.0), (30.0, 5.0), (30.0, 10.0))
 DEV_SEEDS = range(100, 124)
 HELDOUT_SEEDS = range(9000, 9024)
+
+#: Version of the recording → SA pipeline (angular resampling, SA). Part of every rig
+#: cache's key and of the results' configuration key, so that SAs and rows made by an
+#: older pipeline are neither reused nor counted as done. Bump it when the SAs change.
+#: 2: anti-aliased angular resampling (issue #11); 1 (implicit): before it.
+SA_PIPELINE_VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -370,7 +376,8 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
     n_draws = check_int(n_draws, "n_draws", minimum=1)
     campaign = dict(duration=None if duration is None else float(duration),
                     segments=check_int(segments, "segments", minimum=1), healthy=int(healthy),
-                    sizes=[float(y) for y in sizes], repetitions=int(repetitions))
+                    sizes=[float(y) for y in sizes], repetitions=int(repetitions),
+                    sa_pipeline=SA_PIPELINE_VERSION)
     config = _hash(dict(params=params, campaign=campaign, store=str(store)))
     paths = family_paths(frf_folder, n_synthetic=n_synthetic, seed=bank_seed)
     rigs = draw_family(seeds, paths, conditions=conditions)
