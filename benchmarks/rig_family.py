@@ -53,6 +53,9 @@ def main(argv=None):
     parser.add_argument("--data", default=None, help="default $GEARSHOT_DATA")
     parser.add_argument("--tag", default=None, help="results file name (default the range)")
     parser.add_argument("--param", action="append", default=[])
+    parser.add_argument("--paired", action="store_true", help="use the paired database "
+                        "(healthy twins stored; needed by simulated_reference=twin; its "
+                        "SAs equal the plain database's)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--rigs-table", action="store_true", help="print the per-rig table")
     args = parser.parse_args(argv)
@@ -72,10 +75,12 @@ def main(argv=None):
             params[name] = json.loads(value)
         except json.JSONDecodeError:
             params[name] = value
-    store = data / "family" / "db-4conditions-h50-f350-s0"
+    store = data / "family" / ("db-4conditions-h50-f350-s0" + ("-paired" if args.paired
+                                                               else ""))
     t0 = time.perf_counter()
     build_database(store, GearPair.paper(), speeds=[15, 30], loads=[5, 10],
-                   grades=range(1, 13), n_healthy=50, n_faulty=350, seed=0, client=False)
+                   grades=range(1, 13), n_healthy=50, n_faulty=350, seed=0, client=False,
+                   paired=args.paired)
     client = None
     if args.workers > 1:
         from dask.distributed import Client, LocalCluster

@@ -191,6 +191,9 @@ def simulate(
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
+    paired: bool = typer.Option(False, "--paired", help="Also store each signal's healthy "
+                                "twin (same profile errors, no fault), for the estimator's "
+                                "simulated_reference='twin'."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from .._paths import data_home
@@ -199,6 +202,8 @@ def simulate(
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
     if machine is not None:
+        if paired:
+            raise GearshotError("--paired is not available with --machine")
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
                           scheduler, workers, fault_type)
@@ -212,7 +217,7 @@ def simulate(
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
-                       fault_types=fault_type)
+                       fault_types=fault_type, paired=paired)
     finally:
         if client is not None:
             client.close()

@@ -53,7 +53,7 @@ ComplexArray = NDArray[np.complex128]
 
 #: The steps that draw random numbers, each from its own child seed of ``random_state``
 #: (in this order of :meth:`numpy.random.SeedSequence.spawn`).
-STEP_SEEDS = ("select_features", "fit_knn")
+STEP_SEEDS = ("select_features", "fit_knn", "match_noise")
 
 #: Fault types a database may hold (:data:`gearshot.sim.FAULT_TYPES`; named here so that the
 #: estimator does not import the simulator).
@@ -116,6 +116,28 @@ def _database_by_grade(database: Any,
     return out
 
 
+def _database_twins(database: Any, by_grade: Mapping[int, tuple[FloatArray, FloatArray]]
+                    ) -> dict[int, FloatArray]:
+    """The healthy twins ``sa_twin`` of a paired database, split by grade like the SAs."""
+    try:
+        twins = np.asarray(database["sa_twin"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        raise GearshotError("simulated_reference='twin' needs a paired database (with "
+                            "'sa_twin': gearshot.sim.build_database(..., paired=True) or "
+                            "`gearshot simulate --paired`); this one has none") from None
+    grades = np.asarray(database["grade"]).astype(int)
+    if grades.ndim == 0:
+        grades = np.full(twins.shape[0], int(grades))
+    out = {}
+    for g, (sa, _) in by_grade.items():
+        tw = twins[grades == g]
+        if tw.shape != sa.shape:
+            raise GearshotError(f"database['sa_twin'] of grade {g} has shape {tw.shape}; "
+                                f"the SAs have {sa.shape}")
+        out[g] = tw
+    return out
+
+
 def _step_seeds(random_state: Any) -> dict[str, int]:
     """One independent seed per random step, derived from ``random_state``.
 
@@ -168,6 +190,7 @@ class _TargetSide:
     references: FloatArray
     healthy_mean: FloatArray
     healthy_features: FloatArray
+    residue_power: FloatArray
 
 
 @dataclass(frozen=True)
@@ -260,6 +283,17 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     fault_type : str, optional
         Fault type whose database slice trains the model (``fault_type`` coordinate of
         :func:`gearshot.sim.load_database`); ``None``: the database's only type.
+    simulated_reference : {"first_healthy", "twin"}, default "first_healthy"
+        What step 6 subtracts on the simulated side of the grade models.
+        "first_healthy" (the paper): the first healthy simulated SA, a *different* gear
+        from every other signal's (profile errors are drawn per signal), so every
+        simulated difference carries the profile-error difference of two gears, a floor
+        the target (one gear against itself) does not have. "twin": each signal's own
+        healthy twin (same profile errors, no fault; needs a paired database,
+        ``build_database(..., paired=True)``), so the simulated difference is the fault
+        signature alone; the target's non-synchronous residue is then matched by adding
+        Gaussian noise with the power spectrum of the target's healthy difference signals
+        (noise matching, seeded by the ``match_noise`` step seed). Step 1 is unchanged.
 
     Attributes
     ----------
@@ -285,6 +319,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     target_scale_ : float
     references_ : ndarray
     target_healthy_mean_, target_healthy_features_ : ndarray
+    target_residue_power_ : ndarray (n_points // 2 + 1,)
+        Power spectrum of the target's healthy difference signals (step 6 output): what
+        ``simulated_reference="twin"`` adds to the simulated differences as noise.
     n_neighbors_ : int
     n_points_ : int
     faulty_size_ : float or None
@@ -311,6 +348,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "model_discrepancy": [Interval(float, 0, None)],
         "random_state": [RandomStateValue()],
         "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
+        "simulated_reference": [Options(("first_healthy", "twin"))],
     }
 
     def __init__(self, *, features: Sequence[str] | None = None,
@@ -322,8 +360,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  mesh_order: int = 38, zero_shot: bool = False, upsample: int = 100,
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
                  model_discrepancy: float = 0.08, random_state: Any = None,
-                 fault_type: str | None = None) -> None:
+                 fault_type: str | None = None,
+                 simulated_reference: str = "first_healthy") -> None:
         self.fault_type = fault_type
+        self.simulated_reference = simulated_reference
         self.features = features
         self.selection_threshold = selection_threshold
         self.grades = grades
@@ -379,8 +419,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         validate_params(self.get_params(deep=False), self._parameter_constraints)
         inputs = self._check_fit_inputs(target_healthy, faulty_example, faulty_size,
                                         healthy_long, selection_tf)
-        by_grade = _database_by_grade(_select_fault_type(database, self.fault_type),
-                                      inputs.n_points)
+        database = _select_fault_type(database, self.fault_type)
+        by_grade = _database_by_grade(database, inputs.n_points)
+        twins = (_database_twins(database, by_grade)
+                 if self.simulated_reference == "twin" else None)
         grades = self._grades_in(by_grade)
         nominal = self._nominal_grade_in(by_grade)
         seeds = _step_seeds(self.random_state)
@@ -392,7 +434,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                                           seeds["select_features"])
         cols = [names.index(n) for n in selection.selected]
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
-                                seeds["fit_knn"])
+                                seeds["fit_knn"], twins, seeds["match_noise"])
         strategy = self._grade_strategy(grades)
         choose = {"tuned": self._grade_tuned, "soft": self._grade_soft,
                   "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot}[strategy]
@@ -405,6 +447,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             target_scale_=target.scale, references_=target.references,
             candidate_features_=names, target_healthy_mean_=target.healthy_mean,
             target_healthy_features_=target.healthy_features,
+            target_residue_power_=target.residue_power,
             selected_features_=selection.selected, feature_errors_=selection.errors,
             selection_features_=selection.features, selected_columns_=cols,
             grade_strategy_=strategy, grade_=choice.grade, grade_weights_=choice.weights,
@@ -489,7 +532,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         feats_h, mean_h = steps.centred_features(sub_h, mesh_order=self.mesh_order,
                                                  names=names,
                                                  healthy_mask=np.ones(len(sub_h), bool))
-        return _TargetSide(tf, scale, scaled, references, mean_h, feats_h)
+        return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
+                           steps.residue_power(sub_h))
 
     def _target_tf(self, healthy_long: FloatArray | None,
                    n_points: int) -> ComplexArray | None:
@@ -518,14 +562,16 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     def _fit_context(self, by_grade: Mapping[int, tuple[FloatArray, FloatArray]],
                      grades: list[int], nominal: int | None, target: _TargetSide,
                      inputs: _FitInputs, names: tuple[str, ...], cols: list[int],
-                     seed: int) -> _FitContext:
+                     seed: int, twins: Mapping[int, FloatArray] | None = None,
+                     noise_seed: int = 0) -> _FitContext:
         """Bundle what the strategies need; grade models are fitted on first use and kept."""
         models: dict[int, KnnModel] = {}
 
         def model_for(grade: int) -> KnnModel:
             if grade not in models:
-                models[grade] = self._fit_grade_model(by_grade[grade], target, names, cols,
-                                                      seed)
+                models[grade] = self._fit_grade_model(
+                    by_grade[grade], target, names, cols, seed,
+                    None if twins is None else twins[grade], noise_seed)
             return models[grade]
 
         def example_features() -> FloatArray:
@@ -537,12 +583,18 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                            model_for)
 
     def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
-                         names: tuple[str, ...], cols: list[int], seed: int) -> KnnModel:
-        """Steps 4–8 for one grade: its simulated features with the target healthy, KNN."""
+                         names: tuple[str, ...], cols: list[int], seed: int,
+                         twins: FloatArray | None = None, noise_seed: int = 0) -> KnnModel:
+        """Steps 4–8 for one grade: its simulated features with the target healthy, KNN.
+
+        With twins (``simulated_reference="twin"``), step 6 subtracts each signal's twin
+        and the target's residue spectrum is added as noise."""
         sa, y = grade_data
-        X_sim = steps.simulated_features(sa, y == 0, target.transfer_function,
-                                         mesh_order=self.mesh_order, names=names,
-                                         rms_normalization=self.rms_normalization)
+        X_sim = steps.simulated_features(
+            sa, y == 0, target.transfer_function, mesh_order=self.mesh_order, names=names,
+            rms_normalization=self.rms_normalization, twins=twins,
+            noise_power=None if twins is None else target.residue_power,
+            random_state=noise_seed)
         X = np.vstack([X_sim[:, cols], target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
         return steps.fit_knn(X, labels, n_neighbors=self.n_neighbors,

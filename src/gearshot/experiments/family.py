@@ -378,8 +378,10 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
                     segments=check_int(segments, "segments", minimum=1), healthy=int(healthy),
                     sizes=[float(y) for y in sizes], repetitions=int(repetitions),
                     sa_pipeline=SA_PIPELINE_VERSION)
-    config = _hash(dict(params=params, campaign=campaign, store=str(store)))
     paths = family_paths(frf_folder, n_synthetic=n_synthetic, seed=bank_seed)
+    # the path bank is part of the key: another bank is another family
+    config = _hash(dict(params=params, campaign=campaign, store=str(store),
+                        bank=[p.name for p in paths]))
     rigs = draw_family(seeds, paths, conditions=conditions)
     cache_dir = Path(cache_dir) if cache_dir else results.with_name(results.name + ".rigs")
     done = _done_rows(results, config)
