@@ -377,6 +377,10 @@ def experiment_rig(
     out: Path | None = typer.Option(None, "--out"),
     scheduler: str | None = typer.Option(None, "--scheduler"),
     workers: int = typer.Option(2, "--workers"),
+    param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
+                                    "for every variant (VALUE as JSON when it parses)."),
+    paired: bool = typer.Option(False, "--paired", help="Build and use the database with "
+                                "healthy twins (needed by simulated_reference=twin)."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
     if frf_folder is not None and not frf_folder.is_dir():
@@ -391,16 +395,19 @@ def experiment_rig(
     _early(store, "--store", folder=True)
     _early(campaign, "--campaign", folder=True)
     from ..experiments import RIG_VARIANTS, rig_experiment, summarize
+    from ..experiments.family import parse_params
     from ..sim import GearPair, build_database, default_database_path, load_database
     from ..transfer import TransferFunctionBank
 
+    params = parse_params(param)
     store = store or default_database_path(
-        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
+        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}"
+        + ("-paired" if paired else ""))
     client = _client(scheduler, workers, needed=True)
     try:
         build_database(store, GearPair.paper(), speeds=[speed], loads=[load],
                        grades=range(1, 13), n_healthy=n_healthy, n_faulty=n_faulty,
-                       seed=seed, client=client)
+                       seed=seed, client=client, paired=paired)
     finally:
         if client is not None:
             client.close()
@@ -425,7 +432,8 @@ def experiment_rig(
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
                                           n_repeats=repeats, seed=seed,
-                                          keep_estimators="first" if out else False)
+                                          keep_estimators="first" if out else False,
+                                          params=params)
     estimator = None
     if "estimator" in results:
         estimator = results.loc[results["variant"] == "full", "estimator"].dropna().iloc[0]
@@ -433,7 +441,7 @@ def experiment_rig(
     table = summarize(results)
     typer.echo(table.to_string(index=False))
     by_variant = dict(zip(table["variant"], table["mae_percent"]))
-    payload = {"experiment": "rig", "speed": speed, "load": load,
+    payload = {"experiment": "rig", "speed": speed, "load": load, "params": params,
                "mae": by_variant.get("full"), "ablations": by_variant,
                "rows": results.to_dict(orient="records")}
     _write_json(json_out, payload)
