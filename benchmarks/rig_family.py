@@ -9,7 +9,9 @@ and once, at the end, the held-out range (``--range heldout``). Rigs are drawn b
 :func:`gearshot.experiments.family.draw_family` (grade 1–12, the 12 real FRFs + 4 + 4
 synthetic paths, the paper's four conditions, drawn attenuation 10–30 dB); each rig records
 6 healthy + 3 sizes × ``--repetitions`` (2) recordings long enough for ``--segments`` (4)
-50-cycle SAs (30.5 s at 15 rps, 15.3 s at 30 rps), cached as SA segments; ``--draws``
+50-cycle SAs (30.5 s at 15 rps, 15.3 s at 30 rps), cached as SA segments (one folder for
+every range and tag, ``DIR/family/rigs``; the key covers the rig, the campaign and the SA
+pipeline's version); ``--draws``
 example draws per rig. One 12-grade database (50 healthy + 350
 faulty per grade and condition) serves every rig. Results are appended to
 ``DIR/family/<range>.jsonl``; a re-run skips what is there. ``--workers N`` (N > 1) runs
@@ -53,6 +55,8 @@ def main(argv=None):
     parser.add_argument("--paired", action="store_true", help="use the paired database "
                         "(healthy twins stored; needed by simulated_reference=twin; its "
                         "SAs equal the plain database's)")
+    parser.add_argument("--rigs-cache", default=None, help="folder of the rigs' cached SA "
+                        "segments, shared by every range and tag (default DATA/family/rigs)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--rigs-table", action="store_true", help="print the per-rig table")
     args = parser.parse_args(argv)
@@ -80,8 +84,9 @@ def main(argv=None):
         frame = family.rig_family_experiment(
             store, seeds, results=data / "family" / f"{tag}.jsonl", frf_folder=frf,
             n_draws=args.draws, variants=args.variants, duration=args.duration,
-            segments=args.segments,
-            repetitions=args.repetitions, params=params, client=client)
+            segments=args.segments, repetitions=args.repetitions, params=params,
+            cache_dir=Path(args.rigs_cache) if args.rigs_cache else data / "family" / "rigs",
+            client=client)
     finally:
         if client is not None:
             client.close()

@@ -475,6 +475,9 @@ def experiment_rig_family(
     results: Path | None = typer.Option(None, "--results", help="JSON-lines results file "
                                            "(appended, resumable; default "
                                            "DATA_HOME/family/RANGE.jsonl)."),
+    rigs_cache: Path | None = typer.Option(None, "--rigs-cache", help="Folder of the rigs' "
+                                              "cached SA segments (default "
+                                              "DATA_HOME/family/rigs, shared by all runs)."),
     json_out: Path | None = typer.Option(None, "--json", help="Write the summary tables "
                                             "as JSON."),
     rigs_table: bool = typer.Option(False, "--rigs-table", help="Print the per-rig table."),
@@ -510,6 +513,7 @@ def experiment_rig_family(
     home = data_home()
     results = results or home / "family" / f"{'seeds' if seeds else seed_range}.jsonl"
     _early(results, "--results")
+    _early(rigs_cache, "--rigs-cache", folder=True)
     _early(json_out, "--json")
     store = family.family_database(home / "family", paired=paired)
     client = _client(scheduler, workers, needed=len(pool) > 1)
@@ -517,7 +521,7 @@ def experiment_rig_family(
         frame = family.rig_family_experiment(
             store, pool, results=results, frf_folder=frf_folder, n_draws=draws,
             variants=variants, segments=segments, repetitions=repetitions, params=params,
-            client=client)
+            cache_dir=rigs_cache or home / "family" / "rigs", client=client)
     finally:
         if client is not None:
             client.close()
