@@ -247,7 +247,7 @@ def _diagnostic_params(name, rig, paths):
     raise GearshotError(f"unknown diagnostic variant {name!r}")
 
 
-DISCREPANCIES = (0.0, 0.04, 0.06, 0.08, 0.10, 0.12, 0.16, 0.20, 0.24)
+DISCREPANCIES = (0.0, 0.04, 0.06, 0.08, 0.10, 0.12, 0.14, 0.16, 0.20, 0.24)
 
 
 def _interval_sweep(est, test_sa, test_size, coverage=0.9):
