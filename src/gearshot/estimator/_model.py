@@ -44,7 +44,7 @@ from ._params import (
 )
 from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval
-from .zero_shot import healthy_signature, match_grade, signature_weights
+from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
 
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS"]
 
@@ -191,6 +191,7 @@ class _TargetSide:
     healthy_mean: FloatArray
     healthy_features: FloatArray
     residue_power: FloatArray
+    residue_ms: float
 
 
 @dataclass(frozen=True)
@@ -294,6 +295,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         signature alone; the target's non-synchronous residue is then matched by adding
         Gaussian noise with the power spectrum of the target's healthy difference signals
         (noise matching, seeded by the ``match_noise`` step seed). Step 1 is unchanged.
+    zero_shot_signature : {"raw", "denoised"}, default "raw"
+        The target's healthy signature of the zero-shot grade match: as measured, or with
+        the target's non-synchronous residue (half the mean square of its healthy
+        difference signals off the mesh harmonics) taken off the off-harmonic power
+        first (:func:`~gearshot.estimator.zero_shot.healthy_signature`); simulated SAs
+        have no residue, so the raw target signature points at rougher grades.
 
     Attributes
     ----------
@@ -349,6 +356,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "random_state": [RandomStateValue()],
         "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
         "simulated_reference": [Options(("first_healthy", "twin"))],
+        "zero_shot_signature": [Options(("raw", "denoised"))],
     }
 
     def __init__(self, *, features: Sequence[str] | None = None,
@@ -361,8 +369,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
                  model_discrepancy: float = 0.08, random_state: Any = None,
                  fault_type: str | None = None,
-                 simulated_reference: str = "first_healthy") -> None:
+                 simulated_reference: str = "first_healthy",
+                 zero_shot_signature: str = "raw") -> None:
         self.fault_type = fault_type
+        self.zero_shot_signature = zero_shot_signature
         self.simulated_reference = simulated_reference
         self.features = features
         self.selection_threshold = selection_threshold
@@ -533,7 +543,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                                                  names=names,
                                                  healthy_mask=np.ones(len(sub_h), bool))
         return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
-                           steps.residue_power(sub_h))
+                           steps.residue_power(sub_h),
+                           residue_mean_square(sub_h, self.mesh_order))
 
     def _target_tf(self, healthy_long: FloatArray | None,
                    n_points: int) -> ComplexArray | None:
@@ -635,7 +646,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
 
     def _grade_zero_shot(self, ctx: _FitContext) -> _GradeChoice:
         """No example: match healthy-signal statistics of target and simulation."""
-        target_sig = healthy_signature(ctx.target.scaled_healthy, self.mesh_order)
+        residue = ctx.target.residue_ms if self.zero_shot_signature == "denoised" else 0.0
+        target_sig = healthy_signature(ctx.target.scaled_healthy, self.mesh_order,
+                                       residue_ms=residue)
         sims = {g: healthy_signature(
             steps.propagate_simulated(sa[y == 0], ctx.target.transfer_function),
             self.mesh_order) for g, (sa, y) in ctx.by_grade.items() if g in ctx.grades}
