@@ -434,3 +434,21 @@ def test_twin_reference_needs_a_paired_database(data, tf_pair):
     with pytest.raises(GearshotError, match="simulated_reference must be one of .*'twins'"):
         OneFaultShotEstimator(simulated_reference="twins").fit(
             db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
+
+
+def test_denoised_signature_takes_the_residue_off():
+    from gearshot.estimator.zero_shot import healthy_signature, residue_mean_square
+
+    rng = np.random.default_rng(6)
+    theta = np.arange(N) / N
+    gear = np.cos(2 * np.pi * 38 * theta) + 0.2 * np.cos(2 * np.pi * 7 * theta)
+    noisy = gear + 0.3 * rng.normal(size=(40, N))
+    # healthy differences hold two residues: half their mean square is one SA's residue
+    res = residue_mean_square(noisy[:20] - noisy[20:], 38)
+    clean = healthy_signature(gear[None], 38)[0]
+    raw = healthy_signature(noisy, 38)
+    fixed = healthy_signature(noisy, 38, residue_ms=res)
+    assert np.median(raw) > clean + 0.5            # the residue dominates the raw signature
+    assert abs(np.median(fixed) - clean) < 0.15    # and is taken off
+    # never below 1 % of the measured power (no log of <= 0)
+    assert np.all(np.isfinite(healthy_signature(noisy, 38, residue_ms=1e9)))
