@@ -382,9 +382,11 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
                     sizes=[float(y) for y in sizes], repetitions=int(repetitions),
                     sa_pipeline=SA_PIPELINE_VERSION)
     paths = family_paths(frf_folder, n_synthetic=n_synthetic, seed=bank_seed)
-    # the path bank is part of the key: another bank is another family
-    config = _hash(dict(params=params, campaign=campaign, store=str(store),
-                        bank=[p.name for p in paths]))
+    # the key holds every estimator parameter in effect (explicit ones and the library's
+    # defaults, so that a changed default is a new configuration) and the path bank
+    # (another bank is another family)
+    config = _hash(dict(params=_effective_params(params), campaign=campaign,
+                        store=str(store), bank=[p.name for p in paths]))
     rigs = draw_family(seeds, paths, conditions=conditions)
     cache_dir = Path(cache_dir) if cache_dir else results.with_name(results.name + ".rigs")
     done = _done_rows(results, config)
@@ -410,6 +412,15 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
     keep = (frame["config"] == config) & frame["seed"].isin(wanted) \
         & frame["variant"].isin(list(variants)) & (frame["draw"] < n_draws)
     return frame[keep].reset_index(drop=True)
+
+
+def _effective_params(params: dict) -> dict:
+    """Every estimator parameter in effect with ``params`` (defaults filled in)."""
+    from ..estimator import OneFaultShotEstimator
+
+    full = OneFaultShotEstimator(**params).get_params(deep=False)
+    full.pop("random_state", None)   # set per (rig, draw) by the experiment
+    return {k: (list(v) if isinstance(v, range) else v) for k, v in full.items()}
 
 
 def _run(specs, results: Path, client, progress, total):
