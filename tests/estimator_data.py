@@ -42,6 +42,24 @@ def synthetic_database(grades=(3, 6, 9), n_healthy=20, n_faulty=80, seed=0):
                               "grade": ("signal", np.concatenate(gs))})
 
 
+def paired_synthetic_database(grades=(3, 6, 9), n_healthy=20, n_faulty=80, seed=0):
+    """``synthetic_database``'s layout with ``sa_twin``: each signal's own gear, healthy
+    (the profile content drawn from the signal's own seed, as the simulator's database)."""
+    rng = np.random.default_rng(seed)
+    sas, twins, ys, gs = [], [], [], []
+    for g in grades:
+        y = np.r_[np.zeros(n_healthy), rng.uniform(0, 1, n_faulty)]
+        seeds = rng.integers(0, 2**31, y.size)
+        sas += [synthetic_sa([yi], g, np.random.default_rng(s))[0] for yi, s in zip(y, seeds)]
+        twins += [synthetic_sa([0.0], g, np.random.default_rng(s))[0] for s in seeds]
+        ys.append(y)
+        gs.append(np.full(y.size, g))
+    return xr.Dataset({"sa": (("signal", "angle"), np.vstack(sas)),
+                       "sa_twin": (("signal", "angle"), np.vstack(twins))},
+                      coords={"fault_size": ("signal", np.concatenate(ys)),
+                              "grade": ("signal", np.concatenate(gs))})
+
+
 def synthetic_target(grade, tf, *, sizes=(0.32, 0.56, 0.66), n_healthy=30, n_each=15,
                      noise=0.5, seed=1):
     """Target-domain data through ``tf``: healthy SAs, long healthy, example, test set."""

@@ -6,7 +6,7 @@ import sys
 import pytest
 
 SUBCOMMANDS = [[], ["demo"], ["simulate"], ["rig"], ["experiment"], ["experiment", "simulated"],
-               ["experiment", "rig"], ["predict"], ["report"]]
+               ["experiment", "rig"], ["experiment", "rig-family"], ["predict"], ["report"]]
 
 
 def run(*args, env=None):
@@ -40,6 +40,16 @@ def test_version():
          ["speed", "-3"]),
         (["simulate", "--fault-type", "rust", "--grade", "7", "--store", "/tmp/gs-never"],
          ["fault_type", "rust"]),
+        (["experiment", "rig-family", "--range", "test"], ["--range", "'test'"]),
+        (["experiment", "rig-family", "--variant", "magic"], ["--variant", "'magic'"]),
+        (["experiment", "rig-family", "--draws", "0"], ["--draws", "0"]),
+        (["experiment", "rig-family", "--n-rigs", "25"], ["--n-rigs", "25"]),
+        (["experiment", "rig-family", "--param", "tf_exponent=0.5"], ["--param",
+                                                                      "'tf_exponent'"]),
+        (["experiment", "rig-family", "--param", "model_discrepancy=-1"],
+         ["--param", "model_discrepancy", "-1"]),
+        (["experiment", "rig-family", "--param", "simulated_reference"],
+         ["--param", "NAME=VALUE"]),
     ],
 )
 def test_user_errors_are_one_line_without_traceback(args, words, tmp_path):

@@ -400,3 +400,80 @@ def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):
     assert_allclose(best.predict(faulty), best.model_.predict(X))
     with pytest.raises(GearshotError, match="grade_weighting"):
         OneFaultShotEstimator(grade_weighting="mean").fit(*args, selection_tf=tf_pair[1])
+
+
+# ------------------------------------------------------------------------- paired simulation
+def test_simulated_suppression_subtracts_each_twin():
+    rng = np.random.default_rng(3)
+    sa, twins = rng.normal(size=(2, 4, 64))
+    assert_allclose(steps.suppress_harmonics_simulated(sa, np.ones(4, bool), twins),
+                    sa - twins)
+    with pytest.raises(GearshotError, match=r"twins must have the shape.*\(3, 64\)"):
+        steps.suppress_harmonics_simulated(sa, np.ones(4, bool), twins[:3])
+
+
+def test_residue_noise_has_the_measured_power_spectrum():
+    rng = np.random.default_rng(4)
+    shaped = np.fft.irfft(np.fft.rfft(rng.normal(size=(400, 256)), axis=-1)
+                          * np.linspace(0.1, 2.0, 129), n=256, axis=-1)
+    power = steps.residue_power(shaped)
+    noise = steps.residue_noise(power, 400, 256, np.random.default_rng(5))
+    got = steps.residue_power(noise)
+    # bins averaged in blocks of 8: each block's mean power within 10 %
+    assert_allclose(got[1:121].reshape(15, 8).mean(1), power[1:121].reshape(15, 8).mean(1),
+                    rtol=0.1)
+    with pytest.raises(GearshotError, match="129 bins; got shape"):
+        steps.residue_noise(power[:-1], 3, 256, np.random.default_rng(0))
+
+
+@pytest.fixture(scope="module")
+def paired_db():
+    return estimator_data.paired_synthetic_database()
+
+
+def test_twin_reference_fits_and_is_seeded(paired_db, data, tf_pair):
+    _, healthy, long, faulty, y = data
+    kw = dict(simulated_reference="twin", random_state=0, nominal_grade=NOMINAL)
+    args = (paired_db, healthy, faulty[20], y[20], long)
+    a = OneFaultShotEstimator(**kw).fit(*args, selection_tf=tf_pair[1])
+    b = OneFaultShotEstimator(**kw).fit(*args, selection_tf=tf_pair[1])
+    assert a.target_residue_power_.shape == (N // 2 + 1,)
+    assert set(a.step_seeds_) == {"select_features", "fit_knn", "match_noise"}
+    assert_array_equal(a.predict(faulty), b.predict(faulty))
+    pred = a.predict(faulty)
+    means = [pred[y == s].mean() for s in (0.32, 0.56, 0.66)]
+    assert means[0] < means[2]
+    # the paper's reference on the same database ignores the twins
+    paper = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
+        *args, selection_tf=tf_pair[1])
+    plain = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
+        paired_db.drop_vars("sa_twin"), *args[1:], selection_tf=tf_pair[1])
+    assert_array_equal(paper.predict(faulty), plain.predict(faulty))
+
+
+def test_twin_reference_needs_a_paired_database(data, tf_pair):
+    db, healthy, long, faulty, y = data
+    est = OneFaultShotEstimator(simulated_reference="twin", nominal_grade=NOMINAL)
+    with pytest.raises(GearshotError, match="simulated_reference='twin' needs a paired"):
+        est.fit(db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
+    with pytest.raises(GearshotError, match="simulated_reference must be one of .*'twins'"):
+        OneFaultShotEstimator(simulated_reference="twins").fit(
+            db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
+
+
+def test_denoised_signature_takes_the_residue_off():
+    from gearshot.estimator.zero_shot import healthy_signature, residue_mean_square
+
+    rng = np.random.default_rng(6)
+    theta = np.arange(N) / N
+    gear = np.cos(2 * np.pi * 38 * theta) + 0.2 * np.cos(2 * np.pi * 7 * theta)
+    noisy = gear + 0.3 * rng.normal(size=(40, N))
+    # healthy differences hold two residues: half their mean square is one SA's residue
+    res = residue_mean_square(noisy[:20] - noisy[20:], 38)
+    clean = healthy_signature(gear[None], 38)[0]
+    raw = healthy_signature(noisy, 38)
+    fixed = healthy_signature(noisy, 38, residue_ms=res)
+    assert np.median(raw) > clean + 0.5            # the residue dominates the raw signature
+    assert abs(np.median(fixed) - clean) < 0.15    # and is taken off
+    # never below 1 % of the measured power (no log of <= 0)
+    assert np.all(np.isfinite(healthy_signature(noisy, 38, residue_ms=1e9)))

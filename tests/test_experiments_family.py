@@ -102,3 +102,62 @@ def test_results_resume_and_tables(tmp_path, monkeypatch, paths):
     assert_allclose(tables["condition"].loc["rms_only", "mean"], 20.0)
     assert_allclose(tables["coverage"].loc["full", "pooled"], 90.0)
     assert json.loads(out.read_text().splitlines()[0])["variant"] == "full"
+
+
+def _fake_task(spec):
+    return [dict(config=spec["config"], **spec["rig"], draw=d, variant=v,
+                 mae=0.1 if v == "full" else 0.3, coverage=0.9, n_test=10, seconds=1.0,
+                 record_seconds=2.0)
+            for d in spec["draws"] for v in spec["variants"] if (d, v) not in spec["done"]]
+
+
+def test_cli_rig_family_runs_resumes_and_writes_tables(tmp_path, monkeypatch, paths):
+    from typer.testing import CliRunner
+
+    from gearshot.app.cli import app
+
+    calls = []
+
+    def task(spec):
+        calls.append(spec["rig"]["seed"])
+        return _fake_task(spec)
+
+    stores = []
+    monkeypatch.setenv("GEARSHOT_DATA", str(tmp_path))
+    monkeypatch.setattr(family, "family_paths", lambda *a, **k: paths)
+    monkeypatch.setattr(family, "_family_task", task)
+    monkeypatch.setattr(family, "family_database",
+                        lambda folder, paired=False, **k: stores.append(paired) or tmp_path)
+    out = tmp_path / "summary.json"
+    args = ["experiment", "rig-family", "--n-rigs", "3", "--draws", "2", "--variant", "full",
+            "--variant", "rms_only", "--paired", "--param", "model_discrepancy=0.16",
+            "--json", str(out)]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 0, res.output
+    assert calls == [100, 101, 102] and stores == [True]
+    assert (tmp_path / "family" / "dev.jsonl").is_file()
+    summary = json.loads(out.read_text())
+    assert summary["seeds"] == [100, 101, 102] and summary["params"] == {
+        "model_discrepancy": 0.16}
+    cond = summary["tables"]["condition"]
+    mean = cond["data"][cond["index"].index("full")][cond["columns"].index("mean")]
+    assert mean == pytest.approx(10.0)
+    assert "MAE % by condition" in res.output
+    res = CliRunner().invoke(app, args)   # resumed: nothing recomputed
+    assert res.exit_code == 0, res.output
+    assert calls == [100, 101, 102]
+    # another parameter value is another configuration
+    res = CliRunner().invoke(app, args[:-4] + ["--param", "model_discrepancy=0.1"])
+    assert res.exit_code == 0, res.output
+    assert calls == [100, 101, 102] * 2
+
+
+def test_parse_params_names_the_option_and_value():
+    assert family.parse_params(["model_discrepancy=0.16", "grade_weighting=best"]) == {
+        "model_discrepancy": 0.16, "grade_weighting": "best"}
+    with pytest.raises(GearshotError, match="'nope'"):
+        family.parse_params(["nope=1"])
+    with pytest.raises(GearshotError, match=r"--param.*NAME=VALUE.*'x'"):
+        family.parse_params(["x"])
+    with pytest.raises(GearshotError, match=r"--param: simulated_reference.*'other'"):
+        family.parse_params(["simulated_reference=other"])

@@ -135,3 +135,36 @@ def test_signal_reproducible_from_its_seed(tmp_path):
     sa = simulate_sa(GearPair.paper(), speed=15, load=10, grade=7,
                      fault_sizes=[float(ds.fault_size[i])], rng=[int(ds.seed[i])])
     np.testing.assert_allclose(sa[0], ds.sa.values[i], rtol=0, atol=1e-9)
+
+
+PAIR_KW = dict(speeds=[15], loads=[10], grades=[9], n_healthy=2, n_faulty=3, seed=4,
+               n_points=256)
+
+
+def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
+    from gearshot.sim import GearPair, simulate_sa
+
+    build_database(tmp_path / "plain", client=False, progress=False, **PAIR_KW)
+    build_database(tmp_path / "paired", client=False, progress=False, paired=True, **PAIR_KW)
+    plain = load_database(tmp_path / "plain", speed=15, load=10)
+    paired = load_database(tmp_path / "paired", speed=15, load=10)
+    assert "sa_twin" not in plain and paired.sa_twin.shape == paired.sa.shape
+    np.testing.assert_array_equal(plain.sa.values, paired.sa.values)   # same signals
+    healthy = paired.fault_size.values == 0
+    np.testing.assert_array_equal(paired.sa_twin.values[healthy], paired.sa.values[healthy])
+    i = int(np.flatnonzero(~healthy)[0])
+    twin = simulate_sa(GearPair.paper(), speed=15, load=10, grade=9, fault_sizes=[0.0],
+                       n_points=256, rng=[int(paired.seed.values[i])])[0]
+    np.testing.assert_allclose(paired.sa_twin.values[i], twin, rtol=0, atol=1e-12)
+    # the twin shares the profile errors: faulty - twin is far smaller than faulty minus
+    # another gear's healthy SA (what the paper's first-healthy subtraction leaves)
+    other = paired.sa.values[np.flatnonzero(healthy)[0]]
+    own = np.std(paired.sa.values[~healthy] - paired.sa_twin.values[~healthy], axis=1)
+    cross = np.std(paired.sa.values[~healthy] - other, axis=1)
+    assert np.all(own < 0.5 * cross), (own, cross)
+    with pytest.raises(GearshotError, match="differs in paired"):
+        build_database(tmp_path / "plain", client=False, progress=False, paired=True,
+                       **PAIR_KW)
+    with pytest.raises(GearshotError, match="paired must be True or False; got 'yes'"):
+        build_database(tmp_path / "other", client=False, progress=False, paired="yes",
+                       **PAIR_KW)

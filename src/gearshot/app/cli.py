@@ -191,6 +191,9 @@ def simulate(
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
+    paired: bool = typer.Option(False, "--paired", help="Also store each signal's healthy "
+                                "twin (same profile errors, no fault), for the estimator's "
+                                "simulated_reference='twin'."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from .._paths import data_home
@@ -199,6 +202,8 @@ def simulate(
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
     if machine is not None:
+        if paired:
+            raise GearshotError("--paired is not available with --machine")
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
                           scheduler, workers, fault_type)
@@ -212,7 +217,7 @@ def simulate(
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
-                       fault_types=fault_type)
+                       fault_types=fault_type, paired=paired)
     finally:
         if client is not None:
             client.close()
@@ -372,6 +377,10 @@ def experiment_rig(
     out: Path | None = typer.Option(None, "--out"),
     scheduler: str | None = typer.Option(None, "--scheduler"),
     workers: int = typer.Option(2, "--workers"),
+    param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
+                                    "for every variant (VALUE as JSON when it parses)."),
+    paired: bool = typer.Option(False, "--paired", help="Build and use the database with "
+                                "healthy twins (needed by simulated_reference=twin)."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
     if frf_folder is not None and not frf_folder.is_dir():
@@ -386,16 +395,19 @@ def experiment_rig(
     _early(store, "--store", folder=True)
     _early(campaign, "--campaign", folder=True)
     from ..experiments import RIG_VARIANTS, rig_experiment, summarize
+    from ..experiments.family import parse_params
     from ..sim import GearPair, build_database, default_database_path, load_database
     from ..transfer import TransferFunctionBank
 
+    params = parse_params(param)
     store = store or default_database_path(
-        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}")
+        f"sim-db-{speed:g}rps-{load:g}Nm-h{n_healthy}-f{n_faulty}-s{seed}"
+        + ("-paired" if paired else ""))
     client = _client(scheduler, workers, needed=True)
     try:
         build_database(store, GearPair.paper(), speeds=[speed], loads=[load],
                        grades=range(1, 13), n_healthy=n_healthy, n_faulty=n_faulty,
-                       seed=seed, client=client)
+                       seed=seed, client=client, paired=paired)
     finally:
         if client is not None:
             client.close()
@@ -420,7 +432,8 @@ def experiment_rig(
     results, predictions = rig_experiment(campaign, database, speed=speed, load=load,
                                           selection_tf=selection, variants=RIG_VARIANTS,
                                           n_repeats=repeats, seed=seed,
-                                          keep_estimators="first" if out else False)
+                                          keep_estimators="first" if out else False,
+                                          params=params)
     estimator = None
     if "estimator" in results:
         estimator = results.loc[results["variant"] == "full", "estimator"].dropna().iloc[0]
@@ -428,7 +441,7 @@ def experiment_rig(
     table = summarize(results)
     typer.echo(table.to_string(index=False))
     by_variant = dict(zip(table["variant"], table["mae_percent"]))
-    payload = {"experiment": "rig", "speed": speed, "load": load,
+    payload = {"experiment": "rig", "speed": speed, "load": load, "params": params,
                "mae": by_variant.get("full"), "ablations": by_variant,
                "rows": results.to_dict(orient="records")}
     _write_json(json_out, payload)
@@ -436,6 +449,90 @@ def experiment_rig(
         from .figures import rig_figures
 
         rig_figures(results, predictions, out, estimator=estimator)
+
+
+@experiment_app.command("rig-family")
+def experiment_rig_family(
+    seed_range: str = typer.Option("dev", "--range", help="Seed range: dev (100–123; every "
+                                   "choice is made here) or heldout (9000–9023; evaluate "
+                                   "once, at the end)."),
+    seeds: list[int] = typer.Option([], "--seed", help="Explicit rig seed(s) instead of "
+                                    "--range (results file 'seeds.jsonl')."),
+    n_rigs: int | None = typer.Option(None, "--n-rigs", help="The first N seeds only."),
+    draws: int = typer.Option(2, "--draws", help="Example draws (Sec. 4.2 splits) per rig."),
+    variants: list[str] = typer.Option(["full"], "--variant", help="Estimator variant(s): "
+                                       "full, no_feature_selection, no_tuning, before_da, "
+                                       "rms_only, zero_shot (repeat the option)."),
+    frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs of the "
+                                              "path bank (the family of issue #12 uses the 12 "
+                                              "real ones); synthetic paths only when omitted."),
+    segments: int = typer.Option(4, "--segments", help="50-cycle SAs per recording."),
+    repetitions: int = typer.Option(2, "--repetitions", help="Recordings per fault size."),
+    param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
+                                    "for every variant (VALUE as JSON when it parses)."),
+    paired: bool = typer.Option(False, "--paired", help="Use the database with healthy "
+                                "twins (needed by --param simulated_reference=twin)."),
+    results: Path | None = typer.Option(None, "--results", help="JSON-lines results file "
+                                           "(appended, resumable; default "
+                                           "DATA_HOME/family/RANGE.jsonl)."),
+    rigs_cache: Path | None = typer.Option(None, "--rigs-cache", help="Folder of the rigs' "
+                                              "cached SA segments (default "
+                                              "DATA_HOME/family/rigs, shared by all runs)."),
+    json_out: Path | None = typer.Option(None, "--json", help="Write the summary tables "
+                                            "as JSON."),
+    rigs_table: bool = typer.Option(False, "--rigs-table", help="Print the per-rig table."),
+    scheduler: str | None = typer.Option(None, "--scheduler"),
+    workers: int = typer.Option(1, "--workers", help="LocalCluster workers (rigs in "
+                                "parallel) when no --scheduler is given."),
+) -> None:
+    """Issue #12: accuracy over a family of virtual rigs never used for tuning; resumable."""
+    from ..experiments import VARIANTS, family
+
+    if seed_range not in family.RANGES:
+        raise GearshotError(f"--range must be one of {list(family.RANGES)}; got "
+                            f"{seed_range!r}")
+    if frf_folder is not None and not frf_folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    valid = list(VARIANTS) + list(family.DIAGNOSTIC_VARIANTS)
+    for v in variants:
+        if v not in valid:
+            raise GearshotError(f"--variant {v!r} is not a variant; valid: {valid}")
+    for s in seeds:
+        _check_count(s, "--seed", maximum=2**31 - 1)
+    pool = list(seeds) if seeds else list(family.RANGES[seed_range])
+    if n_rigs is not None:
+        _check_count(n_rigs, "--n-rigs", minimum=1, maximum=len(pool))
+        pool = pool[:n_rigs]
+    _check_count(draws, "--draws", minimum=1, maximum=100)
+    _check_count(segments, "--segments", minimum=1, maximum=100)
+    _check_count(repetitions, "--repetitions", minimum=1, maximum=100)
+    _check_count(workers, "--workers", minimum=1, maximum=256)
+    params = family.parse_params(param)
+    from .. import data_home
+
+    home = data_home()
+    results = results or home / "family" / f"{'seeds' if seeds else seed_range}.jsonl"
+    _early(results, "--results")
+    _early(rigs_cache, "--rigs-cache", folder=True)
+    _early(json_out, "--json")
+    store = family.family_database(home / "family", paired=paired)
+    client = _client(scheduler, workers, needed=len(pool) > 1)
+    try:
+        frame = family.rig_family_experiment(
+            store, pool, results=results, frf_folder=frf_folder, n_draws=draws,
+            variants=variants, segments=segments, repetitions=repetitions, params=params,
+            cache_dir=rigs_cache or home / "family" / "rigs", client=client)
+    finally:
+        if client is not None:
+            client.close()
+    typer.echo(f"{len(pool)} rigs × {draws} draws, {len(frame)} rows in {results}")
+    typer.echo(family.format_family_tables(frame, rigs_table=rigs_table))
+    tables = family.family_tables(frame)
+    payload = {"experiment": "rig-family", "range": None if seeds else seed_range,
+               "seeds": pool, "draws": draws, "params": params, "results": str(results),
+               "tables": {name: json.loads(t.to_json(orient="split"))
+                          for name, t in tables.items() if name != "rigs"}}
+    _write_json(json_out, payload)
 
 
 @app.command()

@@ -43,6 +43,8 @@ __all__ = [
     "propagate_simulated",
     "normalize_rms",
     "suppress_harmonics_simulated",
+    "residue_power",
+    "residue_noise",
     "split_target_healthy",
     "suppress_harmonics_target",
     "centred_features",
@@ -219,11 +221,47 @@ def normalize_rms(signals: ArrayLike, healthy: ArrayLike) -> FloatArray:
 
 
 # ---------------------------------------------------------------- step 6
-def suppress_harmonics_simulated(sim_sa: ArrayLike, healthy_mask: ArrayLike) -> FloatArray:
-    """Step 6, simulated side: subtract the first healthy simulated SA from every SA."""
+def suppress_harmonics_simulated(sim_sa: ArrayLike, healthy_mask: ArrayLike,
+                                 twins: ArrayLike | None = None) -> FloatArray:
+    """Step 6, simulated side: subtract the first healthy simulated SA from every SA.
+
+    With ``twins`` (one SA per signal: the healthy SA of the same simulated gear pair,
+    :func:`gearshot.sim.build_database` with ``paired=True``), subtract each signal's own
+    twin instead; the difference is then the fault's signature alone, as on the target
+    side where a gear is compared with itself.
+    """
     sim_sa = np.asarray(sim_sa, dtype=float)
+    if twins is not None:
+        twins = np.asarray(twins, dtype=float)
+        if twins.shape != sim_sa.shape:
+            raise GearshotError(f"twins must have the shape of the simulated SAs "
+                                f"{sim_sa.shape}; got {twins.shape}")
+        return sim_sa - twins
     first = int(np.flatnonzero(healthy_mask)[0])
     return sim_sa - sim_sa[first]
+
+
+def residue_power(differences: ArrayLike) -> FloatArray:
+    """Mean power spectrum ``mean_n |rfft(d_n)|²`` of difference signals (step 6 output).
+
+    On the target's healthy SAs after harmonic suppression this is the spectrum of what a
+    gear compared with itself leaves: the SAs' non-synchronous residue.
+    """
+    d = np.atleast_2d(np.asarray(differences, dtype=float))
+    return np.asarray(np.mean(np.abs(np.fft.rfft(d, axis=-1)) ** 2, axis=0), dtype=np.float64)
+
+
+def residue_noise(power: ArrayLike, n_signals: int, n_points: int,
+                  rng: np.random.Generator) -> FloatArray:
+    """Gaussian noise signals whose expected power spectrum is ``power``
+    (from :func:`residue_power`): white noise shaped in the frequency domain."""
+    power = np.asarray(power, dtype=float)
+    if power.shape != (n_points // 2 + 1,):
+        raise GearshotError(f"power must have n_points // 2 + 1 = {n_points // 2 + 1} bins; "
+                            f"got shape {power.shape}")
+    white = rng.standard_normal((n_signals, n_points))
+    shaped = np.fft.rfft(white, axis=-1) * np.sqrt(power / n_points)
+    return np.asarray(np.fft.irfft(shaped, n=n_points, axis=-1), dtype=np.float64)
 
 
 def split_target_healthy(target_healthy: FloatArray, *, ref_fraction: float = 0.2,
@@ -272,7 +310,9 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
 
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
                        mesh_order: int | Sequence[int], names: Sequence[str],
-                       rms_normalization: bool = True) -> FloatArray:
+                       rms_normalization: bool = True, twins: ArrayLike | None = None,
+                       noise_power: ArrayLike | None = None,
+                       random_state: RandomStateLike = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
 
     Parameters
@@ -286,17 +326,33 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
     names : sequence of str
     rms_normalization : bool, default True
         Apply step 5.
+    twins : ndarray (n_signals, n_points), optional
+        Each signal's healthy twin: step 6 subtracts it (propagated and scaled like the
+        signals) instead of the first healthy SA.
+    noise_power : ndarray (n_points // 2 + 1,), optional
+        Power spectrum of the residue to add to the difference signals (noise matching,
+        :func:`residue_power` of the target's healthy differences); with twins the
+        simulated differences have no residue of their own.
+    random_state : int, RandomState or None
+        Seeds the matched noise.
 
     Returns
     -------
     ndarray (n_signals, n_features)
-        Centred features (the first healthy SA's row is the zero-signal's features).
+        Centred features (without twins, the first healthy SA's row is the zero-signal's
+        features).
     """
     healthy = np.asarray(healthy_mask, bool)
     sim = propagate_simulated(sim_sa, tf)
+    twin = None if twins is None else propagate_simulated(twins, tf)
     if rms_normalization:
+        if twin is not None:
+            twin = normalize_rms(twin, sim[healthy])
         sim = normalize_rms(sim, sim[healthy])
-    sim = suppress_harmonics_simulated(sim, healthy)
+    sim = suppress_harmonics_simulated(sim, healthy, twin)
+    if noise_power is not None:
+        rng = np.random.default_rng(check_random_state(random_state).randint(2**31 - 1))
+        sim = sim + residue_noise(noise_power, sim.shape[0], sim.shape[1], rng)
     feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
     return feats
 

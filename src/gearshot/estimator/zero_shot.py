@@ -24,17 +24,33 @@ from numpy.typing import ArrayLike, NDArray
 from ..signal import difference_signal, harmonic_signal
 from .uncertainty import prune_weights
 
-__all__ = ["healthy_signature", "match_grade", "signature_weights"]
+__all__ = ["healthy_signature", "residue_mean_square", "match_grade", "signature_weights"]
 
 
-def healthy_signature(sa: ArrayLike, mesh_order: int | Sequence[int], *,
-                      n_sidebands: int = 2) -> NDArray[np.float64]:
-    """``log(RMS(diff) / RMS(harmonic))`` of each SA (scale-free)."""
+def healthy_signature(sa: ArrayLike, mesh_order: int | Sequence[int], *, n_sidebands: int = 2,
+                      residue_ms: float = 0.0) -> NDArray[np.float64]:
+    """``log(RMS(diff) / RMS(harmonic))`` of each SA (scale-free).
+
+    ``residue_ms`` (mean square, in the SAs' units) is the part of ``RMS(diff)²`` that is
+    not the gear's: the SA's non-synchronous residue (see :func:`residue_mean_square`).
+    It is taken off ``RMS(diff)²`` (floored at 1 % of it) before the ratio, so that a
+    noisy target is compared with noise-free simulations on its gear content alone.
+    """
     diff = difference_signal(sa, mesh_order, n_sidebands=n_sidebands)
     harm = harmonic_signal(sa, mesh_order, n_sidebands=n_sidebands)
-    d = np.sqrt(np.mean(diff ** 2, axis=-1))
+    d2 = np.mean(diff ** 2, axis=-1)
+    d = np.sqrt(np.maximum(d2 - float(residue_ms), 0.01 * d2))
     h = np.sqrt(np.mean(harm ** 2, axis=-1))
     return np.log(np.maximum(d, 1e-300) / np.maximum(h, 1e-300))
+
+
+def residue_mean_square(healthy_differences: ArrayLike, mesh_order: int | Sequence[int], *,
+                        n_sidebands: int = 2) -> float:
+    """Mean square of one SA's non-synchronous residue off the mesh harmonics, from the
+    target's healthy difference signals (each SA minus an aligned healthy reference: two
+    independent residues, hence half their mean square)."""
+    diff = difference_signal(healthy_differences, mesh_order, n_sidebands=n_sidebands)
+    return 0.5 * float(np.mean(diff ** 2))
 
 
 def match_grade(target_signature: ArrayLike,

@@ -39,11 +39,14 @@ from .._errors import GearshotError
 from .._validation import check_int
 
 __all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SA_PIPELINE_VERSION", "FamilyRig",
-           "family_paths", "draw_family", "rig_family_experiment", "family_tables", "path_kind"]
+           "family_paths", "draw_family", "rig_family_experiment", "family_tables", "path_kind",
+           "family_database", "parse_params", "format_family_tables", "RANGES"]
 
 PAPER_CONDITIONS = ((15.0, 10.0), (15.0, 5.0), (30.0, 5.0), (30.0, 10.0))
 DEV_SEEDS = range(100, 124)
 HELDOUT_SEEDS = range(9000, 9024)
+#: the two seed ranges by name (``--range`` of the benchmark and of the CLI)
+RANGES = {"dev": DEV_SEEDS, "heldout": HELDOUT_SEEDS}
 
 #: Version of the recording → SA pipeline (angular resampling, SA). Part of every rig
 #: cache's key and of the results' configuration key, so that SAs and rows made by an
@@ -244,7 +247,7 @@ def _diagnostic_params(name, rig, paths):
     raise GearshotError(f"unknown diagnostic variant {name!r}")
 
 
-DISCREPANCIES = (0.0, 0.04, 0.06, 0.08, 0.10, 0.12, 0.16)
+DISCREPANCIES = (0.0, 0.04, 0.06, 0.08, 0.10, 0.12, 0.14, 0.16, 0.20, 0.24)
 
 
 def _interval_sweep(est, test_sa, test_size, coverage=0.9):
@@ -378,8 +381,12 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
                     segments=check_int(segments, "segments", minimum=1), healthy=int(healthy),
                     sizes=[float(y) for y in sizes], repetitions=int(repetitions),
                     sa_pipeline=SA_PIPELINE_VERSION)
-    config = _hash(dict(params=params, campaign=campaign, store=str(store)))
     paths = family_paths(frf_folder, n_synthetic=n_synthetic, seed=bank_seed)
+    # the key holds every estimator parameter in effect (explicit ones and the library's
+    # defaults, so that a changed default is a new configuration) and the path bank
+    # (another bank is another family)
+    config = _hash(dict(params=_effective_params(params), campaign=campaign,
+                        store=str(store), bank=[p.name for p in paths]))
     rigs = draw_family(seeds, paths, conditions=conditions)
     cache_dir = Path(cache_dir) if cache_dir else results.with_name(results.name + ".rigs")
     done = _done_rows(results, config)
@@ -405,6 +412,15 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
     keep = (frame["config"] == config) & frame["seed"].isin(wanted) \
         & frame["variant"].isin(list(variants)) & (frame["draw"] < n_draws)
     return frame[keep].reset_index(drop=True)
+
+
+def _effective_params(params: dict) -> dict:
+    """Every estimator parameter in effect with ``params`` (defaults filled in)."""
+    from ..estimator import OneFaultShotEstimator
+
+    full = OneFaultShotEstimator(**params).get_params(deep=False)
+    full.pop("random_state", None)   # set per (rig, draw) by the experiment
+    return {k: (list(v) if isinstance(v, range) else v) for k, v in full.items()}
 
 
 def _run(specs, results: Path, client, progress, total):
@@ -464,6 +480,77 @@ def _done_rows(results: Path, config: str) -> dict:
     for seed, draw, variant in zip(frame["seed"], frame["draw"], frame["variant"]):
         done.setdefault(int(seed), set()).add((int(draw), str(variant)))
     return done
+
+
+# ------------------------------------------------------------------ shared by the CLI
+def family_database(folder, *, paired=False, client=False, progress=True) -> Path:
+    """The family's simulated database (built if missing; resumable).
+
+    Grades 1–12 at the four paper conditions, 50 healthy + 350 faulty signals per block,
+    seed 0, in ``folder/db-4conditions-h50-f350-s0`` (``-paired`` with the healthy twins
+    that ``simulated_reference="twin"`` needs; its SAs equal the plain store's).
+    """
+    from ..sim import GearPair, build_database
+
+    store = Path(folder) / ("db-4conditions-h50-f350-s0" + ("-paired" if paired else ""))
+    build_database(store, GearPair.paper(), speeds=[15, 30], loads=[5, 10],
+                   grades=range(1, 13), n_healthy=50, n_faulty=350, seed=0, client=client,
+                   progress=progress, paired=bool(paired))
+    return store
+
+
+def parse_params(items, *, option="--param") -> dict:
+    """Estimator parameters from ``NAME=VALUE`` strings (VALUE as JSON when it parses).
+
+    Unknown names and values the estimator refuses raise a :class:`GearshotError` that
+    names ``option`` and quotes the item.
+    """
+    from ..estimator import OneFaultShotEstimator
+    from ..estimator._params import validate_params
+
+    known = OneFaultShotEstimator().get_params(deep=False)
+    params = {}
+    for item in items:
+        name, sep, value = str(item).partition("=")
+        if not sep or not name:
+            raise GearshotError(f"{option} must be NAME=VALUE; got {item!r}")
+        if name not in known:
+            raise GearshotError(f"{option} {item!r}: {name!r} is not an estimator parameter "
+                                f"(they are {sorted(known)})")
+        try:
+            params[name] = json.loads(value)
+        except json.JSONDecodeError:
+            params[name] = value
+    est = OneFaultShotEstimator(**params)
+    try:
+        validate_params(est.get_params(deep=False), est._parameter_constraints)
+    except GearshotError as exc:
+        raise GearshotError(f"{option}: {exc}") from None
+    return params
+
+
+def format_family_tables(frame: pd.DataFrame, *, rigs_table: bool = False) -> str:
+    """The family's tables as text (what the benchmark and the CLI print)."""
+    tables = family_tables(frame)
+    with pd.option_context("display.width", 200, "display.max_columns", 50):
+        parts = ["MAE % by condition (speed/load), rig mean over draws; p90/max over rigs:",
+                 tables["condition"].to_string(), "", "MAE % by path type:",
+                 tables["kind"].to_string(), "", "MAE % by the rig's true grade:",
+                 tables["grade"].to_string(), "", "MAE % by path attenuation:",
+                 tables["attenuation"].to_string(), "", "90 % interval coverage %:",
+                 tables["coverage"].to_string()]
+        full = frame[frame["variant"] == "full"]
+        if not full.empty:
+            parts += ["", f"full: fit+predict median {full['seconds'].median():.2f} s per "
+                      f"dataset; recording "
+                      f"{full.groupby('seed')['record_seconds'].first().median():.1f} s per "
+                      f"rig (median, first run)"]
+        if rigs_table:
+            rigs = tables["rigs"].pivot_table(
+                index=["seed", "condition", "kind", "path", "grade", "attenuation_db"],
+                columns="variant", values="mae")
+            parts += ["", rigs.round(1).to_string()]
+    return "\n".join(parts)
 
 
 # ------------------------------------------------------------------ tables

@@ -169,11 +169,13 @@ def simulated_experiment(store, *, speeds, loads, grade=7, frf_folder=None,
 
 
 def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RIG_VARIANTS,
-                   n_repeats=1, seed=0, keep_estimators=False):
+                   n_repeats=1, seed=0, keep_estimators=False, params=None):
     """The paper's Sec. 4.2 experiment on one condition's campaign.
 
     Parameters
     ----------
+    params : dict, optional
+        Estimator parameters for every variant (a variant's own settings win).
     keep_estimators : bool or "first"
         Keep the fitted estimators in an ``estimator`` column: of every repeat (True) or of
         the first repeat only (``"first"``, enough to draw one run's figures).
@@ -199,7 +201,8 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
                                      variants=variants, selection_tf=selection_tf,
                                      random_state=seed + r,
                                      keep_estimators=keep_estimators is True
-                                     or (keep_estimators == "first" and r == 0)):
+                                     or (keep_estimators == "first" and r == 0),
+                                     **dict(params or {})):
             pred = row.pop("prediction")
             preds.append(pd.DataFrame(dict(repeat=r, variant=row["variant"],
                                            true=ds.test_size, predicted=pred,

@@ -87,13 +87,15 @@ def _pair_repr(pair):
 
 
 def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
-              fault_types=("ftff",)):
+              fault_types=("ftff",), paired=False):
     man = {"format": _FORMAT, "pair": _pair_repr(pair), "speeds": [float(s) for s in speeds],
            "loads": [float(x) for x in loads], "grades": [int(g) for g in grades],
            "n_healthy": n_healthy, "n_faulty": n_faulty, "seed": seed, "n_points": n_points}
     if list(fault_types) != ["ftff"]:
         man["fault_types"] = list(fault_types)
         man["fault_models"] = {t: FAULT_MODEL_VERSIONS[t] for t in fault_types}
+    if paired:   # only when set: stores built before pairing keep their manifest
+        man["paired"] = True
     return man
 
 
@@ -224,7 +226,8 @@ def _rebuild_hint(store: Path, man: dict) -> str:
            f"{many('--grade', man.get('grades', []), str)} "
            f"--n-healthy {man.get('n_healthy')} --n-faulty {man.get('n_faulty')} "
            f"--seed {man.get('seed')}"
-           + "".join(f" --fault-type {t}" for t in man.get("fault_types", [])))
+           + "".join(f" --fault-type {t}" for t in man.get("fault_types", []))
+           + (" --paired" if man.get("paired") else ""))
     return (f"run `{cmd}` (or build_database with the same arguments): it rebuilds only "
             f"the damaged block and reuses the rest")
 
@@ -245,8 +248,8 @@ def _read_manifest(store: Path) -> dict:
 
 def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: float,
                  load: float, grade: int, n_healthy: int, n_faulty: int, seed: int,
-                 n_points: int, single_thread: bool = False, fault_type: str = "ftff"
-                 ) -> str:
+                 n_points: int, single_thread: bool = False, fault_type: str = "ftff",
+                 paired: bool = False) -> str:
     import xarray as xr
 
     if single_thread:
@@ -266,9 +269,15 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
                      n_points=n_points, rng=[int(s) for s in sig_seeds],
                      fault_type=fault_type)
+    data = {"sa": (("signal", "angle"), sa.astype(np.float64),
+                   {"units": "g", "long_name": "vertical acceleration SA"})}
+    if paired:
+        data["sa_twin"] = (("signal", "angle"), _healthy_twins(
+            pair, sa, sizes, sig_seeds, speed=speed, load=load, grade=grade,
+            n_points=n_points), {"units": "g", "long_name": "healthy twin SA (same "
+                                 "profile errors, no fault)"})
     ds = xr.Dataset(
-        {"sa": (("signal", "angle"), sa.astype(np.float64),
-                {"units": "g", "long_name": "vertical acceleration SA"})},
+        data,
         coords={"fault_size": ("signal", sizes), "grade": ("signal", np.full(n, grade)),
                 "seed": ("signal", sig_seeds), "speed": float(speed), "load": float(load),
                 "angle": ("angle", 2 * np.pi * np.arange(n_points) / n_points,
@@ -282,10 +291,22 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     return final.name
 
 
+def _healthy_twins(pair, sa, sizes, sig_seeds, *, speed, load, grade, n_points):
+    """The healthy SA of each signal's own gear pair: the same seed (so the same profile
+    errors of both wheels), fault size 0. A healthy signal is its own twin."""
+    twins = np.array(sa, dtype=np.float64, copy=True)
+    faulty = np.flatnonzero(sizes > 0)
+    if faulty.size:
+        twins[faulty] = simulate_sa(pair, speed=speed, load=load, grade=grade,
+                                    fault_sizes=np.zeros(faulty.size), n_points=n_points,
+                                    rng=[int(sig_seeds[i]) for i in faulty])
+    return twins
+
+
 def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades,
                    n_healthy: int = 100, n_faulty: int = 700, seed: int = 0,
                    n_points: int = 2048, client=None, progress: bool = True,
-                   fault_types=("ftff",)) -> Path:
+                   fault_types=("ftff",), paired: bool = False) -> Path:
     """Simulate SAs for every (speed, load, grade) and store them as Zarr.
 
     Parameters
@@ -317,6 +338,12 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         Fault types (:data:`~gearshot.sim.FAULT_TYPES`): one block of ``n_healthy`` +
         ``n_faulty`` signals per type and (speed, load, grade); sizes mean the type's
         size (:mod:`gearshot.sim.fault_types`). Default the FTFF only.
+    paired : bool, default False
+        Also store, as ``sa_twin``, each signal's *healthy twin*: the SA of the same gear
+        pair (same seed, hence the same profile errors) without the fault (a healthy
+        signal is its own twin). The ``sa`` of a paired store equal those of the unpaired
+        store of the same arguments; the twins cost one more simulation per faulty
+        signal. ``OneFaultShotEstimator(simulated_reference="twin")`` needs them.
 
     Returns
     -------
@@ -340,8 +367,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
                             f"{n_healthy + n_faulty}")
     fault_types = _check_fault_types(fault_types)
     store = Path(store).expanduser()
+    if not isinstance(paired, (bool, np.bool_)):
+        raise GearshotError(f"paired must be True or False; got {describe(paired)}")
     manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
-                         fault_types)
+                         fault_types, bool(paired))
     _prepare_store(store, manifest)
 
     tasks = [(i, j, k, float(s), float(ld), int(g), ft)
@@ -372,7 +401,7 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         client = Client(own_cluster)
     try:
         _run_tasks(store, pair, todo, len(tasks), n_healthy, n_faulty, seed, n_points,
-                   client if client else None, progress)
+                   client if client else None, progress, bool(paired))
     finally:
         if own_cluster is not None:
             client.close()
@@ -410,7 +439,7 @@ def _prepare_store(store: Path, manifest: dict) -> None:
 
 
 def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
-               progress):
+               progress, paired=False):
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -427,12 +456,13 @@ def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, 
         if client is None:
             for t in todo:
                 _build_block(str(store), pair, *t[:6], n_healthy, n_faulty, seed, n_points,
-                             fault_type=t[6])
+                             fault_type=t[6], paired=paired)
                 bar.advance(task)
             return
         from dask.distributed import as_completed
         futures = [client.submit(_build_block, str(store), pair, *t[:6], n_healthy,
-                                 n_faulty, seed, n_points, True, t[6], pure=False)
+                                 n_faulty, seed, n_points, True, t[6], paired,
+                                 pure=False)
                    for t in todo]
         for fut in as_completed(futures):
             fut.result()
@@ -456,7 +486,8 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
     Returns
     -------
     xarray.Dataset
-        ``sa`` (signal, angle) float64 in g; coords ``fault_size``, ``grade``, ``seed``
+        ``sa`` (signal, angle) float64 in g (and ``sa_twin``, the healthy twins, in a
+        store built with ``paired=True``); coords ``fault_size``, ``grade``, ``seed``
         and ``fault_type`` along ``signal``; scalar ``speed`` (rev/s) and ``load`` (N m).
         Blocks are concatenated along ``signal`` (grades outer, fault types inner).
     """
@@ -501,7 +532,8 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
                 except Exception as exc:  # a decoder's error on a damaged chunk
                     problem = f"it cannot be decoded ({type(exc).__name__}: {exc})"
                 else:
-                    if "sa" not in part or not np.all(np.isfinite(part["sa"].values)):
+                    if any(name in part and not np.all(np.isfinite(part[name].values))
+                           for name in ("sa", "sa_twin")) or "sa" not in part:
                         problem = "its SA array is incomplete (non-finite values)"
             if problem is not None:
                 raise GearshotError(f"{where} is damaged: {problem}; "
