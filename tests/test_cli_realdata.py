@@ -92,6 +92,8 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--store", str(store), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
     assert "pair 96 -> 32 teeth" in res.stdout and "[10.0]" in res.stdout
+    # a machine's database is paired by default (each signal's healthy twin stored)
+    assert json.loads((store / "manifest.json").read_text()).get("paired") is True
     out = tmp_path / "pred.csv"
     res = run("predict", "--machine", str(SPUR), "--database", str(store), "--healthy",
               str(small["spur3"]), "--faulty", str(small["spur2"]), "--faulty-size", "0.5",

@@ -443,11 +443,29 @@ def test_twin_reference_fits_and_is_seeded(paired_db, data, tf_pair):
     pred = a.predict(faulty)
     means = [pred[y == s].mean() for s in (0.32, 0.56, 0.66)]
     assert means[0] < means[2]
+    assert a.simulated_reference_ == "twin"
+    # "auto" (the default) takes the twins of a paired database ...
+    auto = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
+        *args, selection_tf=tf_pair[1])
+    assert auto.simulated_reference_ == "twin"
+    assert_array_equal(auto.predict(faulty), pred)
+    # ... and step 1 subtracts them too: its simulated healthy differences are zero
+    # through the estimated TF (the training set), so their features sit at the centre
+    from gearshot.estimator._model import _database_by_grade
+
+    train_feats = auto.selection_features_[0]
+    _, y_nom = _database_by_grade(paired_db, N)[NOMINAL]
+    kept = np.delete(np.arange(y_nom.size), np.flatnonzero(y_nom == 0)[0])
+    healthy_rows = np.flatnonzero(y_nom[kept] == 0)
+    assert healthy_rows.size >= 2
+    assert_allclose(np.std(train_feats[healthy_rows], axis=0), 0.0, atol=1e-9)
     # the paper's reference on the same database ignores the twins
-    paper = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
+    paper = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL,
+                                  simulated_reference="first_healthy").fit(
         *args, selection_tf=tf_pair[1])
     plain = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
         paired_db.drop_vars("sa_twin"), *args[1:], selection_tf=tf_pair[1])
+    assert plain.simulated_reference_ == paper.simulated_reference_ == "first_healthy"
     assert_array_equal(paper.predict(faulty), plain.predict(faulty))
 
 

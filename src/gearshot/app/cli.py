@@ -191,9 +191,12 @@ def simulate(
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
-    paired: bool = typer.Option(False, "--paired", help="Also store each signal's healthy "
-                                "twin (same profile errors, no fault), for the estimator's "
-                                "simulated_reference='twin'."),
+    paired: bool | None = typer.Option(None, "--paired/--no-paired", help="Also store each "
+                                       "signal's healthy twin (same profile errors, no "
+                                       "fault): the estimator then subtracts each signal's "
+                                       "own twin (simulated_reference 'auto' -> 'twin'). "
+                                       "Twice the simulation time. Default: on with "
+                                       "--machine, off otherwise."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from .._paths import data_home
@@ -202,11 +205,9 @@ def simulate(
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
     if machine is not None:
-        if paired:
-            raise GearshotError("--paired is not available with --machine")
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
-                          scheduler, workers, fault_type)
+                          scheduler, workers, fault_type, paired=paired is not False)
         return
     store = store or data_home(create=False) / "databases" / "sim-db"  # default_database_path
     _early(store, "--store", folder=True)
@@ -217,7 +218,7 @@ def simulate(
     try:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grade,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
-                       fault_types=fault_type, paired=paired)
+                       fault_types=fault_type, paired=bool(paired))
     finally:
         if client is not None:
             client.close()
@@ -225,8 +226,10 @@ def simulate(
 
 
 def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_faulty, seed,
-                      scheduler, workers, fault_types=("ftff",)):
-    """``simulate --machine``: a database of the machine's monitored pair."""
+                      scheduler, workers, fault_types=("ftff",), paired=True):
+    """``simulate --machine``: a database of the machine's monitored pair (paired by
+    default: on a real machine the target's step 6 subtracts the same gear's healthy SA,
+    and so does the simulated side with twins)."""
     from ..machine import Machine
     from ..sim import build_database
     from .predict_machine import machine_database_path
@@ -234,14 +237,14 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
     mach = Machine.from_toml(machine_file)
     pair = mach.gear_pair()
     store = store or machine_database_path(machine_file, n_healthy=n_healthy,
-                                           n_faulty=n_faulty, seed=seed)
+                                           n_faulty=n_faulty, seed=seed, paired=paired)
     sim_speeds = [mach.sim_speed(s) for s in speeds]
     n_blocks = len(sim_speeds) * len(loads) * len(grades) * len(fault_types)
     client = _client(scheduler, workers, needed=n_blocks > 1)
     try:
         build_database(store, pair, speeds=sim_speeds, loads=loads, grades=grades,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
-                       fault_types=list(fault_types))
+                       fault_types=list(fault_types), paired=paired)
     finally:
         if client is not None:
             client.close()

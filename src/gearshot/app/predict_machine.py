@@ -16,12 +16,12 @@ __all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
 
 
 def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty: int,
-                          seed: int) -> Path:
+                          seed: int, paired: bool = True) -> Path:
     """Default store of ``gearshot simulate --machine FILE``."""
     from ..sim import default_database_path
 
     return default_database_path(f"machine-{Path(machine_file).stem}-h{n_healthy}-"
-                                 f"f{n_faulty}-s{seed}")
+                                 f"f{n_faulty}-s{seed}" + ("-paired" if paired else ""))
 
 
 def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
@@ -159,4 +159,5 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
     frame.attrs["grade"] = getattr(est, "grade_", None)
+    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame

@@ -62,6 +62,7 @@ RandomStateLike = int | np.random.RandomState | None
 def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: ArrayLike, *,
                     mesh_order: int | Sequence[int], names: Sequence[str],
                     threshold: float = 0.10, fallback: str = "best",
+                    twins: ArrayLike | None = None,
                     noise_fraction: float = 0.10, n_long_cycles: int = 128,
                     random_state: RandomStateLike = None, return_features: bool = False,
                     ) -> Any:
@@ -88,6 +89,9 @@ def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: Arra
     threshold : float
     fallback : {"best", "all"}
         When no feature passes: keep the one with the smallest error, or all of them.
+    twins : ndarray (n_signals, n_points), optional
+        Each signal's healthy twin (a paired database): both sets subtract it in step 6
+        instead of their first healthy SA.
     noise_fraction : float
     n_long_cycles : int
         Cycles in the long healthy test signal used for the TF estimate.
@@ -114,11 +118,12 @@ def select_features(sim_sa: ArrayLike, fault_size: ArrayLike, selection_tf: Arra
     long_cycles = propagate(_long_healthy_signal(sim_sa[healthy], n_long_cycles, noise_rms,
                                                  rng), selection_tf)
     tf_hat = estimate_tf(long_cycles.ravel(), n_points)
-    f_train = simulated_features(sim_sa, healthy, tf_hat, mesh_order=mesh_order, names=names)
+    f_train = simulated_features(sim_sa, healthy, tf_hat, mesh_order=mesh_order, names=names,
+                                 twins=twins)
     f_test = simulated_features(noisy, healthy, np.asarray(selection_tf),
-                                mesh_order=mesh_order, names=names)
+                                mesh_order=mesh_order, names=names, twins=twins)
     keep = np.ones(len(f_test), bool)
-    keep[np.flatnonzero(healthy)[0]] = False  # the subtracted reference itself
+    keep[np.flatnonzero(healthy)[0]] = False  # the subtracted reference itself (unpaired)
     err = feature_invariance_errors(f_train[keep], f_test[keep])
     errors = dict(zip(names, err.tolist()))
     selected = tuple(n for n, e in errors.items() if e < threshold)
