@@ -50,6 +50,8 @@ def test_version():
          ["--param", "model_discrepancy", "-1"]),
         (["experiment", "rig-family", "--param", "simulated_reference"],
          ["--param", "NAME=VALUE"]),
+        (["experiment", "rig", "--param", "nope=1", "--store", "/tmp/gs-never"],
+         ["--param", "'nope'"]),
     ],
 )
 def test_user_errors_are_one_line_without_traceback(args, words, tmp_path):
