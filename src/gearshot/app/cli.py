@@ -383,7 +383,9 @@ def experiment_rig(
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
     paired: bool = typer.Option(False, "--paired", help="Build and use the database with "
-                                "healthy twins (needed by simulated_reference=twin)."),
+                                "healthy twins: the estimator's default "
+                                "simulated_reference='auto' then subtracts each signal's "
+                                "own twin (steps 1 and 6)."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
     if frf_folder is not None and not frf_folder.is_dir():
