@@ -76,6 +76,15 @@ def test_feature_invariance_errors_are_offsets_over_spread():
     assert_allclose(err, [0.1, 1.0] / a.std(axis=0), rtol=1e-12)
 
 
+def test_a_flat_tuning_curve_warns_nothing():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        best, curve = steps.tune_grade(lambda g: 0.3, [1, 2, 3, 4], 0.5)
+    assert best == 1 and np.allclose(curve["smoothed"], 0.3)
+
+
 def test_tune_grade_picks_the_nearest_prediction():
     best, curve = steps.tune_grade(lambda g: {1: 0.9, 2: 0.52, 3: 0.3}[g], [1, 2, 3], 0.5,
                                    smoothing="none")

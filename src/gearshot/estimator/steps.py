@@ -191,10 +191,12 @@ def tune_grade(predict_example: Callable[[int], float], grades: Sequence[int],
     raw_error = np.abs(preds - faulty_size)
     smoothed = preds
     if smoothing == "isotonic" and len(grades) > 2:
+        from scipy.stats import ConstantInputWarning
         from sklearn.isotonic import IsotonicRegression
 
         with warnings.catch_warnings():  # 'auto' direction on a flat curve: either is fine
             warnings.simplefilter("ignore", UserWarning)
+            warnings.simplefilter("ignore", ConstantInputWarning)
             smoothed = IsotonicRegression(increasing="auto").fit_transform(grades, preds)
     errors = np.abs(smoothed - faulty_size)
     candidates = np.flatnonzero(np.isclose(errors, errors.min(), rtol=0, atol=1e-12))
