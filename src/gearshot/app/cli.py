@@ -476,7 +476,8 @@ def experiment_rig_family(
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
     paired: bool = typer.Option(False, "--paired", help="Use the database with healthy "
-                                "twins (needed by --param simulated_reference=twin)."),
+                                "twins (the configuration of record: the default "
+                                "simulated_reference='auto' then uses them)."),
     results: Path | None = typer.Option(None, "--results", help="JSON-lines results file "
                                            "(appended, resumable; default "
                                            "DATA_HOME/family/RANGE.jsonl)."),
