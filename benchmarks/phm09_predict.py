@@ -14,7 +14,6 @@ no spur2 test segment). Database: ``gearshot simulate --machine`` (see RESULTS.m
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -22,6 +21,7 @@ import pandas as pd
 
 from gearshot import Machine
 from gearshot.app.predict_machine import predict_from_machine
+from gearshot.experiments.family import parse_params
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -37,13 +37,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results"
                     / "phm09_predict.csv")
     args = ap.parse_args()
-    params = {}
-    for item in args.param:
-        name, _, value = item.partition("=")
-        try:
-            params[name] = json.loads(value)
-        except json.JSONDecodeError:
-            params[name] = value
+    params = parse_params(args.param)
     machine = Machine.from_toml(ROOT / "examples" / "machines" / "phm09_spur.toml")
     frames = []
     for speed in (30, 40):

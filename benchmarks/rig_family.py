@@ -19,7 +19,8 @@ rigs on a Dask LocalCluster of N single-threaded processes.
 
 ``--param NAME=VALUE`` sets an estimator parameter for every variant (a new configuration:
 its rows are computed afresh; VALUE is parsed as JSON when it can be). ``--paired`` uses
-the database with healthy twins (needed by ``--param simulated_reference=twin``).
+the database with healthy twins, which the default ``simulated_reference="auto"`` then
+subtracts (the configuration of record).
 
 The same run from the command line: ``gearshot experiment rig-family`` (same options).
 """

@@ -487,8 +487,9 @@ def family_database(folder, *, paired=False, client=False, progress=True) -> Pat
     """The family's simulated database (built if missing; resumable).
 
     Grades 1–12 at the four paper conditions, 50 healthy + 350 faulty signals per block,
-    seed 0, in ``folder/db-4conditions-h50-f350-s0`` (``-paired`` with the healthy twins
-    that ``simulated_reference="twin"`` needs; its SAs equal the plain store's).
+    seed 0, in ``folder/db-4conditions-h50-f350-s0`` (``-paired`` with the healthy twins,
+    which the estimator's default ``simulated_reference="auto"`` uses; its SAs equal the
+    plain store's).
     """
     from ..sim import GearPair, build_database
 
