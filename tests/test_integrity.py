@@ -286,3 +286,92 @@ def test_temporaries_of_a_killed_run_are_removed_on_next_start(store):
     (store / ".manifest.json.xyz.tmp").write_text("{")
     build_database(store, **KW)
     assert not _leftovers(store)
+
+
+# ------------------------------------------------------------------------- model files
+@pytest.fixture(scope="module")
+def fitted_estimator():
+    sys.path.insert(0, str(Path(__file__).parent))
+    from estimator_data import synthetic_database, synthetic_target, tf_pair
+
+    from gearshot.estimator import OneFaultShotEstimator
+
+    tfs = tf_pair()
+    healthy, long, faulty, y = synthetic_target(6, tfs[0])
+    est = OneFaultShotEstimator(random_state=0, nominal_grade=3)
+    est.fit(synthetic_database(), healthy, faulty[20], y[20], long, selection_tf=tfs[1])
+    return est, faulty
+
+
+class _Evil:
+    """Unpickling this creates the marker file: the code a crafted model file runs."""
+
+    def __init__(self, marker):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (open, (str(self.marker), "w"))
+
+
+def test_model_file_round_trip_runs_no_pickle(fitted_estimator, tmp_path):
+    from gearshot.estimator import OneFaultShotEstimator, load_estimator, save_estimator
+
+    est, faulty = fitted_estimator
+    save_estimator(est, tmp_path / "m.skops")
+    assert (tmp_path / "m.skops").read_bytes()[:2] == b"PK"        # a zip of JSON + .npy
+    again = load_estimator(tmp_path / "m.skops")
+    np.testing.assert_array_equal(again.predict(faulty), est.predict(faulty))
+    assert isinstance(OneFaultShotEstimator.load(tmp_path / "m.skops"), OneFaultShotEstimator)
+
+
+def test_crafted_pickle_model_file_runs_no_code(fitted_estimator, tmp_path):
+    import joblib
+
+    from gearshot.estimator import load_estimator
+
+    marker = tmp_path / "pwned"
+    joblib.dump({"format": "gearshot-estimator/1", "estimator": _Evil(marker)},
+                tmp_path / "evil.joblib")
+    with pytest.raises(GearshotError, match="trusted=True") as info:
+        load_estimator(tmp_path / "evil.joblib")
+    assert "evil.joblib" in str(info.value) and "runs any code" in str(info.value)
+    assert not marker.exists()
+    # an old gearshot pickle loads when the caller vouches for it
+    est, faulty = fitted_estimator
+    joblib.dump({"format": "gearshot-estimator/1", "gearshot_version": "0.1.0",
+                 "sklearn_version": "x", "estimator": est}, tmp_path / "old.joblib")
+    with pytest.warns(UserWarning, match="sklearn"):
+        old = load_estimator(tmp_path / "old.joblib", trusted=True)
+    np.testing.assert_array_equal(old.predict(faulty), est.predict(faulty))
+
+
+def test_crafted_skops_model_file_is_refused(tmp_path):
+    import skops.io as sio
+
+    from gearshot.estimator import load_estimator
+
+    sio.dump({"format": "gearshot-estimator/2", "estimator": os.system,
+              "also": eval}, tmp_path / "evil.skops")
+    with pytest.raises(GearshotError, match="would construct types") as info:
+        load_estimator(tmp_path / "evil.skops")
+    assert "system" in str(info.value) and "eval" in str(info.value)
+    (tmp_path / "junk.skops").write_bytes(b"PK\x03\x04" + b"\0" * 100)
+    with pytest.raises(GearshotError, match="junk.skops"):
+        load_estimator(tmp_path / "junk.skops")
+
+
+def test_killed_save_leaves_a_temporary_that_the_next_save_removes(fitted_estimator,
+                                                                    tmp_path):
+    """A save killed between write and rename leaves ``.m.skops.<pid>-….tmp.skops``; the
+    next write to the same folder removes temporaries whose process is gone."""
+    code = ("import os, sys, gearshot._atomic as a\n"
+            "with a.atomic_path(sys.argv[1]) as tmp:\n"
+            "    tmp.write_bytes(b'half')\n"
+            "    os.kill(os.getpid(), 9)\n")
+    subprocess.run([sys.executable, "-c", code, str(tmp_path / "m.skops")],
+                   env=dict(os.environ, PYTHONPATH=str(SRC)), timeout=120)
+    assert _leftovers(tmp_path)
+    from gearshot.estimator import save_estimator
+
+    save_estimator(fitted_estimator[0], tmp_path / "m.skops")
+    assert not _leftovers(tmp_path) and (tmp_path / "m.skops").is_file()
