@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 
 __all__ = ["shaft_indicators", "record_indicators", "indicator_table", "indicator_figures",
@@ -179,6 +180,7 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
         ax.legend(fontsize=7, ncol=2)
         fig.tight_layout()
         path = folder / f"{col}.png"
-        fig.savefig(path, dpi=110)
+        with atomic_path(path, make_parents=True) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
         paths.append(path)
     return paths

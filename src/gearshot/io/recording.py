@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int, check_positive, describe
+from .._validation import MAX_FS, as_signal_array, check_int, check_positive, describe
 from ..signal.angle import TACHO_SHAFTS, check_pulse_train, uniform_cycle_times
 from ._fileio import METADATA_KEYS, RawFile, reconcile_fs, select_channels
 from ._format_csv import read_csv, write_csv
@@ -124,6 +124,8 @@ class Recording:
                                     f"({acc.shape[-1]}); got {tac.size}")
             set_(self, "tacho", tac)
         set_(self, "fs", check_positive(self.fs, "fs"))
+        if self.fs > MAX_FS:
+            raise GearshotError(f"fs must be <= {MAX_FS:g} Hz; got {self.fs:g}")
         set_(self, "speed", _opt_float(self.speed, "speed"))
         if self.speed is not None and self.speed <= 0:
             raise GearshotError(f"speed must be > 0 rev/s; got {self.speed}")

@@ -36,7 +36,7 @@ import numpy as np
 from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
-from .._validation import check_finite, check_int, describe
+from .._validation import check_finite, check_int, check_load, check_speed, describe
 from ._integrity import (
     block_content_problem,
     block_draws,
@@ -409,6 +409,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         raise GearshotError(f"pair must be a GearPair; got {describe(pair)}")
     speeds = _check_values(speeds, "speeds", lo=0)
     loads = _check_values(loads, "loads", lo=0)
+    for v in speeds:
+        check_speed(float(v), "speeds")
+    for v in loads:
+        check_load(float(v), "loads")
     grades = _check_values(grades, "grades", integer=True, hi=12)
     n_healthy = check_int(n_healthy, "n_healthy", minimum=0)
     n_faulty = check_int(n_faulty, "n_faulty", minimum=0)
