@@ -25,6 +25,7 @@ import scipy.io
 
 from .._errors import GearshotError
 from ._fileio import FS_NAMES, RawFile, atomic_path
+from ._format_hdf5 import check_extent
 
 __all__ = ["read_mat", "write_mat"]
 
@@ -104,6 +105,7 @@ def read_mat(path: Path) -> RawFile:
         with h5py.File(path, "r") as f:
             for name, obj in f.items():
                 if isinstance(obj, h5py.Dataset) and not name.startswith("#"):
+                    check_extent(path, obj)
                     variables[name] = _read_v73_dataset(obj)
         return _collect(path, variables)
     variables = scipy.io.loadmat(path, squeeze_me=True, chars_as_strings=True)
