@@ -375,3 +375,278 @@ def test_killed_save_leaves_a_temporary_that_the_next_save_removes(fitted_estima
 
     save_estimator(fitted_estimator[0], tmp_path / "m.skops")
     assert not _leftovers(tmp_path) and (tmp_path / "m.skops").is_file()
+
+
+# ---------------------------------------------------------------------------- bounded reads
+@pytest.fixture(scope="module")
+def recording():
+    from gearshot.io import Recording
+
+    rng = np.random.default_rng(0)
+    n = 200_000
+    tacho = (np.sin(2 * np.pi * 15 * np.arange(n) / 20_000) > 0.99).astype(float)
+    return Recording(rng.standard_normal(n), tacho, 20_000.0, speed=15.0)
+
+
+@pytest.mark.parametrize("suffix", [".h5", ".wav", ".mat", ".csv"])
+@pytest.mark.parametrize("frac", [0.1, 0.5, 0.9, 0.999])
+def test_zeroed_tail_fails_fast_never_loads(recording, tmp_path, suffix, frac):
+    """A file whose tail is overwritten with zeros: a GearshotError naming it, in seconds
+    (the read budget), never a recording of wrong samples."""
+    from gearshot.io import Recording
+
+    path = tmp_path / f"rec{suffix}"
+    recording.write(path)
+    data = path.read_bytes()
+    cut = int(len(data) * frac)
+    path.write_bytes(data[:cut] + b"\0" * (len(data) - cut))
+    t0 = time.monotonic()
+    with pytest.raises(GearshotError, match="rec"):
+        Recording.read(path)
+    assert time.monotonic() - t0 < 30
+
+
+def test_truncated_hdf5_names_the_dataset_before_reading(recording, tmp_path):
+    from gearshot.io import Recording
+
+    path = tmp_path / "rec.h5"
+    recording.write(path)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(GearshotError, match="rec.h5"):
+        Recording.read(path)
+
+
+def test_a_stuck_reader_gives_up_within_the_budget(recording, tmp_path, monkeypatch):
+    import gearshot.io.recording as r
+
+    path = tmp_path / "rec.h5"
+    recording.write(path)
+    monkeypatch.setattr(r, "READ_BUDGET_S", 0.5)
+    monkeypatch.setattr(r, "read_hdf5", lambda p: time.sleep(20))
+    t0 = time.monotonic()
+    with pytest.raises(GearshotError, match="did not finish within"):
+        r.Recording.read(path)
+    assert time.monotonic() - t0 < 5
+
+
+def test_ctrl_c_stops_a_stuck_read(recording, tmp_path):
+    path = tmp_path / "rec.h5"
+    recording.write(path)
+    code = ("import sys, time\nimport gearshot.io.recording as r\n"
+            "r.read_hdf5 = lambda p: time.sleep(120)\nprint('reading', flush=True)\n"
+            "try:\n    r.Recording.read(sys.argv[1])\n"
+            "except KeyboardInterrupt:\n    print('interrupted', flush=True)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(path)], stdout=subprocess.PIPE,
+                            text=True, env=dict(os.environ, PYTHONPATH=str(SRC)))
+    assert proc.stdout.readline().strip() == "reading"
+    time.sleep(1.0)
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=60)
+    assert "interrupted" in out and time.monotonic() - t0 < 10
+
+
+# ------------------------------------------------------------------- command-line cases
+def _cli(args, tmp_path, timeout=300):
+    env = dict(os.environ, PYTHONPATH=str(SRC), GEARSHOT_DATA=str(tmp_path / "home"))
+    return subprocess.run([sys.executable, "-m", "gearshot.app.cli", *map(str, args)],
+                          capture_output=True, text=True, env=env, timeout=timeout,
+                          cwd=tmp_path)
+
+
+def _one_line(res, *words):
+    err = res.stderr.strip()
+    assert res.returncode == 2, (res.returncode, err)      # a user error, never exit 3
+    lines = [ln for ln in err.splitlines() if ln.startswith("gearshot: error:")]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for w in words:
+        assert w in lines[0], err
+    return lines[0]
+
+
+def _machine_file(tmp_path, **file_overrides):
+    import tomllib
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "machines" / "phm09_spur.toml").read_text()
+    data = tomllib.loads(text)
+    lines = [ln for ln in text.splitlines()]
+    for key, value in file_overrides.items():
+        lines = [f"{key} = {value}" if ln.split("=")[0].strip() == key
+                 and key in data["file"] else ln for ln in lines]
+    path = tmp_path / "m.toml"
+    path.write_text("\n".join(lines))
+    return path
+
+
+USER_ERRORS = {
+    "predict --seed -1": (lambda t: ["predict", "--database", t / "db", "--healthy", t / "h.h5",
+                                     "--faulty", t / "f.h5", "--faulty-size", "0.5",
+                                     "--recordings", t, "--speed", "15", "--load", "10",
+                                     "--seed", "-1"], ["--seed", "-1"]),
+    "predict --out p.xlsx": (lambda t: ["predict", "--database", t / "db", "--healthy",
+                                        t / "h.h5", "--faulty", t / "f.h5", "--faulty-size",
+                                        "0.5", "--recordings", t, "--speed", "15", "--load",
+                                        "10", "--out", t / "p.xlsx"], ["p.xlsx", ".csv"]),
+    "simulate --speed 1e308": (lambda t: ["simulate", "--store", t / "db", "--speed", "1e308",
+                                          "--grade", "7"], ["--speed", "1e+308"]),
+    "simulate --speed 1e-6": (lambda t: ["simulate", "--store", t / "db", "--speed", "1e-6",
+                                         "--grade", "7"], ["--speed", "rev/s"]),
+    "simulate --load 1e12": (lambda t: ["simulate", "--store", t / "db", "--load", "1e12",
+                                        "--grade", "7"], ["--load", "N m"]),
+    "rig --load 1e9": (lambda t: ["rig", t / "camp", "--load", "1e9"], ["--load"]),
+    "machine fs 1e400": (lambda t: ["simulate", "--machine",
+                                    _machine_file(t, fs='"1e400"'), "--grade", "7"],
+                         ["m.toml", "file.fs"]),
+    "machine fs 1e300": (lambda t: ["simulate", "--machine", _machine_file(t, fs="1e300"),
+                                    "--grade", "7"], ["m.toml", "file.fs"]),
+    "machine delimiter list": (lambda t: ["simulate", "--machine",
+                                          _machine_file(t, delimiter='[","]'), "--grade",
+                                          "7"], ["m.toml", "delimiter"]),
+    "report on a JSON list": (lambda t: ["report", _write(t / "r.json", "[1, 2]")],
+                              ["r.json", "rows"]),
+    "report rows without keys": (lambda t: ["report", _write(t / "r.json",
+                                                              '{"rows": [{"x": 1}]}')],
+                                 ["r.json", "variant"]),
+    "report rows not objects": (lambda t: ["report", _write(t / "r.json", '{"rows": [1]}')],
+                                ["r.json"]),
+    "experiment simulated, empty FRF folder": (
+        lambda t: ["experiment", "simulated", "--frf-folder", _mkdir(t / "frf"), "--store",
+                   t / "db"], ["--frf-folder", "no FRF files"]),
+    "experiment rig --rig-grade 13": (lambda t: ["experiment", "rig", "--rig-grade", "13",
+                                                 "--store", t / "db"], ["--rig-grade", "13"]),
+}
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+def _mkdir(path):
+    path.mkdir(exist_ok=True)
+    return path
+
+
+@pytest.mark.parametrize("case", sorted(USER_ERRORS))
+def test_user_errors_are_one_line_exit_2_before_any_work(tmp_path, case):
+    make, words = USER_ERRORS[case]
+    _one_line(_cli(make(tmp_path), tmp_path), *words)
+    assert not (tmp_path / "db").exists() and not (tmp_path / "camp").exists()
+    assert not list((tmp_path / "home").rglob("*.zarr")) if (tmp_path / "home").exists() \
+        else True
+
+
+def test_simulate_at_an_absurd_speed_does_not_suggest_duration(tmp_path):
+    line = _one_line(_cli(["simulate", "--store", tmp_path / "db", "--speed", "1e-6"],
+                          tmp_path), "--speed")
+    assert "--duration" not in line
+
+
+def test_multi_line_library_errors_print_as_one_line(monkeypatch, capsys, tmp_path):
+    """The rig's disk-full error (h5py's message spans lines) is one line."""
+    import gearshot.app.cli as cli
+
+    def full(*a, **k):
+        raise GearshotError(f"cannot write {str(tmp_path / 'camp' / 'x.h5')!r}:\n  No space "
+                            f"left on device\n  (errno 28)")
+
+    monkeypatch.setattr("gearshot.rig.virtual.VirtualRig.campaign", full)
+    monkeypatch.setattr(sys, "argv", ["gearshot", "rig", str(tmp_path / "camp"), "--duration",
+                                      "8", "--healthy", "1", "--repetitions", "0"])
+    with pytest.raises(SystemExit) as info:
+        cli.main()
+    err = capsys.readouterr().err.strip()
+    assert info.value.code == 2 and len(err.splitlines()) == 1
+    assert "x.h5" in err and "No space left on device" in err
+
+
+def test_indicator_figures_go_through_the_atomic_writer(tmp_path, monkeypatch):
+    """A full disk while saving a figure leaves no 0-byte PNG and names the path."""
+    import errno
+
+    from matplotlib.figure import Figure
+
+    from gearshot.app.indicators import indicator_figures
+
+    def full(self, fname, *a, **k):
+        Path(fname).write_bytes(b"")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full)
+    payload = {"records": [{"file": f"case{i}_30hz.zip", "speed_hz": 30.0 + i,
+                            "n_cycles": 10, "indicators": {"rms": 1.0 + i, "fm4": 3.0}}
+                           for i in range(2)]}
+    with pytest.raises(GearshotError, match="No space left on device") as info:
+        indicator_figures(payload, tmp_path / "figs", title="t")
+    assert str(tmp_path / "figs") in str(info.value) and ".png" in str(info.value)
+    assert not list((tmp_path / "figs").glob("*.png"))
+    assert not _leftovers(tmp_path)
+
+
+# ------------------------------------------------------------------------------ API cases
+def test_machine_from_dict_never_raises_type_error():
+    import tomllib
+
+    from gearshot import Machine
+
+    root = Path(__file__).resolve().parents[1]
+    base = tomllib.loads((root / "examples" / "machines" / "phm09_spur.toml").read_text())
+    hostile = [[","], {"a": 1}, [[1]], 1e400, float("nan"), None, True, "x" * 1000]
+    n = 0
+    for table in ("file", "tacho", "monitored", "analysis"):
+        for key in list(base.get(table, {})) + ["unknown"]:
+            for value in hostile:
+                data = {**base, table: {**base.get(table, {}), key: value}}
+                try:
+                    Machine.from_dict(data)
+                except GearshotError:
+                    n += 1
+    for top in ("shafts", "stage", "sensor", "name"):
+        for value in hostile:
+            try:
+                Machine.from_dict({**base, top: value})
+            except GearshotError:
+                n += 1
+    assert n > 100
+    with pytest.raises(GearshotError):
+        Machine.from_dict([1, 2])
+
+
+def test_order_mask_with_huge_sidebands_is_fast_and_exact():
+    import gearshot.signal as gs
+
+    mask = gs.order_mask(2 ** 24, 38, n_sidebands=2 ** 24)
+    assert mask.all() and mask.size == 2 ** 23 + 1
+    small = gs.order_mask(64, 5, n_sidebands=1)
+    want = np.zeros(33, bool)
+    for h in range(5, 33, 5):
+        want[[h - 1, h, min(h + 1, 32)]] = True
+    want[31] = want[31] or False
+    np.testing.assert_array_equal(small, want | np.isin(np.arange(33), [64 - 31]))
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(speeds=[1e308]), ["speeds", "rev/s"]), (dict(speeds=[1e-6]), ["speeds"]),
+    (dict(loads=[1e12]), ["loads", "N m"]), (dict(loads=[1e9]), ["loads"]),
+])
+def test_database_physical_bounds(tmp_path, kw, words):
+    from gearshot.sim import build_database
+
+    with pytest.raises(GearshotError) as info:
+        build_database(tmp_path / "db", **{**KW, **kw})
+    assert all(w in str(info.value) for w in words)
+    assert not (tmp_path / "db").exists()
+
+
+def test_recording_and_simulator_bounds():
+    from gearshot.io import Recording
+    from gearshot.sim import GearPair, simulate_sa
+
+    with pytest.raises(GearshotError, match="fs must be <= 1e"):
+        Recording(np.zeros(10), None, 1e300)
+    with pytest.raises(GearshotError, match="load must lie"):
+        simulate_sa(GearPair.paper(), speed=15, load=1e12, grade=7, n_points=64)
+    with pytest.raises(GearshotError, match="speed must lie"):
+        simulate_sa(GearPair.paper(), speed=1e308, load=10, grade=7, n_points=64)
