@@ -272,8 +272,10 @@ def staging_dir(folder: str | os.PathLike) -> Iterator[Path]:
     """
     folder = Path(folder)
     _make_folder(folder, folder)
+    remove_stale_temporaries(folder)
     try:
-        staging = Path(tempfile.mkdtemp(prefix=".staging-", suffix=".tmp", dir=folder))
+        staging = Path(tempfile.mkdtemp(prefix=f".staging.g{os.getpid()}@{_HOST}-",
+                                        suffix=".tmp", dir=folder))
     except OSError as exc:
         raise _fail(folder, exc) from None
     try:
@@ -289,7 +291,7 @@ def remove_tree(path: str | os.PathLike) -> None:
     path = Path(path)
     if not path.exists():
         return
-    trash = path.with_name(f".{path.name}.removed-{os.getpid()}.tmp")
+    trash = path.with_name(f"{_temp_prefix(path)}removed.tmp")
     try:
         os.rename(path, trash)
     except OSError as exc:
