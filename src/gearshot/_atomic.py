@@ -143,7 +143,7 @@ def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
     """
     removed = []
     with contextlib.suppress(OSError):
-        for entry in os.scandir(folder):
+        for entry in os.scandir(os.fspath(folder)):
             m = _STALE.match(entry.name)
             if m is None or m.group(2) != _HOST or _alive(int(m.group(1))):
                 continue

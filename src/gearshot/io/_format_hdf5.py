@@ -14,8 +14,10 @@ Layout (``format_version`` 1)::
     /acceleration           (n_samples,) float64 or float32; attribute units
     /tacho                  (n_samples,) same dtype, LZF-compressed (absent = no tacho)
 
-Both datasets are written in chunks with Fletcher-32 checksums (HDF5 refuses a damaged
-chunk); every reader first checks that each dataset's declared bytes lie inside the file.
+The tacho's chunks carry Fletcher-32 checksums (HDF5 refuses a damaged chunk); every reader
+first checks that each dataset's declared bytes lie inside the file. (A chunked acceleration
+would carry checksums too, but HDF5 then crashes the process when a write fails on a full
+disk: it stays contiguous.)
 
 Files are written to a temporary name in the target folder and moved into place with
 ``os.replace``, so a reader never sees a half-written file. A generic HDF5 file (no
@@ -146,11 +148,9 @@ def write_hdf5(rec: Any, path: Path, *, dtype: Any = np.float64) -> None:
             f.attrs["fs"] = float(rec.fs)
             f.attrs["n_samples"] = int(rec.acceleration.size)
             f.attrs["metadata_json"] = json.dumps(rec.metadata, sort_keys=True)
-            # chunks with Fletcher-32 checksums: HDF5 refuses a damaged chunk on read
-            chunks = (min(rec.acceleration.size, 1 << 16),)
-            d = f.create_dataset("acceleration", data=rec.acceleration.astype(dtype, copy=False),
-                                 chunks=chunks, fletcher32=True)
+            d = f.create_dataset("acceleration", data=rec.acceleration.astype(dtype, copy=False))
             d.attrs["units"] = rec.units
-            if rec.tacho is not None:
+            if rec.tacho is not None:   # Fletcher-32: HDF5 refuses a damaged chunk on read
                 f.create_dataset("tacho", data=rec.tacho.astype(dtype, copy=False),
-                                 compression="lzf", chunks=chunks, fletcher32=True)
+                                 compression="lzf", chunks=(min(rec.tacho.size, 1 << 16),),
+                                 fletcher32=True)

@@ -83,7 +83,8 @@ def store_lock(store: Path, manifest: dict, *, progress: bool = True) -> Iterato
             if other is None:
                 time.sleep(0.1)
         if other is not None and other.get("manifest_sha256") != digest:
-            theirs = other.get("manifest") if isinstance(other.get("manifest"), dict) else {}
+            recorded = other.get("manifest")
+            theirs: dict = recorded if isinstance(recorded, dict) else {}
             raise GearshotError(
                 f"store {str(store)!r} is being built right now by process "
                 f"{other.get('pid')} on {other.get('host')!r} with other arguments "

@@ -213,7 +213,8 @@ def _ownership_problem(path: Path, manifest: dict, i: int, j: int, k: int,
     if digest is not None:
         if digest == manifest_digest(manifest):
             return None
-        theirs = record.get("manifest") if isinstance(record.get("manifest"), dict) else {}
+        recorded = record.get("manifest")
+        theirs: dict = recorded if isinstance(recorded, dict) else {}
         return f"it was built by another build (differs in {manifest_diff(theirs, manifest)})"
     import xarray as xr
 
@@ -272,6 +273,7 @@ def _check_against_manifest(store: Path, path: Path, part, man: dict, where: str
     record = _block_record(path)
     digest = record.get("manifest_sha256")
     theirs = _block_manifest(path)
+    problem: str | None
     if digest is not None and digest != manifest_digest(man):
         problem = ("it records another build than manifest.json (differs in "
                    f"{manifest_diff(theirs or {}, man)})")
