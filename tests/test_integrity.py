@@ -650,3 +650,24 @@ def test_recording_and_simulator_bounds():
         simulate_sa(GearPair.paper(), speed=15, load=1e12, grade=7, n_points=64)
     with pytest.raises(GearshotError, match="speed must lie"):
         simulate_sa(GearPair.paper(), speed=1e308, load=10, grade=7, n_points=64)
+
+
+def test_rig_family_cache_is_keyed_by_frf_contents():
+    import dataclasses
+
+    from gearshot.experiments.family import _tf_digest
+    from gearshot.transfer import TransferFunctionBank
+
+    tf = TransferFunctionBank.synthetic(1, rng=0)[0]
+    same_name = dataclasses.replace(tf, values=tf.values * 1.01)
+    assert same_name.name == tf.name and _tf_digest(same_name) != _tf_digest(tf)
+    assert _tf_digest(dataclasses.replace(tf)) == _tf_digest(tf)
+
+
+def test_os_errors_are_one_line(tmp_path):
+    from gearshot._atomic import atomic_path
+
+    with pytest.raises(GearshotError) as info:
+        with atomic_path(tmp_path / "a.h5"):
+            raise OSError(27, "file write failed: time = x\n, errno = 27, 'File too large'")
+    assert "\n" not in str(info.value) and "a.h5" in str(info.value)

@@ -60,7 +60,8 @@ def _is_io_error(exc: BaseException) -> bool:
 
 
 def _fail(path: Path, exc: BaseException, what: str = "write") -> GearshotError:
-    return GearshotError(f"cannot {what} {str(path)!r}: {os_error_text(exc)}")
+    text = " ".join(os_error_text(exc).split())     # libraries' messages may span lines
+    return GearshotError(f"cannot {what} {str(path)!r}: {text}")
 
 
 def check_writable(path: str | os.PathLike, name: str, *, folder: bool = False) -> Path:
