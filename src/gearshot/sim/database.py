@@ -270,18 +270,17 @@ def _check_against_manifest(store: Path, path: Path, part, man: dict, where: str
     repair named is the blocks' build when every block vouches for another manifest than
     ``manifest.json`` (the file was edited), else a rebuild of this block.
     """
-    record = _block_record(path)
-    digest = record.get("manifest_sha256")
-    theirs = _block_manifest(path)
+    digest = _block_record(path).get("manifest_sha256")
     problem: str | None
     if digest is not None and digest != manifest_digest(man):
         problem = ("it records another build than manifest.json (differs in "
-                   f"{manifest_diff(theirs or {}, man)})")
+                   f"{manifest_diff(_block_manifest(path) or {}, man)})")
     else:
         problem = block_content_problem(part, man, i, j, k, fault_type,
                                         list(FAULT_TYPES).index(fault_type))
     if problem is None:
         return
+    theirs = _block_manifest(path)
     if theirs is not None and theirs != man and all(
             _block_manifest(b) == theirs for b in (store / "blocks").glob("*.zarr")):
         raise GearshotError(f"{where} contradicts manifest.json: {problem}; manifest.json "
