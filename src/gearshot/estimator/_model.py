@@ -43,6 +43,7 @@ from ._params import (
     validate_params,
 )
 from .steps import KnnModel
+from .comparability import Comparability, fit_comparability
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
 
@@ -362,6 +363,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         The seeds the random steps used.
     simulated_reference_ : {"first_healthy", "twin"}
         The simulated reference step 6 used (``simulated_reference`` with "auto" resolved).
+    comparability_reference_ : ComparabilityReference
+        The fitted machine's harmonic profiles (healthy mean, the example's direction,
+        healthy spread) that :meth:`comparability` measures segments against
+        (:mod:`gearshot.estimator.comparability`).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -488,6 +493,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                   "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot}[strategy]
         choice = choose(ctx)
         models = {g: ctx.model_for(g) for g in choice.weights}
+        comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
+                                          faulty_example=inputs.faulty_example,
+                                          faulty_size=inputs.faulty_size)
         best = ctx.model_for(choice.grade)
 
         learned = dict(
@@ -501,7 +509,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             grade_strategy_=strategy, grade_=choice.grade, grade_weights_=choice.weights,
             grade_models_=models, model_=best, tuning_curve_=choice.tuning_curve,
             n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
-            step_seeds_=seeds, simulated_reference_=reference)
+            step_seeds_=seeds, simulated_reference_=reference,
+            comparability_reference_=comparability)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
@@ -756,6 +765,38 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         X = self.features_of(sa)
         return sum((w * self.grade_models_[g].predict(X)
                     for g, w in self.grade_weights_.items()), np.zeros(len(X)))
+
+    def comparability(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
+        """Whether target SAs look like the fitted machine (know when not to answer).
+
+        Compares each SA's regular part — the unit-norm amplitudes of its mesh-harmonic
+        orders (:func:`~gearshot.estimator.comparability.harmonic_profile`) — with the
+        fitted machine's states: the healthy SAs' mean profile, moved toward the faulty
+        example's profile as a fault grows to size 1. The score is the distance from
+        those states in units of the healthy SAs' own spread; a segment of another build,
+        another speed or load than the database's, or another sensor lies far from them
+        and is not comparable: its estimate should not be acted on.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        threshold : float > 0, optional
+            Largest score of a comparable segment; default
+            :data:`~gearshot.estimator.comparability.DEFAULT_THRESHOLD` (3.0, chosen on
+            the PHM 2009 spur subset's 30 Hz cells, benchmarks/RESULTS.md).
+
+        Returns
+        -------
+        Comparability
+            ``score`` (n_signals,), ``comparable`` (bool, ``score <= threshold``) and
+            ``threshold``.
+        """
+        self._check_fitted("comparability")
+        reference = getattr(self, "comparability_reference_", None)
+        if reference is None:  # an estimator saved before comparability existed
+            raise GearshotError("this estimator was fitted by an older gearshot without "
+                                "a comparability reference; fit it again")
+        return reference.evaluate(sa, threshold)
 
     def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
                          ) -> tuple[FloatArray, FloatArray]:
