@@ -42,8 +42,8 @@ from ._params import (
     RandomStateValue,
     validate_params,
 )
-from .steps import KnnModel
 from .comparability import Comparability, fit_comparability
+from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
 
