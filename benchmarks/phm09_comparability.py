@@ -85,6 +85,42 @@ def _pooled(table: pd.DataFrame, which: str) -> str:
             f"({int((~s1.comparable.astype(bool)).sum())}/{len(s1)})")
 
 
+def _cross_conditions(args) -> pd.DataFrame:
+    """Every fit's comparability reference (as ``fit`` builds it: the fit segments of
+    spur3 and spur2's segment 0) scoring spur3's segments of every *other* cell and
+    sensor: another sensor, another load, another speed of the same build."""
+    from gearshot.app.predict_machine import machine_segments
+    from gearshot.estimator.comparability import fit_comparability
+
+    machine = Machine.from_toml(ROOT / "examples" / "machines" / "phm09_spur.toml")
+    meshes = list(machine.mesh_orders(machine.monitored.shaft))
+    fits = [(sp, ld, se) for sp in (30, 40) for ld in ("High", "Low")
+            for se in ("acc_input", "acc_output")]
+    seg = {}
+    for sp, ld, se in fits:
+        for case in ("spur2", "spur3"):
+            seg[case, sp, ld, se] = machine_segments(
+                args.data / f"{case}_{sp}hz_{ld}_1.zip", machine, cycles_per_segment=10,
+                sensor=se)[0]
+    rows = []
+    for sp, ld, se in fits:
+        healthy = seg["spur3", sp, ld, se]
+        n_fit = healthy.shape[0] - int(np.floor(0.25 * healthy.shape[0]))
+        ref = fit_comparability(healthy[:n_fit], meshes,
+                                faulty_example=seg["spur2", sp, ld, se][0],
+                                faulty_size=args.size)
+        for sp2, ld2, se2 in fits:
+            if (sp2, ld2, se2) == (sp, ld, se):
+                continue
+            kind = "+".join(k for k, a, b in (("speed", sp, sp2), ("load", ld, ld2),
+                                                ("sensor", se, se2)) if a != b)
+            res = ref.evaluate(seg["spur3", sp2, ld2, se2])
+            rows.extend(dict(set="dev" if sp in DEV_SPEEDS else "held-out", other=kind,
+                             score=s, comparable=bool(c))
+                        for s, c in zip(res.score, res.comparable))
+    return pd.DataFrame(rows)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--database", type=Path, required=True)
@@ -104,6 +140,17 @@ def main() -> None:
     print()
     for which in ("dev", "held-out", "all"):
         print(_pooled(table, which))
+    cross = _cross_conditions(args)
+    print()
+    print("spur3 segments of another cell/sensor scored by each fit's reference "
+          "(flagged = not comparable):")
+    summary = cross.groupby(["set", "other"]).comparable.agg(n="size", comparable="mean")
+    summary["flagged"] = 1 - summary.pop("comparable")
+    print(summary.to_string(float_format=lambda v: f"{v:.1%}"))
+    for which in ("dev", "held-out"):
+        sub = cross[cross.set == which]
+        print(f"{which}: another condition or sensor flagged {1 - sub.comparable.mean():.1%} "
+              f"({int((~sub.comparable).sum())}/{len(sub)})")
     print(f"per-segment table: {args.out}; fit+predict "
           f"{np.round(table.groupby(['cell', 'sensor']).seconds.first().to_numpy(), 1)} s")
 
