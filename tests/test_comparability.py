@@ -181,3 +181,38 @@ def test_bad_input_names_the_argument(call, words):
 def test_comparability_before_fit_is_an_error():
     with pytest.raises(NotFittedError, match="comparability"):
         OneFaultShotEstimator().comparability(np.zeros((2, N)))
+
+
+def test_predict_without_machine_writes_the_columns(tmp_path):
+    """`gearshot predict` (files of the paper's pair) carries comparability + comparable."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    from gearshot.rig import VirtualRig
+
+    env = {**os.environ, "GEARSHOT_DATA": str(tmp_path / "home")}
+    idx = VirtualRig(seed=1, engine="surrogate").campaign(
+        tmp_path / "camp", speed=15, load=10, duration=8.0, healthy=3, sizes=(0.5,),
+        repetitions=1, progress=False)
+    paths = idx["path"].tolist()  # three healthy (one SA each), one faulty
+    cli = [sys.executable, "-m", "gearshot.app.cli"]
+    res = subprocess.run([*cli, "simulate", "--speed", "15", "--load", "10", "--grade", "7",
+                          "--n-healthy", "6", "--n-faulty", "12",
+                          "--store", str(tmp_path / "db")], capture_output=True, text=True,
+                         env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    out = tmp_path / "p.json"
+    res = subprocess.run([*cli, "predict", "--database", str(tmp_path / "db"), "--healthy",
+                          paths[0], "--healthy", paths[1], "--faulty", paths[3],
+                          "--faulty-size", "0.5", "--recordings", paths[2], "--speed", "15",
+                          "--load", "10", "--out", str(out)], capture_output=True,
+                         text=True, env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    records = json.loads(out.read_text())
+    assert len(records) == 1
+    assert isinstance(records[0]["comparable"], bool)
+    assert records[0]["comparability"] >= 0
+    n_yes = int(records[0]["comparable"])
+    assert f"comparable: {n_yes} segment(s), not comparable: {1 - n_yes}" in res.stdout
