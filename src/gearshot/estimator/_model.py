@@ -367,6 +367,17 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         have no residue, so the raw target signature points at rougher grades.
         "denoised" was chosen on the rig family's development range (zero-shot MAE
         16.4 % against 18.8 % raw, benchmarks/RESULTS.md).
+    calibration : {"grade", "joint"}, CalibrationOptions or mapping, default "grade"
+        What the one example calibrates (with soft grade weighting). "grade": the grade
+        only, each grade weighted by how well its model predicts the example's size.
+        "joint" (paired databases; otherwise "grade"): every setting of a grid of grade ×
+        fault gain × fault width × TF mode (× noise scale) on the twin differences,
+        weighted by how well it explains the example's whole feature vector
+        (:mod:`gearshot.estimator.calibration`); a :class:`CalibrationOptions` (or a
+        mapping of its fields) sets that grid. On the rig family's development range
+        (issue #19) "joint" scored 12.0 % (11.6 % matching the selected features only)
+        against 11.3 % for "grade", within the draw-to-draw noise (± 0.8), with more even
+        conditions (worst 13.2 against 15.7 %) but a worse p90; "grade" was kept.
 
     Attributes
     ----------
@@ -378,8 +389,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     selection_features_ : (train, test) tuple of ndarray or None
         Step 1's paired candidate features through the estimated and the held-out TF
         (the paper's Fig. 11; see :func:`gearshot.plotting.plot_feature_invariance`).
-    grade_strategy_ : {"tuned", "soft", "nominal", "zero_shot"}
-        The grade-choice strategy that ran.
+    grade_strategy_ : {"tuned", "soft", "joint", "nominal", "zero_shot"}
+        The grade-choice strategy that ran ("joint": ``calibration="joint"`` on a paired
+        database).
     grade_ : int
         The best grade (the paper's choice).
     grade_weights_ : dict grade → weight
@@ -402,6 +414,14 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         The seeds the random steps used.
     simulated_reference_ : {"first_healthy", "twin"}
         The simulated reference step 6 used (``simulated_reference`` with "auto" resolved).
+    calibration_ : dict
+        What the example calibrated: ``strategy`` ("grade" or "joint"), ``settings`` (list
+        of dicts ``grade, gain, width, tf, noise, weight`` — and ``log_likelihood`` with
+        "joint" — largest weight first; the models that predict, their weights summing
+        to 1), ``grid`` (with "joint": every setting tried, its log-likelihood and
+        weight; else None) and ``options`` (the joint grid's options or None).
+    setting_models_ : list of KnnModel
+        One model per entry of ``calibration_["settings"]``.
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -442,7 +462,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  fault_type: str | None = None,
                  simulated_reference: str = "auto",
                  zero_shot_signature: str = "denoised",
-                 calibration: str | CalibrationOptions | Mapping[str, Any] = "joint") -> None:
+                 calibration: str | CalibrationOptions | Mapping[str, Any] = "grade") -> None:
         self.calibration = calibration
         self.fault_type = fault_type
         self.zero_shot_signature = zero_shot_signature

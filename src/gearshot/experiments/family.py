@@ -266,12 +266,14 @@ def true_path_on_grid(rig: FamilyRig, paths, n_points=2048, gear_teeth=38, pinio
 
 
 def _diagnostic_params(name, rig, paths):
-    if name in ("oracle_tf", "oracle_both"):
+    if name == "oracle_tf":
         return dict(transfer_function=true_path_on_grid(rig, paths))
+    if name == "oracle_both":
+        return dict(transfer_function=true_path_on_grid(rig, paths), calibration="joint")
     if name == "true_grade":
         return dict(tune_simulation=False, nominal_grade=int(rig.grade))
     if name == "oracle_calibration":
-        return {}
+        return dict(calibration="joint")
     raise GearshotError(f"unknown diagnostic variant {name!r}")
 
 
