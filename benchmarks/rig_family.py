@@ -18,9 +18,9 @@ faulty per grade and condition) serves every rig. Results are appended to
 rigs on a Dask LocalCluster of N single-threaded processes.
 
 ``--param NAME=VALUE`` sets an estimator parameter for every variant (a new configuration:
-its rows are computed afresh; VALUE is parsed as JSON when it can be). The database holds the healthy twins (paired, the
-default), which ``simulated_reference="auto"`` then subtracts; ``--no-paired`` uses the old
-unpaired one.
+its rows are computed afresh; VALUE is parsed as JSON when it can be). The database holds
+the healthy twins (paired, the default), which ``simulated_reference="auto"`` then
+subtracts; ``--no-paired`` uses the old unpaired one.
 
 The same run from the command line: ``gearshot experiment rig-family`` (same options).
 """

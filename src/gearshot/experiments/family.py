@@ -38,7 +38,8 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_int
 
-__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS", "SA_PIPELINE_VERSION", "FamilyRig",
+__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS",
+           "SA_PIPELINE_VERSION", "FamilyRig",
            "family_paths", "draw_family", "rig_family_experiment", "family_tables", "path_kind",
            "family_database", "parse_params", "format_family_tables", "RANGES"]
 
