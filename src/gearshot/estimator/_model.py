@@ -559,7 +559,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         for st in settings:
             grade_w[st["grade"]] = grade_w.get(st["grade"], 0.0) + st["weight"]
         grade_w = dict(sorted(grade_w.items(), key=lambda kv: -kv[1]))
-        models = {}
+        models: dict[int, KnnModel] = {}
         for st, m in zip(settings, setting_models):
             models.setdefault(st["grade"], m)   # settings come largest weight first
         best = setting_models[0] if choice.settings is not None else ctx.model_for(choice.grade)
@@ -826,7 +826,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         w_all /= w_all.sum()
         order = np.argsort(-w_all, kind="stable")[: int(options.max_settings)]
         kept = prune_weights(order, w_all[order])
-        settings = []
+        settings: list[dict[str, Any]] = []
         for i, wt in kept.items():
             g, a, w, m, ns = keys[i]
             settings.append(dict(grade=g, gain=a, width=w, tf=m, noise=ns, weight=wt,
@@ -836,7 +836,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                     width=np.array([k[2] for k in keys]), tf=np.array([k[3] for k in keys]),
                     noise=np.array([k[4] for k in keys]), log_likelihood=loglik,
                     weight=w_all)
-        return _GradeChoice(settings[0]["grade"], {}, None, settings, models, grid)
+        return _GradeChoice(int(settings[0]["grade"]), {}, None, settings, models, grid)
 
     def _calibration_examples(self, ctx: _FitContext) -> tuple[FloatArray, FloatArray]:
         """The faulty SAs (and sizes) the calibration explains: the one example.
