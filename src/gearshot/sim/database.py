@@ -227,7 +227,7 @@ def _rebuild_hint(store: Path, man: dict) -> str:
            f"--n-healthy {man.get('n_healthy')} --n-faulty {man.get('n_faulty')} "
            f"--seed {man.get('seed')}"
            + "".join(f" --fault-type {t}" for t in man.get("fault_types", []))
-           + (" --paired" if man.get("paired") else ""))
+           + ("" if man.get("paired") else " --no-paired"))   # paired is the default
     return (f"run `{cmd}` (or build_database with the same arguments): it rebuilds only "
             f"the damaged block and reuses the rest")
 
