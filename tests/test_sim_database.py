@@ -171,8 +171,8 @@ def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
     # the repair command of a damaged store rebuilds the same layout
     from gearshot.sim.database import _read_manifest, _rebuild_hint
     assert "--no-paired" in _rebuild_hint(tmp_path / "plain", _read_manifest(tmp_path / "plain"))
-    assert "paired" not in _rebuild_hint(tmp_path / "paired",
-                                         _read_manifest(tmp_path / "paired"))
+    assert "--no-paired" not in _rebuild_hint(tmp_path / "paired",
+                                              _read_manifest(tmp_path / "paired"))
     with pytest.raises(GearshotError, match="paired must be True or False; got 'yes'"):
         build_database(tmp_path / "other", client=False, progress=False, paired="yes",
                        **PAIR_KW)
