@@ -37,6 +37,9 @@ SAFE_TYPES = (
     "builtins.range",
     "gearshot.estimator._model.OneFaultShotEstimator",
     "gearshot.estimator.steps.KnnModel",
+    "gearshot.estimator.calibration.CalibrationOptions",
+    "gearshot.estimator.comparability.Comparability",
+    "gearshot.estimator.comparability.ComparabilityReference",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",
     "sklearn.neighbors._kd_tree.KDTree",
 )
