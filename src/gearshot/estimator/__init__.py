@@ -11,7 +11,7 @@
 
 from .._errors import NotFittedError
 from . import steps, uncertainty
-from ._model import STEP_SEEDS, OneFaultShotEstimator
+from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -32,6 +32,7 @@ __all__ = [
     "OneFaultShotEstimator",
     "NotFittedError",
     "STEP_SEEDS",
+    "default_selection_tf",
     "steps",
     "uncertainty",
     "select_features",
