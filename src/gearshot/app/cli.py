@@ -26,6 +26,12 @@ experiment_app = typer.Typer(help="Run the paper's experiments (Sec. 4.1 and 4.2
                              no_args_is_help=True)
 app.add_typer(experiment_app, name="experiment")
 
+HELP_N_HEALTHY = "Simulated healthy signals per grade and condition."
+HELP_N_FAULTY = ("Simulated faulty signals per grade and condition (sizes drawn uniformly "
+                 "in (0, 1]).")
+HELP_SCHEDULER = "Address of a running Dask scheduler (default: a LocalCluster of --workers)."
+HELP_WORKERS = "LocalCluster workers when no --scheduler is given."
+
 PAPER_SPEEDS = [float(s) for s in range(10, 36)]
 PAPER_LOADS = [5.0, 10.0, 15.0, 20.0]
 
@@ -177,9 +183,10 @@ def simulate(
     speed: list[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps."),
     load: list[float] = typer.Option([10.0], "--load", help="Load(s), Nm."),
     grade: list[int] = typer.Option(list(range(1, 13)), "--grade", help="DIN grade(s)."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
-    seed: int = typer.Option(0, "--seed"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
+    seed: int = typer.Option(0, "--seed", help="Seed of the profile errors, fault sizes and "
+                             "noise (each block from its own child seed)."),
     paper: bool = typer.Option(False, "--paper", help="All paper speeds (10–35 rps) and "
                                "loads (5–20 Nm)."),
     scheduler: str | None = typer.Option(None, "--scheduler", help="Address of a "
@@ -258,12 +265,13 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
 @app.command()
 def rig(
     folder: Path = typer.Argument(..., help="Campaign folder (created)."),
-    speed: float = typer.Option(15.0, "--speed"),
-    load: float = typer.Option(10.0, "--load"),
+    speed: float = typer.Option(15.0, "--speed", help="Input (pinion) speed of the rig, "
+                                "rps."),
+    load: float = typer.Option(10.0, "--load", help="Load torque of the rig, N m."),
     duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
-    healthy: int = typer.Option(6, "--healthy"),
+    healthy: int = typer.Option(6, "--healthy", help="Number of healthy recordings."),
     size: list[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
-    repetitions: int = typer.Option(6, "--repetitions"),
+    repetitions: int = typer.Option(6, "--repetitions", help="Recordings per fault size."),
     seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "for the transfer path (default synthetic)."),
@@ -300,23 +308,26 @@ def _make_rig(seed, frf_folder, rig_grade):
 def experiment_simulated(
     store: Path | None = typer.Option(None, "--store", help="Database store (built if "
                                          "missing)."),
-    speed: list[float] = typer.Option([15.0], "--speed"),
-    load: list[float] = typer.Option([10.0], "--load"),
+    speed: list[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps "
+                                      "(repeat the option)."),
+    load: list[float] = typer.Option([10.0], "--load", help="Load(s), N m (repeat the "
+                                     "option)."),
     grade: int = typer.Option(7, "--grade", help="Grade of the simulated signals."),
-    attenuation_db: list[float] = typer.Option([10.0], "--attenuation-db"),
+    attenuation_db: list[float] = typer.Option([10.0], "--attenuation-db", help="Path "
+                                               "attenuation(s) of the measured TFs, dB."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "(default: a synthetic bank of 24)."),
     selection_tf: str | None = typer.Option(None, "--selection-tf", help="Name of the "
                                                "held-out TF (default the bank's last)."),
-    seed: int = typer.Option(0, "--seed"),
+    seed: int = typer.Option(0, "--seed", help="Seed of the database and the splits."),
     full: bool = typer.Option(False, "--full", help="The paper's sweep: 26 speeds × 4 loads "
                               "× 23 TFs."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
     json_out: Path | None = typer.Option(None, "--json", help="Write results as JSON."),
     out: Path | None = typer.Option(None, "--out", help="Folder for figures and report."),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
-    workers: int = typer.Option(2, "--workers"),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
+    workers: int = typer.Option(2, "--workers", help=HELP_WORKERS),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
     if frf_folder is not None and not frf_folder.is_dir():
@@ -363,23 +374,26 @@ def experiment_simulated(
 def experiment_rig(
     campaign: Path | None = typer.Option(None, "--campaign", help="Campaign folder "
                                             "(recorded if missing)."),
-    store: Path | None = typer.Option(None, "--store"),
-    speed: float = typer.Option(15.0, "--speed"),
-    load: float = typer.Option(10.0, "--load"),
-    seed: int = typer.Option(0, "--seed"),
-    frf_folder: Path | None = typer.Option(None, "--frf-folder"),
-    rig_grade: int | None = typer.Option(None, "--rig-grade"),
+    store: Path | None = typer.Option(None, "--store", help="Database store (built if "
+                                         "missing; default under gearshot's data home)."),
+    speed: float = typer.Option(15.0, "--speed", help="Input speed, rps."),
+    load: float = typer.Option(10.0, "--load", help="Load, N m."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
+    frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs for "
+                                              "the rig's path (default synthetic)."),
+    rig_grade: int | None = typer.Option(None, "--rig-grade", help="Force the rig's true "
+                                            "surface grade (default: hidden, drawn)."),
     attenuation_db: float | None = typer.Option(None, "--attenuation-db",
                                                    help="Rig path attenuation (default "
                                                    "hidden, 10–30 dB)."),
-    duration: float = typer.Option(60.0, "--duration"),
+    duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
     repeats: int = typer.Option(5, "--repeats", help="Random example draws."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
-    json_out: Path | None = typer.Option(None, "--json"),
-    out: Path | None = typer.Option(None, "--out"),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
-    workers: int = typer.Option(2, "--workers"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
+    json_out: Path | None = typer.Option(None, "--json", help="Write results as JSON."),
+    out: Path | None = typer.Option(None, "--out", help="Folder for figures and report."),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
+    workers: int = typer.Option(2, "--workers", help=HELP_WORKERS),
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
     paired: bool = typer.Option(False, "--paired", help="Build and use the database with "
@@ -487,7 +501,7 @@ def experiment_rig_family(
     json_out: Path | None = typer.Option(None, "--json", help="Write the summary tables "
                                             "as JSON."),
     rigs_table: bool = typer.Option(False, "--rigs-table", help="Print the per-rig table."),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
     workers: int = typer.Option(1, "--workers", help="LocalCluster workers (rigs in "
                                 "parallel) when no --scheduler is given."),
 ) -> None:
