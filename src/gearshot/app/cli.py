@@ -257,8 +257,9 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
             client.close()
     mate_shaft, _ = mach.mate()
     typer.echo(f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
-               f"gear); {mate_shaft} speeds {[round(s, 4) for s in sim_speeds]} rev/s for "
-               f"{mach.tacho.shaft} speeds {list(speeds)}")
+               f"gear, its mate on the {mate_shaft} shaft); conditions: {mach.tacho.shaft} "
+               f"(tacho) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "
+               f"{', '.join(f'{x:g}' for x in loads)} N m")
     typer.echo(f"database ready: {store}")
 
 
