@@ -134,10 +134,19 @@ def _family_report(payload, out: Path) -> Path:
              f"Range {payload.get('range')}, {len(payload.get('seeds', []))} rigs x "
              f"{payload.get('draws')} draws; parameters {payload.get('params') or 'defaults'}.",
              "MAE and coverage in %.", ""]
-    for name, split in payload["tables"].items():
-        frame = pd.DataFrame(split.get("data", []), columns=split.get("columns"),
-                             index=split.get("index"))
+    tables = {name: pd.DataFrame(split.get("data", []), columns=split.get("columns"),
+                                 index=split.get("index"))
+              for name, split in payload["tables"].items()}
+    for name, frame in tables.items():
         lines += [f"## {name}", ""] + _md_table(frame.reset_index(names=""), "{:.1f}")
+    cond = tables.get("condition")
+    if cond is not None and len(cond.columns):
+        from .figures import ablation_figure
+
+        col = "mean" if "mean" in cond else cond.columns[0]
+        fig = ablation_figure({str(k): float(v) / 100 for k, v in cond[col].items()}, out,
+                              name="family_mae")
+        lines += ["## MAE by variant over the rigs", "", f"![MAE by variant]({fig.name})", ""]
     target = out / "report.md"
     write_text_atomic(target, "\n".join(lines), make_parents=True)
     return target
