@@ -298,7 +298,7 @@ def test_one_record_indicators_path_imports_no_heavy_package(small):
             f"record_indicators; m = Machine.from_toml({str(SPUR)!r}); "
             f"record_indicators([{str(small['spur2'])!r}], m, shaft='input'); "
             f"print(sorted(k for k in ('dask', 'xarray', 'zarr', 'matplotlib', 'numba', "
-            f"'scipy.signal', 'h5py', 'sklearn') if k in sys.modules))")
+            f"'scipy.signal', 'h5py', 'sklearn', 'pandas') if k in sys.modules))")
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300)
     assert res.returncode == 0, res.stderr

@@ -687,7 +687,7 @@ def indicators(
     """Condition indicators of one shaft per recording and sensor (--labels: a ranking)."""
     from ..machine import Machine
     from .files import expand_recordings
-    from .indicators import indicator_figures, indicator_table, record_indicators
+    from .indicators import format_indicators, indicator_figures, record_indicators
 
     mach = Machine.from_toml(machine)
     _early(json_out, "--json")
@@ -701,9 +701,7 @@ def indicators(
         label_table = read_labels(labels, [f.name for f in files])
     payload = record_indicators(files, mach, shaft=shaft, sensors=sensor or None,
                                 baseline_paths=base, machine_file=machine)
-    table = indicator_table(payload)
-    typer.echo(table.drop(columns=["case", "condition"]).to_string(
-        index=False, float_format=lambda v: f"{v:.4g}"))
+    typer.echo(format_indicators(payload))
     if label_table is not None:
         from .ranking import format_ranking, indicator_ranking, ranking_figure
 

@@ -12,6 +12,7 @@ import numpy as np
 from .._errors import GearshotError
 
 __all__ = ["shaft_indicators", "record_indicators", "indicator_table", "indicator_figures",
+           "format_indicators", "indicator_units",
            "baseline_variance", "INDICATOR_EXTRAS"]
 
 #: Indicators added to every registered feature: RMS of the raw (mean-removed) time signal
@@ -179,6 +180,22 @@ def _case_of(file_name: str) -> tuple[str, str]:
     stem = re.sub(r"(\.[A-Za-z0-9]+)+$", "", file_name)
     case, _, rest = stem.partition("_")
     return case, rest
+
+
+def format_indicators(payload: dict[str, Any]) -> str:
+    """The payload as the aligned text table ``gearshot indicators`` prints (one row per
+    record and sensor; plain Python, so that a one-record call does not import pandas)."""
+    head = ["file", "sensor", "tacho_hz", "shaft_hz", "n_cycles"]
+    rows = []
+    for r in payload["records"]:
+        rows.append([r["file"], r.get("sensor", ""), f"{r['tacho_speed_hz']:.4g}",
+                     f"{r['shaft_speed_hz']:.4g}", str(r["n_cycles"])]
+                    + [f"{v:.4g}" for v in r["indicators"].values()])
+    if payload["records"]:
+        head += list(payload["records"][0]["indicators"])
+    widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
+    lines = [" ".join(str(c).rjust(w) for c, w in zip(line, widths)) for line in [head, *rows]]
+    return "\n".join(lines)
 
 
 def indicator_table(payload: dict[str, Any]):
