@@ -66,6 +66,11 @@ def test_several_files_after_one_option_are_spread():
     assert spread_file_options(argv) == [
         "predict", "--healthy", "a.zip", "--healthy", "b.zip", "--faulty", "f.zip",
         "--recordings", "c.zip", "--recordings", "d", "--speed", "-3", "--", "--healthy", "x"]
+    # `gearshot rig --healthy 6 FOLDER`: a count, and FOLDER stays the argument
+    assert spread_file_options(["rig", "--healthy", "6", "out"]) == ["rig", "--healthy", "6",
+                                                                      "out"]
+    assert spread_file_options(["indicators", "--baseline", "h1", "h2"]) == [
+        "indicators", "--baseline", "h1", "--baseline", "h2"]
 
 
 def test_healthy_takes_several_files_on_the_command_line(small, tmp_path):

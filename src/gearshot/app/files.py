@@ -18,13 +18,18 @@ from .._errors import GearshotError
 
 __all__ = ["FILE_OPTIONS", "spread_file_options", "expand_recordings", "recording_suffixes"]
 
-#: Options that take recording files, each any number of them after one flag
-FILE_OPTIONS = frozenset({"--healthy", "--recordings", "--baseline"})
+#: Options that take recording files, each any number of them after one flag, by command
+#: (``gearshot rig --healthy N`` is a count, not files)
+FILE_OPTIONS = {"predict": frozenset({"--healthy", "--recordings"}),
+                "indicators": frozenset({"--baseline"})}
 
 
 def spread_file_options(argv: Sequence[str]) -> list[str]:
-    """``--healthy a b`` -> ``--healthy a --healthy b`` for every option of
-    :data:`FILE_OPTIONS`; everything after ``--`` is left as it is."""
+    """``--healthy a b`` -> ``--healthy a --healthy b`` for the file options of the
+    command (the first word not starting with ``-``; :data:`FILE_OPTIONS`); everything
+    after ``--`` is left as it is."""
+    command = next((w for w in argv if not w.startswith("-")), None)
+    options = FILE_OPTIONS.get(command or "", frozenset())
     out: list[str] = []
     current: str | None = None
     first = False
@@ -32,7 +37,7 @@ def spread_file_options(argv: Sequence[str]) -> list[str]:
         if word == "--":
             out.extend(argv[k:])
             break
-        if word in FILE_OPTIONS:
+        if word in options:
             current, first = word, True
             out.append(word)
             continue
