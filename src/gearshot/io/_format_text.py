@@ -158,11 +158,11 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
         raise GearshotError(f"{str(path)!r}: header=True but the first row {rows[0][:60]!r} is "
                             f"numeric (no header row?)")
     n_cols = len(_split(rows[1] if len(rows) > 1 else rows[0], delimiter))
-    data = None
+    table = None
     if not header and delimiter is None:
-        data = _plain_numbers(text, skip_rows)
-    if data is not None:
-        n_read, cols = data.shape[1], [data[:, i] for i in range(data.shape[1])]
+        table = _plain_numbers(text, skip_rows)
+    if table is not None:
+        n_read, cols = table.shape[1], [table[:, i] for i in range(table.shape[1])]
         names = [str(i) for i in range(n_read)]
     else:
         n_read, names, cols = _read_with_pandas(path, text, delimiter, header, skip_rows)
