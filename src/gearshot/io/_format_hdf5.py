@@ -31,7 +31,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-import h5py
 import numpy as np
 
 from .._errors import GearshotError
@@ -64,7 +63,7 @@ def _split_2d(name: str, arr: np.ndarray, out: dict[str, np.ndarray]) -> None:
             out[f"{name}[{i}]"] = row
 
 
-def check_extent(path: Path, ds: h5py.Dataset, size: int | None = None) -> None:
+def check_extent(path: Path, ds: Any, size: int | None = None) -> None:
     """Raise unless every byte a dataset declares lies inside the file (checked before the
     dataset is read: a truncated file fails at once, naming the dataset)."""
     size = Path(path).stat().st_size if size is None else size
@@ -92,6 +91,7 @@ def check_extent(path: Path, ds: h5py.Dataset, size: int | None = None) -> None:
 
 def read_hdf5(path: Path) -> RawFile:
     """Read a native (or generic) HDF5 recording file."""
+    import h5py  # imported on use: text/zip readers never pay for it
     with h5py.File(path, "r") as f:
         attrs = {k: _attr(v) for k, v in f.attrs.items()}
         if attrs.get("gearshot_format") == FORMAT_NAME:
@@ -138,6 +138,7 @@ def read_hdf5(path: Path) -> RawFile:
 
 def write_hdf5(rec: Any, path: Path, *, dtype: Any = np.float64) -> None:
     """Write ``rec`` (a Recording) in the native layout, atomically."""
+    import h5py
     dtype = np.dtype(dtype)
     if dtype not in (np.dtype(np.float64), np.dtype(np.float32)):
         raise GearshotError(f"dtype for HDF5 must be float64 or float32; got {dtype}")

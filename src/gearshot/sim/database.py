@@ -541,24 +541,15 @@ def _prepare_store(store: Path, manifest: dict, progress: bool = True) -> None:
 
 def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
                progress, paired=False, manifest=None):
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+    from .._progress import progress as progress_of
 
-    columns = (TextColumn("simulating blocks"), BarColumn(), MofNCompleteColumn(),
-               TimeElapsedColumn(), TimeRemainingColumn())
-    with Progress(*columns, disable=not progress) as bar:
-        task = bar.add_task("blocks", total=n_total, completed=n_total - len(todo))
+    with progress_of("simulating blocks", n_total, completed=n_total - len(todo),
+                     enabled=progress) as bar:
         if client is None:
             for t in todo:
                 _build_block(str(store), pair, *t[:6], n_healthy, n_faulty, seed, n_points,
                              fault_type=t[6], paired=paired, manifest=manifest)
-                bar.advance(task)
+                bar.advance()
             return
         from dask.distributed import as_completed
         futures = [client.submit(_build_block, str(store), pair, *t[:6], n_healthy,
@@ -568,7 +559,7 @@ def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, 
         try:
             for fut in as_completed(futures):
                 fut.result()
-                bar.advance(task)
+                bar.advance()
         except Exception:
             # a failed block (a full disk, ...): drop the queued blocks, and give the
             # running ones a minute to finish or to remove their temporary folders
