@@ -16,6 +16,14 @@ from .level import mean_rms, rms
 from .orders import difference_signal, harmonic_signal, mesh_band_orders, order_mask
 from .spectra import acs_background, amplitude_spectrum
 from .trains import antialias_filter, shaft_cycle_times
+from .tracking import (
+    ShaftAngle,
+    SpeedRidge,
+    angle_pulse_times,
+    demodulate_angle,
+    estimate_shaft_angle,
+    speed_ridge,
+)
 
 __all__ = [
     "pulse_times",
@@ -39,4 +47,10 @@ __all__ = [
     "minimum_phase",
     "fractional_shift",
     "subtract_healthy",
+    "speed_ridge",
+    "demodulate_angle",
+    "angle_pulse_times",
+    "estimate_shaft_angle",
+    "ShaftAngle",
+    "SpeedRidge",
 ]

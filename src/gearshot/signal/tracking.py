@@ -1,0 +1,486 @@
+"""Shaft speed and angle from the vibration itself, for machines without a tachometer.
+
+A gear mesh makes the vibration repeat ``z`` times per revolution of the shaft that carries
+a ``z``-tooth gear, so its harmonics sit at whole *orders* of that shaft: at shaft speed
+``s(t)`` (rev/s) the mesh harmonic of order ``o`` is at ``o * s(t)`` Hz. Tracking one such
+harmonic gives the speed; its phase divided by the order gives the shaft angle. Three steps:
+
+1. **Time–frequency ridge** (:func:`speed_ridge`). Short-time Fourier transform
+   (:class:`scipy.signal.ShortTimeFFT`, Hann window of ``window`` s); every frame's power
+   in dB above the frame's median over the searched band. For every candidate shaft speed
+   in ``speed_range``, a score sums those levels at ``h * o * s`` for every mesh order
+   ``o`` of the shaft (all meshes synchronous with it, known from the gear train) and
+   harmonic ``h = 1 … n_harmonics``. The best path through (frame, candidate speed) whose
+   speed changes by at most ``max_rate`` rev/s per second is found by dynamic programming.
+   Several orders make the choice unambiguous: a candidate at half or double the true speed
+   puts only some of its comb teeth on spectral lines.
+2. **Phase demodulation** (:func:`demodulate_angle`). The harmonic followed by the ridge
+   (order ``o * h`` with the highest level along it) is mixed down to 0 Hz with the ridge's
+   own phase (``x(t) exp(-i 2π ∫ o h s_ridge dt)``), decimated and low-passed to
+   ``± bandwidth`` shaft orders (zero-phase Butterworth): this is the band-pass around the
+   tracked harmonic and its analytic signal, expressed at baseband. The unwrapped phase of
+   what is left, added to the ridge's phase, is the harmonic's phase; divided by ``2π`` and
+   the order it is the shaft angle (revolutions), with the ridge's coarse frequency
+   corrected to within the phase noise.
+3. **Virtual tacho** (:func:`angle_pulse_times`). The times at which the angle passes
+   ``k / pulses_per_rev`` revolutions: pulses as a tacho would give, for the angular
+   re-sampler and :func:`gearshot.signal.shaft_cycle_times`.
+
+The absolute orientation of the shaft cannot be known without a key-phasor: the angle
+starts at an arbitrary value (the first virtual pulse is at an arbitrary mark), so
+synchronous averages from the vibration angle are circularly shifted against the
+tacho-based ones; SAs of one recording are aligned with each other.
+
+Uncertainty: the in-band signal-to-noise ratio ``snr`` (signal power in the ``± bandwidth``
+band over the noise floor there, from the median of the decimated baseband spectrum) gives
+the phase noise ``σ_φ ≈ (2 snr)^-1/2`` rad, the angle noise ``σ_φ / (2π o)`` rev and the
+noise of the instantaneous speed ``σ_φ B / (√3 o)`` rev/s (``B`` the band edge in Hz; white
+phase noise over ``|f| < B``). It covers noise only, not a neighbouring line inside the band.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.ndimage
+import scipy.signal
+from scipy.interpolate import CubicSpline
+
+from .._errors import GearshotError
+from .._validation import as_signal_array, check_in_range, check_int, check_positive, describe
+
+__all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
+           "estimate_shaft_angle", "MIN_SNR_DB"]
+
+#: Default in-band SNR (dB) below which no mesh harmonic is taken to stand out.
+MIN_SNR_DB = 10.0
+_CAP_DB = 30.0  # one strong line counts at most this much in the comb score
+
+
+@dataclass(frozen=True)
+class SpeedRidge:
+    """The speed ridge of :func:`speed_ridge`.
+
+    Attributes
+    ----------
+    times : ndarray, shape (n_frames,)
+        Frame centres, s from the first sample.
+    speed : ndarray, shape (n_frames,)
+        Shaft speed along the ridge, rev/s.
+    order : int
+        The order to demodulate: ``track``, or the harmonic of the shaft's own mesh
+        (``orders[0]``) with the highest level along the ridge.
+    level_db : float
+        Mean level of that harmonic along the ridge, dB above the frames' median.
+    """
+
+    times: np.ndarray
+    speed: np.ndarray
+    order: int
+    level_db: float
+
+
+@dataclass(frozen=True)
+class ShaftAngle:
+    """A shaft angle estimated from the vibration (:func:`estimate_shaft_angle`).
+
+    Attributes
+    ----------
+    times : ndarray, shape (m,)
+        Sample times of ``angle``, s (a decimated grid from 0).
+    angle : ndarray, shape (m,)
+        Shaft angle, revolutions (arbitrary origin), increasing.
+    speed : ndarray, shape (m,)
+        Instantaneous shaft speed, rev/s.
+    order : int
+        The demodulated harmonic, in orders of the shaft.
+    snr_db : float
+        In-band SNR of that harmonic, dB.
+    speed_std : float
+        Standard uncertainty of the instantaneous speed from the phase noise, rev/s.
+    angle_std : float
+        Standard uncertainty of the angle from the phase noise, revolutions.
+    pulse_times : ndarray, shape (n_pulses,)
+        Virtual tacho: times at which ``angle`` passes whole multiples of
+        ``1 / pulses_per_rev`` revolutions, s.
+    pulses_per_rev : int
+    ridge : SpeedRidge
+        The coarse time–frequency ridge.
+    """
+
+    times: np.ndarray
+    angle: np.ndarray
+    speed: np.ndarray
+    order: int
+    snr_db: float
+    speed_std: float
+    angle_std: float
+    pulse_times: np.ndarray
+    pulses_per_rev: int
+    ridge: SpeedRidge
+
+    @property
+    def mean_speed(self) -> float:
+        """Mean shaft speed over the estimated span, rev/s."""
+        return float((self.angle[-1] - self.angle[0]) / (self.times[-1] - self.times[0]))
+
+
+def _orders(orders) -> tuple[int, ...]:
+    if isinstance(orders, (int, np.integer)) and not isinstance(orders, bool):
+        orders = [orders]
+    if not isinstance(orders, (Sequence, np.ndarray)) or len(orders) == 0:
+        raise GearshotError(f"orders must be a positive integer or a non-empty sequence of "
+                            f"them; got {describe(orders)}")
+    out: list[int] = []
+    for i, o in enumerate(orders):
+        o = check_int(o, f"orders[{i}]", minimum=1, maximum=100_000)
+        if o not in out:
+            out.append(o)
+    return tuple(out)
+
+
+def _speed_range(speed_range) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in speed_range)
+    except (TypeError, ValueError):
+        raise GearshotError(f"speed_range must be (low, high) in rev/s; got "
+                            f"{describe(speed_range)}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+        raise GearshotError(f"speed_range must be (low, high) with 0 < low < high rev/s; got "
+                            f"{describe(speed_range)}")
+    return lo, hi
+
+
+def speed_ridge(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
+                max_rate=None, smooth=0.5, track=None) -> SpeedRidge:
+    """Shaft speed along the time–frequency ridge of its mesh harmonics.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Vibration, any unit, sampled at ``fs``.
+    fs : float
+        Sampling rate, Hz.
+    orders : int or sequence of int
+        Mesh orders synchronous with the shaft (its gears' tooth counts and every other
+        whole-order mesh, :meth:`gearshot.Machine.mesh_orders`), the shaft's own gear
+        first: all of them vote for the speed; the harmonic demodulated afterwards is one
+        of the first order's (another stage's mesh carries the other shafts' transmission
+        errors in its phase).
+    speed_range : (float, float)
+        Lowest and highest shaft speed searched, rev/s. Keep it within an octave
+        (high < 2 low) where the spectrum may hold strong lines at half the mesh orders:
+        a comb at half the speed then cannot win.
+    n_harmonics : int, default 3
+        Harmonics of every mesh order in the comb (those below ``fs / 2``).
+    window : float, default 0.5
+        STFT window length, s (rounded to a power of two of samples); hop a quarter of it.
+        Long enough to resolve the line from sidebands a third of an order away at 10
+        rev/s; during a run-up the line's peak stays at the window's centre frequency
+        (a chirp smears symmetrically), and the phase step corrects the rest.
+    max_rate : float, optional
+        Largest speed change, rev/s per second. Default: half the top of ``speed_range``
+        per second.
+    smooth : float, default 0.5
+        Span of the local quadratic (Savitzky–Golay) that smooths the ridge, s.
+    track : int, optional
+        The order to follow (and demodulate). Default: the harmonic of ``orders[0]`` with
+        the highest level along the ridge.
+
+    Returns
+    -------
+    SpeedRidge
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import speed_ridge
+    >>> fs = 20_000.0
+    >>> t = np.arange(int(2 * fs)) / fs
+    >>> x = np.sin(2 * np.pi * 32 * 25.0 * t) + 0.5 * np.sin(2 * np.pi * 16 * 25.0 * t)
+    >>> x += 0.1 * np.random.default_rng(0).standard_normal(t.size)
+    >>> r = speed_ridge(x, fs, orders=[32, 16], speed_range=(15, 40))
+    >>> bool(abs(np.median(r.speed) - 25.0) < 0.1)
+    True
+    """
+    x = as_signal_array(x, "x", max_ndim=1, min_length=16)
+    fs = check_positive(fs, "fs")
+    orders = _orders(orders)
+    lo, hi = _speed_range(speed_range)
+    n_harmonics = check_int(n_harmonics, "n_harmonics", minimum=1, maximum=100)
+    max_rate = 0.5 * hi if max_rate is None else check_positive(max_rate, "max_rate")
+    smooth = check_positive(smooth, "smooth")
+    pairs = [(h * o, 1.0 / h) for o in orders for h in range(1, n_harmonics + 1)
+             if h * o * hi < 0.5 * fs]  # (order, weight): fundamentals count most
+    if not pairs:
+        raise GearshotError(f"orders={list(orders)} at speed_range top {hi:g} rev/s lie above "
+                            f"the Nyquist frequency {fs / 2:g} Hz")
+    if track is None:
+        candidates = [h * orders[0] for h in range(1, n_harmonics + 1)
+                      if h * orders[0] * hi < 0.5 * fs] or sorted({c for c, _ in pairs})
+    else:
+        track = check_int(track, "track", minimum=1, maximum=100_000)
+        if track * hi >= 0.5 * fs:
+            raise GearshotError(f"track={track} at {hi:g} rev/s is above the Nyquist "
+                                f"frequency {fs / 2:g} Hz")
+        candidates = [track]
+    args = (x, fs, pairs, candidates, lo, hi, max_rate, smooth)
+    return _ridge_pass(*args, check_positive(window, "window"))
+
+
+def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> SpeedRidge:
+    """One STFT + comb + dynamic-programming pass of :func:`speed_ridge`."""
+    combos = sorted({c for c, _ in pairs})
+    nper = int(2 ** round(math.log2(max(window * fs, 16.0))))
+    if nper > x.size:
+        raise GearshotError(f"x holds {x.size} samples, shorter than one STFT window of "
+                            f"window={window:g} s ({nper} samples at fs={fs:g} Hz)")
+    hop = max(1, nper // 4)
+    stft = scipy.signal.ShortTimeFFT(scipy.signal.windows.hann(nper, sym=False), hop, fs)
+    p0 = stft.lower_border_end[1]
+    p1 = max(stft.upper_border_begin(x.size)[1], p0 + 1)
+    power = stft.spectrogram(x, p0=p0, p1=p1)  # (n_freq, n_frames)
+    times = stft.t(x.size, p0, p1)
+    df = fs / nper
+    top = min(power.shape[0] - 1, int(math.ceil(max(combos) * hi * 1.05 / df)) + 2)
+    bottom = max(1, int(math.floor(min(combos) * lo * 0.95 / df)) - 1)
+    level = 10.0 * np.log10(power[: top + 1] + 1e-30 * (power.max() + 1e-300))
+    level -= np.median(level[bottom: top + 1], axis=0, keepdims=True)
+    level = np.clip(level, 0.0, _CAP_DB)
+    step = df / (2.0 * max(combos))
+    speeds = np.arange(lo, hi + 0.5 * step, step)
+    score = np.zeros((speeds.size, times.size))
+    for c, w in pairs:
+        pos = c * speeds / df
+        i0 = np.clip(np.floor(pos).astype(np.int64), 0, top - 1)
+        score += w * np.maximum(level[i0], level[i0 + 1])
+    score /= sum(w for _, w in pairs)
+    # dynamic programming: best path with |jump| <= J candidates per frame
+    jump = max(1, int(math.ceil(max_rate * hop / fs / step)))
+    acc = np.empty_like(score)
+    acc[:, 0] = score[:, 0]
+    for k in range(1, times.size):
+        acc[:, k] = score[:, k] + scipy.ndimage.maximum_filter1d(acc[:, k - 1], 2 * jump + 1,
+                                                                 mode="nearest")
+    path = np.empty(times.size, dtype=np.int64)
+    path[-1] = int(np.argmax(acc[:, -1]))
+    for k in range(times.size - 1, 0, -1):
+        a, b = max(0, path[k] - jump), min(speeds.size, path[k] + jump + 1)
+        path[k - 1] = a + int(np.argmax(acc[a:b, k - 1]))
+    ridge = speeds[path]
+    # the harmonic to follow (highest level along the ridge) and its peak by parabola
+    frames = np.arange(times.size)
+    best, best_level = candidates[0], -1.0
+    for c in candidates:
+        i0 = np.clip(np.rint(c * ridge / df).astype(np.int64), 1, top - 1)
+        lev = float(np.mean(level[i0, frames]))
+        if lev > best_level + 1e-9:
+            best, best_level = c, lev
+    i0 = np.clip(np.rint(best * ridge / df).astype(np.int64), 2, top - 2)
+    nb = np.stack([power[i0 + d, frames] for d in (-1, 0, 1)])
+    k = i0 + np.argmax(nb, axis=0) - 1  # local peak within ±1 bin
+    a, b, c3 = (np.log(power[k + d, frames] + 1e-300) for d in (-1, 0, 1))
+    denom = a - 2 * b + c3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(denom < 0, 0.5 * (a - c3) / denom, 0.0)
+    refined = (k + np.clip(delta, -0.5, 0.5)) * df / best
+    ok = np.abs(refined - ridge) <= 2.0 * df / best
+    ridge = np.where(ok, refined, ridge)
+    # the speed changes slowly: a local quadratic over ``smooth`` s takes out the beating of
+    # the line with its sidebands inside one window, and keeps a ramp unbiased
+    span = int(round(smooth * fs / hop)) | 1
+    if span >= 5 and times.size >= 5:
+        ridge = scipy.signal.savgol_filter(ridge, min(span, times.size - 1 + times.size % 2),
+                                           2, mode="interp")
+    return SpeedRidge(times=times, speed=ridge, order=int(best), level_db=best_level)
+
+
+def demodulate_angle(x, fs, *, order, ridge_times, ridge_speed, bandwidth=0.25
+                     ) -> tuple[np.ndarray, np.ndarray, float]:
+    """Shaft angle from the phase of one harmonic, refined around a speed ridge.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Vibration sampled at ``fs``.
+    fs : float
+        Sampling rate, Hz.
+    order : int
+        Order of the harmonic (per shaft revolution).
+    ridge_times, ridge_speed : array_like, shape (n_frames,)
+        Coarse speed (rev/s) at increasing times (s), e.g. from :func:`speed_ridge`;
+        held constant outside their span. It must be within ``bandwidth`` orders of the
+        truth.
+    bandwidth : float, default 0.25
+        Half-width of the kept band around the harmonic, in shaft orders at the lowest
+        ridge speed (speed changes faster than this many cycles per revolution are
+        smoothed away; keep it below the nearest sideband, e.g. 1/3 order for a 1:3 idler).
+
+    Returns
+    -------
+    times : ndarray, shape (m,)
+        Decimated sample times, s.
+    angle : ndarray, shape (m,)
+        Shaft angle, revolutions, starting near 0.
+    snr : float
+        In-band signal-to-noise power ratio of the harmonic (linear).
+    """
+    x = as_signal_array(x, "x", max_ndim=1, min_length=16)
+    fs = check_positive(fs, "fs")
+    order = check_int(order, "order", minimum=1, maximum=1_000_000)
+    bandwidth = check_in_range(bandwidth, "bandwidth", 0.0, 10.0, low_inclusive=False)
+    rt = as_signal_array(ridge_times, "ridge_times", max_ndim=1)
+    rs = as_signal_array(ridge_speed, "ridge_speed", max_ndim=1)
+    if rt.size != rs.size or rt.size < 1 or np.any(np.diff(rt) <= 0) or np.any(rs <= 0):
+        raise GearshotError(f"ridge_times must increase and ridge_speed be > 0 with the same "
+                            f"length; got {rt.size} times and {rs.size} speeds")
+    n = x.size
+    band = bandwidth * float(rs.min())  # Hz
+    rate = 20.0 * band
+    down = max(1, int(fs // rate))
+    t = np.arange(n) / fs
+    freq = order * np.interp(t, rt, rs)
+    psi = np.empty(n)
+    psi[0] = 0.0
+    np.cumsum(freq[:-1] * (2 * np.pi / fs), out=psi[1:])
+    base = x * np.exp(-1j * psi)
+    if down > 1:
+        base = scipy.signal.resample_poly(base, 1, down, padtype="line")
+    fs_d = fs / down
+    m = base.size
+    td = np.arange(m) * (down / fs)
+    spec = np.abs(np.fft.fft(base)) ** 2
+    f = np.fft.fftfreq(m, 1.0 / fs_d)
+    inside = np.abs(f) <= band
+    outside = (np.abs(f) > 1.5 * band) & (np.abs(f) <= 0.4 * fs_d)
+    noise = float(np.median(spec[outside])) / math.log(2.0) if outside.any() else 0.0
+    signal_power = float(spec[inside].sum()) - noise * inside.sum()
+    snr = signal_power / (noise * inside.sum()) if noise > 0 else math.inf
+    sos = scipy.signal.butter(4, band, fs=fs_d, output="sos")
+    padlen = min(m - 1, int(3 * fs_d / band))
+    narrow = scipy.signal.sosfiltfilt(sos, base, padtype="odd", padlen=padlen)
+    phase = np.unwrap(np.angle(narrow))
+    angle = (psi[np.arange(m) * down] + phase - phase[0]) / (2 * np.pi * order)
+    return td, angle, max(snr, 0.0)
+
+
+def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
+    """Times at which a shaft angle passes whole multiples of ``1 / pulses_per_rev`` rev.
+
+    Parameters
+    ----------
+    times : array_like, shape (m,)
+        Increasing sample times, s.
+    angle : array_like, shape (m,)
+        Shaft angle at ``times``, revolutions, strictly increasing.
+    pulses_per_rev : int, default 8
+        Virtual pulses per revolution.
+
+    Returns
+    -------
+    ndarray, shape (n_pulses,)
+        Pulse times, s (a cubic spline of time against angle, read at the marks).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import angle_pulse_times
+    >>> t = np.linspace(0.0, 1.0, 101)
+    >>> angle_pulse_times(t, 10.0 * t + 0.05, pulses_per_rev=1)[:3]
+    array([0.095, 0.195, 0.295])
+    """
+    t = as_signal_array(times, "times", max_ndim=1, min_length=2)
+    a = as_signal_array(angle, "angle", max_ndim=1, min_length=2)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
+    if t.size != a.size:
+        raise GearshotError(f"times and angle must have the same length; got {t.size} and "
+                            f"{a.size}")
+    if np.any(np.diff(a) <= 0):
+        i = int(np.flatnonzero(np.diff(a) <= 0)[0])
+        raise GearshotError(f"angle must increase (a shaft turning one way); it stops or "
+                            f"reverses at t={t[i]:.4g} s")
+    marks = np.arange(math.ceil(a[0] * ppr), math.floor(a[-1] * ppr) + 1) / ppr
+    return np.asarray(CubicSpline(a, t)(marks))
+
+
+def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
+                         max_rate=None, smooth=0.5, track=None, bandwidth=0.25,
+                         min_snr_db=MIN_SNR_DB, pulses_per_rev=8,
+                         label="the vibration") -> ShaftAngle:
+    """Shaft angle and instantaneous speed from the vibration: ridge, then phase.
+
+    :func:`speed_ridge` finds the speed coarsely from all mesh orders of the shaft;
+    :func:`demodulate_angle` refines it on the strongest harmonic along the ridge;
+    :func:`angle_pulse_times` turns the angle into virtual tacho pulses.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Vibration sampled at ``fs`` (one sensor).
+    fs : float
+        Sampling rate, Hz.
+    orders : int or sequence of int
+        Mesh orders synchronous with the shaft (from the gear train).
+    speed_range : (float, float)
+        Shaft speeds searched, rev/s.
+    n_harmonics, window, max_rate, smooth, track
+        See :func:`speed_ridge`.
+    bandwidth : float, default 0.25
+        See :func:`demodulate_angle` (shaft orders).
+    min_snr_db : float, default 10
+        Refuse below this in-band SNR of the tracked harmonic.
+    pulses_per_rev : int, default 8
+        Virtual pulses per revolution in ``pulse_times``.
+    label : str
+        Names the signal in the refusal.
+
+    Returns
+    -------
+    ShaftAngle
+
+    Raises
+    ------
+    GearshotError
+        No mesh harmonic stands out (in-band SNR below ``min_snr_db``; the message states
+        the SNR found), or bad input.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import estimate_shaft_angle
+    >>> fs = 20_000.0
+    >>> t = np.arange(int(4 * fs)) / fs
+    >>> revs = 20.0 * t + 0.5 * t ** 2          # run-up: 20 -> 24 rev/s
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.sin(2 * np.pi * 32 * revs) + 0.3 * rng.standard_normal(t.size)
+    >>> est = estimate_shaft_angle(x, fs, orders=[32], speed_range=(15, 30))
+    >>> bool(abs(est.mean_speed - 22.0) < 0.01)
+    True
+    """
+    min_snr_db = check_in_range(min_snr_db, "min_snr_db", -100.0, 100.0)
+    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
+    x = as_signal_array(x, "x", max_ndim=1, min_length=16)
+    fs = check_positive(fs, "fs")
+    ridge = speed_ridge(x, fs, orders=orders, speed_range=speed_range,
+                        n_harmonics=n_harmonics, window=window, max_rate=max_rate,
+                        smooth=smooth, track=track)
+    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
+                                         ridge_speed=ridge.speed, bandwidth=bandwidth)
+    snr_db = 10.0 * math.log10(snr) if snr > 0 else -math.inf
+    if not snr_db >= min_snr_db:
+        raise GearshotError(
+            f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
+            f"tracked at {np.median(ridge.speed):.4g} rev/s, is {snr_db:.1f} dB above the "
+            f"noise in its band (min_snr_db={min_snr_db:g}); the speed cannot be estimated "
+            f"from the vibration (give a tacho, another sensor or the speed range)")
+    sigma_phi = math.sqrt(1.0 / (2.0 * snr))
+    band = bandwidth * float(ridge.speed.min())
+    speed = np.gradient(angle, times)
+    pulses = angle_pulse_times(times, angle, pulses_per_rev=ppr)
+    return ShaftAngle(times=times, angle=angle, speed=speed, order=ridge.order,
+                      snr_db=snr_db, speed_std=sigma_phi * band / (math.sqrt(3) * ridge.order),
+                      angle_std=sigma_phi / (2 * np.pi * ridge.order), pulse_times=pulses,
+                      pulses_per_rev=ppr, ridge=ridge)
