@@ -56,7 +56,7 @@ __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle
            "estimate_shaft_angle", "MIN_SNR_DB"]
 
 #: Default in-band SNR (dB) below which no mesh harmonic is taken to stand out.
-MIN_SNR_DB = 10.0
+MIN_SNR_DB = 3.0
 _CAP_DB = 30.0  # one strong line counts at most this much in the comb score
 
 
@@ -364,7 +364,7 @@ def demodulate_angle(x, fs, *, order, ridge_times, ridge_speed, bandwidth=0.25
     narrow = scipy.signal.sosfiltfilt(sos, base, padtype="odd", padlen=padlen)
     phase = np.unwrap(np.angle(narrow))
     angle = (psi[np.arange(m) * down] + phase - phase[0]) / (2 * np.pi * order)
-    return td, angle, max(snr, 0.0)
+    return td, angle, max(snr, 1e-3)
 
 
 def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
@@ -430,8 +430,9 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
         See :func:`speed_ridge`.
     bandwidth : float, default 0.25
         See :func:`demodulate_angle` (shaft orders).
-    min_snr_db : float, default 10
-        Refuse below this in-band SNR of the tracked harmonic.
+    min_snr_db : float, default 3
+        Refuse below this in-band SNR of the tracked harmonic (white noise gives at most
+        -4.6 dB in 20 synthetic trials; the threshold was set on those, not on real data).
     pulses_per_rev : int, default 8
         Virtual pulses per revolution in ``pulse_times``.
     label : str
