@@ -251,7 +251,7 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
     mate_shaft, _ = mach.mate()
     typer.echo(f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
                f"gear); {mate_shaft} speeds {[round(s, 4) for s in sim_speeds]} rev/s for "
-               f"{mach.tacho.shaft} speeds {list(speeds)}")
+               f"{mach.reference_shaft} speeds {list(speeds)}")
     typer.echo(f"database ready: {store}")
 
 

@@ -105,8 +105,11 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
     Returns
     -------
     dict
-        ``{"records": [{"file", "speed_hz", "n_cycles", "indicators"}, ...]}``; ``speed_hz``
-        is the mean speed of the tacho shaft read from the tacho.
+        ``{"records": [{"file", "speed_hz", "speed_source", "speed_uncertainty_hz",
+        "n_cycles", "indicators"}, ...]}``; ``speed_hz`` is the mean speed of the tacho
+        shaft, read from the tacho (``speed_source="tacho"``) or, for a machine without
+        ``[tacho]``, estimated from the vibration (``"vibration"``, with the standard
+        uncertainty of the instantaneous speed, rev/s; ``null`` with a tacho).
     """
     from ..io import Recording
 
@@ -122,6 +125,8 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
                                baseline=baseline)[name]
         records.append({"file": Path(path).name, "speed_hz": float(rec.shaft_speed()),
+                        "speed_source": rec.speed_source,
+                        "speed_uncertainty_hz": rec.speed_uncertainty,
                         "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
     return {"records": records}
 
@@ -140,8 +145,10 @@ def indicator_table(payload: dict[str, Any]):
     rows = []
     for r in payload["records"]:
         case, cond = _case_of(r["file"])
+        extra = {k: r[k] for k in ("speed_source", "speed_uncertainty_hz") if k in r}
         rows.append({"file": r["file"], "case": case, "condition": cond,
-                     "speed_hz": r["speed_hz"], "n_cycles": r["n_cycles"], **r["indicators"]})
+                     "speed_hz": r["speed_hz"], **extra, "n_cycles": r["n_cycles"],
+                     **r["indicators"]})
     return pd.DataFrame(rows)
 
 
@@ -155,7 +162,8 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     cols = [c for c in table.columns if c not in ("file", "case", "condition", "speed_hz",
-                                                  "n_cycles")]
+                                                  "n_cycles", "speed_source",
+                                                  "speed_uncertainty_hz")]
     cases = sorted(table["case"].unique())
     conds = sorted({re.sub(r"^\d+hz_?", "", c, flags=re.I) for c in table["condition"]})
     markers = "osD^v<>pP*X"
@@ -173,7 +181,10 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
         for k, cond in enumerate(conds):
             if cond:
                 ax.plot([], [], markers[k % len(markers)], color="0.4", label=cond)
-        ax.set_xlabel("tacho-shaft speed read from the tacho (Hz)")
+        source = (table["speed_source"].iloc[0] if "speed_source" in table.columns
+                  and table["speed_source"].nunique() == 1 else "tacho")
+        ax.set_xlabel("tacho-shaft speed read from the tacho (Hz)" if source == "tacho"
+                      else "shaft speed estimated from the vibration (Hz)")
         ax.set_ylabel(col)
         ax.set_title(f"{title} {col}".strip(), fontsize=9)
         ax.legend(fontsize=7, ncol=2)

@@ -25,8 +25,13 @@ def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty:
 
 
 def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
-                     sensor: str | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+                     sensor: str | None = None, info: dict | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, float]:
     """SA segments of the monitored gear's shaft for one recording file.
+
+    ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
+    machine without ``[tacho]``) and ``speed_uncertainty_hz`` (rev/s of the reference
+    shaft, ``None`` with a tacho).
 
     Returns
     -------
@@ -52,6 +57,8 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
                             f"{machine.monitored.shaft!r}; --cycles-per-segment="
                             f"{cycles_per_segment} is too many")
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
+    if info is not None:
+        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
@@ -101,7 +108,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, speed_hz, predicted, low, high``.
+        ``recording, role, segment, speed_hz, predicted, low, high, speed_source,
+        speed_uncertainty_hz`` (where the speed came from: ``tacho`` or ``vibration``).
     """
     from ..estimator import OneFaultShotEstimator
     from ..sim import load_database
@@ -121,9 +129,11 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             raise GearshotError(f"recording {str(p)!r} does not exist")
     db = load_database(database, speed=machine.sim_speed(speed), load=load)
     rows = []
+    sources: dict[str, dict] = {}
     train, long = [], None
     for p in healthy:
-        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
+                                     info=sources.setdefault(str(p), {}))
         n_hold = int(np.floor(holdout * sa.shape[0]))
         n_fit = sa.shape[0] - n_hold
         if n_fit < 1:
@@ -134,14 +144,16 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
         for k in range(n_fit, sa.shape[0]):
             rows.append((str(p), "healthy_holdout", k, sp, sa[k]))
-    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor)
+    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor,
+                                   info=sources.setdefault(str(faulty), {}))
     example_segment = check_int(example_segment, "example_segment", minimum=0,
                                 maximum=fsa.shape[0] - 1)
     for k in range(fsa.shape[0]):
         if k != example_segment:
             rows.append((str(faulty), "faulty_rest", k, fsp, fsa[k]))
     for p in recordings:
-        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
+                                     info=sources.setdefault(str(p), {}))
         rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
     # too), on the simulated side as on the recorded one
@@ -158,6 +170,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         low, high = est.predict_interval(sas, coverage=coverage)
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
+    frame["speed_source"] = [sources[r]["speed_source"] for r in frame["recording"]]
+    frame["speed_uncertainty_hz"] = [sources[r]["speed_uncertainty_hz"]
+                                     for r in frame["recording"]]
     frame.attrs["grade"] = getattr(est, "grade_", None)
     frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame
