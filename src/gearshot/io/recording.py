@@ -528,6 +528,9 @@ class Recording:
         vs = None if m is None else m.vibration_speed
         shaft = self.tacho_shaft
         track = None if vs is None or vs.shaft != shaft else vs.track
+        cache = self.__dict__.setdefault("_angle_cache", {})
+        if orders is None and m is None and cache and speed_range is None:
+            return next(reversed(cache.values()))  # the last estimate (its orders known)
         if orders is None:
             if m is None:
                 raise GearshotError(f"{self._label()} has no tacho; estimating the speed from "
@@ -558,7 +561,6 @@ class Recording:
             acc = acc[self._channel_index(name)]
         key = (tuple(np.atleast_1d(orders).tolist()), tuple(float(v) for v in speed_range),
                track, bandwidth)
-        cache = self.__dict__.setdefault("_angle_cache", {})
         if key not in cache:
             try:
                 cache[key] = estimate_shaft_angle(acc, self.fs, orders=orders,

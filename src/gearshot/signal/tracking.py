@@ -124,8 +124,10 @@ class ShaftAngle:
 
     @property
     def mean_speed(self) -> float:
-        """Mean shaft speed over the estimated span, rev/s."""
-        return float((self.angle[-1] - self.angle[0]) / (self.times[-1] - self.times[0]))
+        """Mean shaft speed over the record, rev/s: the least-squares slope of the angle
+        (the speed at mid-record for a steady ramp; less sensitive to the ends, where the
+        zero-phase filter has only one side)."""
+        return float(np.polyfit(self.times - self.times.mean(), self.angle, 1)[0])
 
 
 def _orders(orders) -> tuple[int, ...]:
