@@ -298,7 +298,7 @@ def test_dataclass_replace_drops_the_angle_cache():
     fs = 20_000.0
     t, revs = _ramp(fs, seconds=2.0)
     x = np.sin(2 * np.pi * 32 * revs) + 0.1 * np.random.default_rng(1).standard_normal(t.size)
-    rec = Recording(x, None, fs, speed=21.0)
+    rec = Recording(x, None, fs, speed=22.0)
     a = rec.vibration_angle(orders=[32])
     assert rec.vibration_angle(orders=[32]) is a
     assert dataclasses.replace(rec).vibration_angle(orders=[32]) is not a

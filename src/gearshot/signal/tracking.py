@@ -57,6 +57,9 @@ __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle
 
 #: Default in-band SNR (dB) below which no mesh harmonic is taken to stand out.
 MIN_SNR_DB = 3.0
+#: Largest RMS of the demodulated harmonic's frequency wander, as a fraction of the band
+#: half-width, for a lock: noise alone gives 1/sqrt(3) = 0.58 (flat in the band).
+MAX_WANDER = 0.3
 _CAP_DB = 30.0  # one strong line counts at most this much in the comb score
 
 
@@ -103,6 +106,9 @@ class ShaftAngle:
         Standard uncertainty of the instantaneous speed from the phase noise, rev/s.
     angle_std : float
         Standard uncertainty of the angle from the phase noise, revolutions.
+    wander : float
+        RMS of the demodulated harmonic's frequency about the ridge, as a fraction of the
+        band half-width (noise alone: about 0.58; a clean line: near 0).
     pulse_times : ndarray, shape (n_pulses,)
         Virtual tacho: times at which ``angle`` passes whole multiples of
         ``1 / pulses_per_rev`` revolutions, s.
@@ -118,6 +124,7 @@ class ShaftAngle:
     snr_db: float
     speed_std: float
     angle_std: float
+    wander: float
     pulse_times: np.ndarray
     pulses_per_rev: int
     ridge: SpeedRidge
@@ -344,6 +351,16 @@ def demodulate_angle(x, fs, *, order, ridge_times, ridge_speed, bandwidth=0.25
     rate = 20.0 * band
     down = max(1, int(fs // rate))
     t = np.arange(n) / fs
+    # beyond the first/last frame centre the speed goes on along the end slopes (a ridge
+    # held constant there would leave the band during a run-up)
+    k = min(5, rt.size)
+    if k >= 2 and rt[0] > 0:
+        rs = np.r_[np.polyval(np.polyfit(rt[:k], rs[:k], 1), 0.0), rs]
+        rt = np.r_[0.0, rt]
+    if k >= 2 and rt[-1] < t[-1]:
+        rs = np.r_[rs, np.polyval(np.polyfit(rt[-k:], rs[-k:], 1), t[-1])]
+        rt = np.r_[rt, t[-1]]
+    rs = np.maximum(rs, 0.05 * float(rs.max()))
     freq = order * np.interp(t, rt, rs)
     psi = np.empty(n)
     psi[0] = 0.0
@@ -410,7 +427,7 @@ def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
 
 def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
                          max_rate=None, smooth=0.5, track=None, bandwidth=0.25,
-                         min_snr_db=MIN_SNR_DB, pulses_per_rev=8,
+                         min_snr_db=MIN_SNR_DB, max_wander=MAX_WANDER, pulses_per_rev=8,
                          label="the vibration") -> ShaftAngle:
     """Shaft angle and instantaneous speed from the vibration: ridge, then phase.
 
@@ -435,6 +452,11 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
     min_snr_db : float, default 3
         Refuse below this in-band SNR of the tracked harmonic (white noise gives at most
         -4.6 dB in 20 synthetic trials; the threshold was set on those, not on real data).
+    max_wander : float, default 0.3
+        Refuse when the demodulated harmonic's frequency wanders about the ridge by more
+        than this fraction of the band half-width (RMS): noise alone gives about
+        ``1/sqrt(3) = 0.58``; the default is about half of that. Catches a lock on a line
+        that is not there, or a slipping phase, which the SNR alone may pass.
     pulses_per_rev : int, default 8
         Virtual pulses per revolution in ``pulse_times``.
     label : str
@@ -447,8 +469,8 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
     Raises
     ------
     GearshotError
-        No mesh harmonic stands out (in-band SNR below ``min_snr_db``; the message states
-        the SNR found), or bad input.
+        No mesh harmonic stands out (in-band SNR below ``min_snr_db`` or a phase that
+        wanders like noise; the message states both), or bad input.
 
     Examples
     --------
@@ -464,6 +486,7 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
     True
     """
     min_snr_db = check_in_range(min_snr_db, "min_snr_db", -100.0, 100.0)
+    max_wander = check_positive(max_wander, "max_wander")
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
     x = as_signal_array(x, "x", max_ndim=1, min_length=16)
     fs = check_positive(fs, "fs")
@@ -473,17 +496,27 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
     times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
                                          ridge_speed=ridge.speed, bandwidth=bandwidth)
     snr_db = 10.0 * math.log10(snr) if snr > 0 else -math.inf
-    if not snr_db >= min_snr_db:
+    band = bandwidth * float(ridge.speed.min())
+    speed = np.gradient(angle, times)
+    # how fast the demodulated phase wanders about the ridge: a locked line barely moves,
+    # noise in the band sweeps it at ~band / sqrt(3)
+    span = times[-1] - times[0]
+    inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
+    ridge_at = np.interp(times, ridge.times, ridge.speed)
+    wander = float(np.std(ridge.order * (speed - ridge_at)[inner]) / band) if inner.any() \
+        else 0.0
+    if not (snr_db >= min_snr_db and wander <= max_wander):
         raise GearshotError(
             f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
             f"tracked at {np.median(ridge.speed):.4g} rev/s, is {snr_db:.1f} dB above the "
-            f"noise in its band (min_snr_db={min_snr_db:g}); the speed cannot be estimated "
-            f"from the vibration (give a tacho, another sensor or the speed range)")
+            f"noise in its band (min_snr_db={min_snr_db:g}) and its phase wanders "
+            f"{wander:.2f} of the band (noise: 0.58; max_wander={max_wander:g}); the speed "
+            f"cannot be estimated from the vibration (give a tacho, another sensor or a "
+            f"narrower speed range)")
     sigma_phi = math.sqrt(1.0 / (2.0 * snr))
-    band = bandwidth * float(ridge.speed.min())
-    speed = np.gradient(angle, times)
     pulses = angle_pulse_times(times, angle, pulses_per_rev=ppr)
     return ShaftAngle(times=times, angle=angle, speed=speed, order=ridge.order,
                       snr_db=snr_db, speed_std=sigma_phi * band / (math.sqrt(3) * ridge.order),
-                      angle_std=sigma_phi / (2 * np.pi * ridge.order), pulse_times=pulses,
+                      angle_std=sigma_phi / (2 * np.pi * ridge.order), wander=wander,
+                      pulse_times=pulses,
                       pulses_per_rev=ppr, ridge=ridge)
