@@ -60,6 +60,8 @@ MIN_SNR_DB = 3.0
 #: Largest RMS of the demodulated harmonic's frequency wander, as a fraction of the band
 #: half-width, for a lock: noise alone gives 1/sqrt(3) = 0.58 (flat in the band).
 MAX_WANDER = 0.3
+_SETTLED = 0.1  # wander below which a shorter STFT window is not tried
+_AUTO_WINDOWS = (0.125, 0.5)  # s: shortest and default STFT window of the automatic choice
 _CAP_DB = 30.0  # one strong line counts at most this much in the comb score
 
 
@@ -425,7 +427,7 @@ def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
     return np.asarray(CubicSpline(a, t)(marks))
 
 
-def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
+def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=None,
                          max_rate=None, smooth=0.5, track=None, bandwidth=0.25,
                          min_snr_db=MIN_SNR_DB, max_wander=MAX_WANDER, pulses_per_rev=8,
                          label="the vibration") -> ShaftAngle:
@@ -445,8 +447,13 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
         Mesh orders synchronous with the shaft (from the gear train).
     speed_range : (float, float)
         Shaft speeds searched, rev/s.
-    n_harmonics, window, max_rate, smooth, track
+    n_harmonics, max_rate, smooth, track
         See :func:`speed_ridge`.
+    window : float, optional
+        STFT window of the ridge, s. Default: 0.5 s; when the phase then wanders more than
+        0.1 of the band (a run-up smears the line over many bins of a long window), once
+        more with the window the measured chirp allows (``1 / sqrt(chirp in Hz/s)``, at
+        least 1/8 s), keeping the steadier result.
     bandwidth : float, default 0.25
         See :func:`demodulate_angle` (shaft orders).
     min_snr_db : float, default 3
@@ -490,21 +497,50 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=0.
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
     x = as_signal_array(x, "x", max_ndim=1, min_length=16)
     fs = check_positive(fs, "fs")
-    ridge = speed_ridge(x, fs, orders=orders, speed_range=speed_range,
-                        n_harmonics=n_harmonics, window=window, max_rate=max_rate,
-                        smooth=smooth, track=track)
-    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
-                                         ridge_speed=ridge.speed, bandwidth=bandwidth)
+    def one_pass(win):
+        ridge = speed_ridge(x, fs, orders=orders, speed_range=speed_range,
+                            n_harmonics=n_harmonics, window=win, max_rate=max_rate,
+                            smooth=smooth, track=track)
+        times, angle, snr = demodulate_angle(x, fs, order=ridge.order,
+                                             ridge_times=ridge.times,
+                                             ridge_speed=ridge.speed, bandwidth=bandwidth)
+        band = bandwidth * float(ridge.speed.min())
+        speed = np.gradient(angle, times)
+        # how fast the demodulated phase wanders about the (independent) coarse ridge: a
+        # locked line barely moves, noise in the band sweeps it at ~band / sqrt(3)
+        span = times[-1] - times[0]
+        inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
+        ridge_at = np.interp(times, ridge.times, ridge.speed)
+        # above band/4 only: slow errors of the coarse ridge are not noise (the phase step
+        # corrects them), while noise's frequency wander lies almost all (98 %) up there
+        diff = ridge.order * (speed - ridge_at)
+        if times.size > 30:
+            fs_d = 1.0 / (times[1] - times[0])
+            hp = scipy.signal.butter(2, band / 4, btype="highpass", fs=fs_d, output="sos")
+            diff = scipy.signal.sosfiltfilt(hp, diff)
+        wander = float(np.std(diff[inner]) / band) if inner.any() else 0.0
+        return ridge, times, angle, snr, speed, wander, band
+
+    result = one_pass(window if window is not None else _AUTO_WINDOWS[-1])
+    if window is None and result[5] > _SETTLED:
+        # a run-up smears the line over many bins of the long window: retry with the
+        # window its chirp allows (the line moves < 1 bin: W <= 1 / sqrt(Hz/s))
+        ridge, times, _, _, speed, _, _ = result
+        span = times[-1] - times[0]
+        inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
+        slope = np.abs(np.polyfit(times[inner], speed[inner], 2)[1]) if inner.sum() > 3 \
+            else 0.0
+        slope = max(slope, float(np.max(np.abs(np.gradient(ridge.speed, ridge.times))))
+                    if ridge.times.size > 1 else 0.0)
+        chirp = ridge.order * slope
+        short = float(np.clip(1.0 / math.sqrt(max(chirp, 1e-9)), _AUTO_WINDOWS[0],
+                              _AUTO_WINDOWS[-1]))
+        if short < 0.75 * _AUTO_WINDOWS[-1]:
+            other = one_pass(short)
+            if other[5] < result[5]:
+                result = other
+    ridge, times, angle, snr, speed, wander, band = result
     snr_db = 10.0 * math.log10(snr) if snr > 0 else -math.inf
-    band = bandwidth * float(ridge.speed.min())
-    speed = np.gradient(angle, times)
-    # how fast the demodulated phase wanders about the ridge: a locked line barely moves,
-    # noise in the band sweeps it at ~band / sqrt(3)
-    span = times[-1] - times[0]
-    inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
-    ridge_at = np.interp(times, ridge.times, ridge.speed)
-    wander = float(np.std(ridge.order * (speed - ridge_at)[inner]) / band) if inner.any() \
-        else 0.0
     if not (snr_db >= min_snr_db and wander <= max_wander):
         raise GearshotError(
             f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
