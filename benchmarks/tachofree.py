@@ -99,7 +99,7 @@ def part_a(data: Path, files: list[Path], *, nominal_prior: bool = False
                "speed_tacho": sp_t, "speed_vib": sp_v,
                "speed_err_pct": 100 * (sp_v / sp_t - 1),
                "speed_std_hz": est.speed_std, "refused": ""}
-        for i, sensor in enumerate(mt.sensors):
+        for sensor in mt.sensors:
             a = rt.to_sa_segments(shaft=shaft, sensor=sensor.name, cycles_per_segment=None)[0]
             b = rv.to_sa_segments(shaft=shaft, sensor=sensor.name, cycles_per_segment=None)[0]
             row[f"sa_diff_{sensor.name}"] = aligned_rms_diff(a, b)

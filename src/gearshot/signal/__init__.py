@@ -22,7 +22,6 @@ from .orders import (
     residual_signal,
 )
 from .spectra import acs_background, amplitude_spectrum
-from .trains import antialias_filter, shaft_cycle_times
 from .tracking import (
     ShaftAngle,
     SpeedRidge,
@@ -31,6 +30,7 @@ from .tracking import (
     estimate_shaft_angle,
     speed_ridge,
 )
+from .trains import antialias_filter, shaft_cycle_times
 
 __all__ = [
     "pulse_times",
