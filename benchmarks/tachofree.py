@@ -92,7 +92,9 @@ def part_a(data: Path, files: list[Path], *, nominal_prior: bool = False
         try:
             est = rv.vibration_angle()
         except GearshotError as exc:
-            rows.append({"file": path.name, "refused": str(exc)})
+            msg = str(exc)
+            rows.append({"file": path.name,
+                         "refused": msg[msg.find("order "):msg.find("; the speed")]})
             continue
         sp_t, sp_v = rt.shaft_speed(), rv.shaft_speed()
         row = {"file": path.name, "order": est.order, "snr_db": est.snr_db,
@@ -158,11 +160,15 @@ def orderings(table: pd.DataFrame) -> pd.DataFrame:
                     sel = table[(table.cell == cell) & (table.sensor == sensor)
                                 & (table.source == source)]
                     v = dict(zip(sel.case, sel[name]))
-                    spur.append("y" if v["spur2"] > v["spur3"] else "n"
-                                if {"spur2", "spur3"} <= set(v) else "-")
-                    ladder.append("y" if v["helical1"] < v["helical2"] < v["helical5"] else
-                                  "n" if {"helical1", "helical2", "helical5"} <= set(v)
-                                  else "-")
+                    if {"spur2", "spur3"} <= set(v):
+                        spur.append("y" if v["spur2"] > v["spur3"] else "n")
+                    else:
+                        spur.append("-")
+                    if {"helical1", "helical2", "helical5"} <= set(v):
+                        ladder.append("y" if v["helical1"] < v["helical2"] < v["helical5"]
+                                      else "n")
+                    else:
+                        ladder.append("-")
                 r[f"spur2>spur3 {source}"] = "".join(spur)
                 r[f"h1<h2<h5 {source}"] = "".join(ladder)
             # cells where the vibration refused ("-") are not counted as changes

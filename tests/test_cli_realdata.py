@@ -55,7 +55,9 @@ def test_indicators_json_layout_and_figures(small, tmp_path):
     assert list(payload) == ["records"] and len(payload["records"]) == 2
     want = {*available_features(), "rms_raw", "rms_residual"}
     for rec, name in zip(payload["records"], ("spur2", "spur3")):
-        assert list(rec) == ["file", "speed_hz", "n_cycles", "indicators"]
+        assert list(rec) == ["file", "speed_hz", "speed_source", "speed_uncertainty_hz",
+                             "n_cycles", "indicators"]
+        assert rec["speed_source"] == "tacho" and rec["speed_uncertainty_hz"] is None
         assert rec["file"] == f"{name}_30hz_High_1.zip"
         assert 29.0 < rec["speed_hz"] < 30.0  # read from the tacho, input shaft
         assert rec["n_cycles"] == 14  # 1.5 s at ~29.9 Hz: 44 whole input revs, 14 idler revs
