@@ -60,6 +60,8 @@ MIN_SNR_DB = 3.0
 #: Largest RMS of the demodulated harmonic's frequency wander, as a fraction of the band
 #: half-width, for a lock: noise alone gives 1/sqrt(3) = 0.58 (flat in the band).
 MAX_WANDER = 0.3
+_LINE_DB = 6.0  # a comb line "stands out" at this mean level above the median (noise: ~3)
+MIN_LINES = 2  # comb lines that must stand out: one lone line may be any tone
 _SETTLED = 0.1  # wander below which a shorter STFT window is not tried
 _AUTO_WINDOWS = (0.125, 0.5)  # s: shortest and default STFT window of the automatic choice
 _CAP_DB = 30.0  # one strong line counts at most this much in the comb score
@@ -80,12 +82,17 @@ class SpeedRidge:
         (``orders[0]``) with the highest level along the ridge.
     level_db : float
         Mean level of that harmonic along the ridge, dB above the frames' median.
+    n_lines, n_comb : int
+        Comb lines (mesh order × harmonic, below Nyquist) whose mean level along the ridge
+        is at least 6 dB above the frames' median, and comb lines in all.
     """
 
     times: np.ndarray
     speed: np.ndarray
     order: int
     level_db: float
+    n_lines: int = 0
+    n_comb: int = 0
 
 
 @dataclass(frozen=True)
@@ -306,7 +313,14 @@ def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> S
     if span >= 5 and times.size >= 5:
         ridge = scipy.signal.savgol_filter(ridge, min(span, times.size - 1 + times.size % 2),
                                            2, mode="interp")
-    return SpeedRidge(times=times, speed=ridge, order=int(best), level_db=best_level)
+    # how many comb lines (order x harmonic) stand out along the final ridge
+    lines = 0
+    for c in combos:
+        i0 = np.clip(np.rint(c * ridge / df).astype(np.int64), 0, top - 1)
+        lev = np.maximum(level[i0, frames], level[np.minimum(i0 + 1, top), frames])
+        lines += int(float(np.mean(lev)) >= _LINE_DB)
+    return SpeedRidge(times=times, speed=ridge, order=int(best), level_db=best_level,
+                      n_lines=lines, n_comb=len(combos))
 
 
 def demodulate_angle(x, fs, *, order, ridge_times, ridge_speed, bandwidth=0.25
@@ -429,7 +443,8 @@ def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
 
 def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=None,
                          max_rate=None, smooth=0.5, track=None, bandwidth=0.25,
-                         min_snr_db=MIN_SNR_DB, max_wander=MAX_WANDER, pulses_per_rev=8,
+                         min_snr_db=MIN_SNR_DB, max_wander=MAX_WANDER, min_lines=MIN_LINES,
+                         pulses_per_rev=8,
                          label="the vibration") -> ShaftAngle:
     """Shaft angle and instantaneous speed from the vibration: ridge, then phase.
 
@@ -464,6 +479,11 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=No
         than this fraction of the band half-width (RMS): noise alone gives about
         ``1/sqrt(3) = 0.58``; the default is about half of that. Catches a lock on a line
         that is not there, or a slipping phase, which the SNR alone may pass.
+    min_lines : int, default 2
+        Refuse unless at least this many lines of the comb (mesh orders × harmonics) stand
+        out along the ridge (mean level >= 6 dB above the median; noise gives about 3):
+        a gear mesh has harmonics, a lone tone (an electrical line, another machine) may
+        be anything.
     pulses_per_rev : int, default 8
         Virtual pulses per revolution in ``pulse_times``.
     label : str
@@ -487,13 +507,15 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=No
     >>> t = np.arange(int(4 * fs)) / fs
     >>> revs = 20.0 * t + 0.5 * t ** 2          # run-up: 20 -> 24 rev/s
     >>> rng = np.random.default_rng(0)
-    >>> x = np.sin(2 * np.pi * 32 * revs) + 0.3 * rng.standard_normal(t.size)
+    >>> x = np.sin(2 * np.pi * 32 * revs) + 0.5 * np.sin(2 * np.pi * 64 * revs + 1.0)
+    >>> x += 0.3 * rng.standard_normal(t.size)
     >>> est = estimate_shaft_angle(x, fs, orders=[32], speed_range=(15, 30))
     >>> bool(abs(est.mean_speed - 22.0) < 0.01)
     True
     """
     min_snr_db = check_in_range(min_snr_db, "min_snr_db", -100.0, 100.0)
     max_wander = check_positive(max_wander, "max_wander")
+    min_lines = check_int(min_lines, "min_lines", minimum=0, maximum=1000)
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
     x = as_signal_array(x, "x", max_ndim=1, min_length=16)
     fs = check_positive(fs, "fs")
@@ -541,14 +563,15 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=No
                 result = other
     ridge, times, angle, snr, speed, wander, band = result
     snr_db = 10.0 * math.log10(snr) if snr > 0 else -math.inf
-    if not (snr_db >= min_snr_db and wander <= max_wander):
+    if not (snr_db >= min_snr_db and wander <= max_wander and ridge.n_lines >= min_lines):
         raise GearshotError(
             f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
             f"tracked at {np.median(ridge.speed):.4g} rev/s, is {snr_db:.1f} dB above the "
-            f"noise in its band (min_snr_db={min_snr_db:g}) and its phase wanders "
-            f"{wander:.2f} of the band (noise: 0.58; max_wander={max_wander:g}); the speed "
-            f"cannot be estimated from the vibration (give a tacho, another sensor or a "
-            f"narrower speed range)")
+            f"noise in its band (min_snr_db={min_snr_db:g}), its phase wanders "
+            f"{wander:.2f} of the band (noise: 0.58; max_wander={max_wander:g}) and "
+            f"{ridge.n_lines} of {ridge.n_comb} comb lines stand out (min_lines="
+            f"{min_lines}); the speed cannot be estimated from the vibration (give a tacho, "
+            f"another sensor or a narrower speed range)")
     sigma_phi = math.sqrt(1.0 / (2.0 * snr))
     pulses = angle_pulse_times(times, angle, pulses_per_rev=ppr)
     return ShaftAngle(times=times, angle=angle, speed=speed, order=ridge.order,
