@@ -19,6 +19,7 @@ C. Run-ups / run-downs with a known profile: (1) the virtual rig (surrogate and 
 D. Time of the tacho-free angle of one 4 s, 66.7 kHz record (spur2 30 Hz High).
 
     PYTHONPATH=src python benchmarks/tachofree.py [--data ../shared/data/phm09] [--quick]
+    PYTHONPATH=src python benchmarks/tachofree.py --nominal-orderings   # B with A2's range
 """
 
 from __future__ import annotations
@@ -281,8 +282,18 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data" / "phm09")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     ap.add_argument("--quick", action="store_true", help="surrogate rig only, 3 timings")
+    ap.add_argument("--nominal-orderings", action="store_true",
+                    help="only part B on the records read with the nominal-speed range")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.nominal_orderings:
+        _, recs = part_a(args.data, sorted(args.data.glob("*.zip")), nominal_prior=True)
+        b = orderings(part_b(recs))
+        b.to_csv(args.out / "tachofree_orderings_nominal.csv", index=False)
+        print(markdown(b))
+        print(f"spur2>spur3 unchanged for {int(b['spur same'].sum())}/{len(b)}; ladder "
+              f"unchanged for {int(b['ladder same'].sum())}/{len(b)}")
+        return
     d = part_d(args.data, 3 if args.quick else 7)
     print(f"D. tacho-free angle, spur2 30 Hz High (266,656 samples): best wall "
           f"{d['best_wall_s']:.3f} s, median {d['median_wall_s']:.3f} s, best CPU "
