@@ -513,7 +513,7 @@ class Recording:
 
         Returns
         -------
-        gearshot.signal.ShaftAngle
+        gearshot.signal.tracking.ShaftAngle
             Cached per argument set.
 
         Raises

@@ -21,15 +21,9 @@ from .orders import (
     regular_signal,
     residual_signal,
 )
+from .ridge import speed_ridge
 from .spectra import acs_background, amplitude_spectrum
-from .tracking import (
-    ShaftAngle,
-    SpeedRidge,
-    angle_pulse_times,
-    demodulate_angle,
-    estimate_shaft_angle,
-    speed_ridge,
-)
+from .tracking import angle_pulse_times, demodulate_angle, estimate_shaft_angle
 from .trains import antialias_filter, shaft_cycle_times
 
 __all__ = [
@@ -61,6 +55,4 @@ __all__ = [
     "demodulate_angle",
     "angle_pulse_times",
     "estimate_shaft_angle",
-    "ShaftAngle",
-    "SpeedRidge",
 ]
