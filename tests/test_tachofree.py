@@ -312,3 +312,18 @@ def test_dataclass_replace_drops_the_angle_cache():
     a = rec.vibration_angle(orders=[32])
     assert rec.vibration_angle(orders=[32]) is a
     assert dataclasses.replace(rec).vibration_angle(orders=[32]) is not a
+
+
+@needs_phm09
+def test_phm09_predict_segments_say_where_the_speed_came_from():
+    from gearshot.app.predict_machine import machine_segments
+
+    for machine, source in (("phm09_spur.toml", "tacho"),
+                            ("phm09_spur_notacho.toml", "vibration")):
+        info: dict = {}
+        sa, x, speed = machine_segments(PHM09 / "spur3_30hz_High_1.zip",
+                                        Machine.from_toml(MACHINES / machine),
+                                        cycles_per_segment=10, info=info)
+        assert info["speed_source"] == source and sa.shape == (11, 2048)
+        assert (info["speed_uncertainty_hz"] is None) == (source == "tacho")
+        assert speed == pytest.approx(29.92, rel=0.002)
