@@ -62,6 +62,12 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
+def _comparability_columns(est, sas) -> tuple[np.ndarray, np.ndarray]:
+    """The ``comparability`` (score) and ``comparable`` columns of a predict table."""
+    result = est.comparability(sas)
+    return result.score, result.comparable
+
+
 def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                          faulty: str | Path, faulty_size: float,
                          recordings: Sequence[str | Path] = (), *, speed: float, load: float,
@@ -108,8 +114,12 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, speed_hz, predicted, low, high, speed_source,
-        speed_uncertainty_hz`` (where the speed came from: ``tacho`` or ``vibration``).
+        ``recording, role, segment, speed_hz, predicted, low, high, comparability,
+        comparable, speed_source, speed_uncertainty_hz``
+        (:meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`: the score and
+        whether the segment looks like the fitted machine; where the speed came from:
+        ``tacho`` or ``vibration``, with the standard uncertainty of the instantaneous
+        speed, rev/s, for ``vibration``).
     """
     from ..estimator import OneFaultShotEstimator
     from ..sim import load_database
@@ -170,6 +180,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         low, high = est.predict_interval(sas, coverage=coverage)
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
+        frame["comparability"], frame["comparable"] = _comparability_columns(est, sas)
     frame["speed_source"] = [sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
