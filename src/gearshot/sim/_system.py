@@ -25,7 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import newmark_batch, newmark_batch_tables
+from ._kernel import (
+    G0,
+    contact_slots,
+    newmark_spur,
+    newmark_tables,
+    spur_shared,
+    table_shared,
+)
 from ._slices import box
 from .faults import ToothFault
 from .geometry import GearPair
@@ -48,6 +55,12 @@ def system_matrices(pair: GearPair):
     omega : ndarray (7,)
         Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
     """
+    return _modal_system(pair)[:5]
+
+
+def _modal_system(pair: GearPair):
+    """:func:`system_matrices` plus the mean system's squared natural frequencies and
+    mass-normalised modes (columns)."""
     m1, m2 = pair.masses
     j1, j2 = pair.inertias
     kt1, kt2 = pair.shaft_torsional_stiffness
@@ -79,28 +92,31 @@ def system_matrices(pair: GearPair):
     phi = Li.T @ psi                          # mass-normalised modes
     omega = np.sqrt(np.maximum(w2, 0.0))
     C = M @ phi @ np.diag(2 * pair.damping_ratio * omega) @ phi.T @ M
-    return M, K0, C, v, omega
+    return M, K0, C, v, omega, w2, phi
 
 
 @dataclass(frozen=True)
 class Integrator:
-    """Newmark (beta 1/4, gamma 1/2) update matrices for one pair and time step."""
+    """Newmark (beta 1/4, gamma 1/2) coefficients for one pair and time step, in the
+    mass-normalised modal coordinates of the mean-stiffness system.
 
-    B1: np.ndarray
-    B2: np.ndarray
-    B3: np.ndarray
-    w: np.ndarray
-    s: float
-    v: np.ndarray
-    c_load: np.ndarray
-    c_motor: np.ndarray
+    ``mc`` (ndof, 9) per mode: the factors of displacement, velocity and acceleration in
+    the right-hand side, the modal line-of-action, load and motor vectors, 1/D (D: the
+    diagonal effective stiffness), line-of-action / D and the output factor (g per modal
+    acceleration); ``sc`` = (a0, a2, a3, a6, a7, k_mean, sum vt^2 / D); ``to_modal``
+    maps a physical state to modal coordinates (Phi^T M); ``x_static`` is the static
+    state under the mean mesh stiffness (modal).
+    """
+
+    mc: np.ndarray
+    sc: np.ndarray
+    to_modal: np.ndarray
     x_static: np.ndarray
-    coef: np.ndarray      # a0, a2, a3, a6, a7
     omega_min: float
 
 
 def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
-    M, K0, C, v, omega = system_matrices(pair)
+    M, K0, C, v, omega, w2, phi = _modal_system(pair)
     beta, gamma = 0.25, 0.5
     a0 = 1 / (beta * dt ** 2)
     a1 = gamma / (beta * dt)
@@ -110,13 +126,7 @@ def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
     a5 = dt / 2 * (gamma / beta - 2)
     a6 = dt * (1 - gamma)
     a7 = gamma * dt
-    A = K0 + a0 * M + a1 * C
-    Ai = np.linalg.inv(A)
-    Ai = 0.5 * (Ai + Ai.T)
-    B1 = Ai @ (a0 * M + a1 * C)
-    B2 = Ai @ (a2 * M + a4 * C)
-    B3 = Ai @ (a3 * M + a5 * C)
-    w = Ai @ v
+    damp = 2 * pair.damping_ratio * omega          # modal damping, diagonal
     f_load = np.zeros(v.size)
     f_load[6] = -1.0                      # brake torque opposes rotation (per N m)
     ratio = pair.z_pinion / pair.z_gear
@@ -124,8 +134,17 @@ def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
     f_motor[:7] = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
     k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
     x_static = np.linalg.solve(K0 + k_mean * np.outer(v, v), f_load * load0)
-    return Integrator(B1, B2, B3, w, float(v @ w), v, Ai @ f_load, Ai @ f_motor, x_static,
-                      np.array([a0, a2, a3, a6, a7]), float(omega[omega > 0].min()))
+    # Phi^T (K0 + a0 M + a1 C) Phi = diag(w2 + a0 + a1 damp) - k_mean vt vt^T: the mesh
+    # stiffness k_m enters as the rank-one term (k_m - k_mean) vt vt^T
+    d = w2 + a0 + a1 * damp
+    vt = phi.T @ v
+    mc = np.column_stack([a0 + a1 * damp, a2 + a4 * damp, a3 + a5 * damp, vt,
+                          phi.T @ f_load, phi.T @ f_motor, 1.0 / d, vt / d,
+                          (phi[1] + phi[4]) / G0])
+    sc = np.array([a0, a2, a3, a6, a7, k_mean, float(np.sum(vt * vt / d))])
+    to_modal = phi.T @ M
+    return Integrator(np.ascontiguousarray(mc), sc, to_modal, to_modal @ x_static,
+                      float(omega[omega > 0].min()))
 
 
 def warmup_time(pair: GearPair, integ: Integrator) -> float:
@@ -154,9 +173,22 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
 
 
 def _stack_errors(errs: list[ToothProfileErrors]):
-    return (np.stack([e.slope for e in errs]), np.stack([e.waviness for e in errs]),
-            np.stack([e.phase for e in errs]), np.stack([e.noise for e in errs]),
+    """Slope, the waviness as sine/cosine amplitudes (half the waviness times cos/sin of
+    each tooth's phase) and noise knots of every signal; the waves per profile."""
+    half = 0.5 * np.stack([e.waviness for e in errs])
+    phase = np.stack([e.phase for e in errs])
+    return ((np.stack([e.slope for e in errs]), half * np.cos(phase), half * np.sin(phase),
+             np.ascontiguousarray(np.stack([e.noise for e in errs]))),
             float(errs[0].n_waves))
+
+
+def _contacts(mesh_pos, span, k_tab):
+    """The batch-shared contact data of :func:`._kernel.contact_slots` and
+    :func:`._kernel.table_shared`."""
+    pair_id, wgt, pos, count = contact_slots(np.ascontiguousarray(mesh_pos, dtype=float),
+                                             float(span))
+    cell, frac, k_h = table_shared(pos, count, k_tab)
+    return pair_id, wgt, pos, count, cell, frac, k_h
 
 
 class Batch:
@@ -165,24 +197,30 @@ class Batch:
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
         self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
-        self.g = _stack_errors(gear_errs)
-        self.p = _stack_errors(pin_errs)
-        n = len(faults)
-        self.X = np.tile(integ.x_static, (n, 1))
-        self.V = np.zeros((n, integ.x_static.size))
-        self.A = np.zeros((n, integ.x_static.size))
+        self.g, self.g_nw = _stack_errors(gear_errs)
+        self.p, self.p_nw = _stack_errors(pin_errs)
+        self._init_state(len(faults))
+
+    def _init_state(self, n):
+        x0 = self.integ.x_static
+        self.X = np.tile(x0, (n, 1))          # modal coordinates
+        self.V = np.zeros((n, x0.size))
+        self.A = np.zeros((n, x0.size))
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
         """Advance over the given steps; return the vertical acceleration (g) of steps
         ``rec_start ... rec_start + n_rec - 1``."""
         pair, integ = self.pair, self.integ
+        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, pair.contact_ratio,
+                                                        _pair_table(pair, None))
+        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[2], self.g_nw,
+                                           self.p_nw)
         out = np.empty((self.X.shape[0], n_rec))
-        newmark_batch(np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
-                      np.ascontiguousarray(load), _pair_table(pair, None), self.kf,
-                      self.ef, self.tooth, *self.g, *self.p, pair.contact_ratio,
-                      pair.z_gear, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
-                      integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
-                      rec_start, out)
+        newmark_spur(np.ascontiguousarray(load, dtype=float),
+                     np.ascontiguousarray(motor_acc, dtype=float), count, wgt, pos,
+                     pair_id % self.g[0].shape[1], pair_id % self.p[0].shape[1], k_h,
+                     n_cell, n_frac, trig, self.kf, self.ef, self.tooth, *self.g, *self.p,
+                     integ.mc, integ.sc, self.X, self.V, self.A, rec_start, out)
         return out
 
 
@@ -223,18 +261,18 @@ class HelicalBatch(Batch):
                 self.fg[i, t] += part
             for part in box(dk[:, None, :] * e_p[i][None], ea, eb, lo, hi, tau):
                 self.fpf[i] += part
-        self.X = np.tile(integ.x_static, (n, 1))
-        self.V = np.zeros((n, integ.x_static.size))
-        self.A = np.zeros((n, integ.x_static.size))
+        self._init_state(n)
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
         integ = self.integ
+        pair_id, wgt, _, count, cell, frac, k_h = _contacts(mesh_pos, self.span, self.k)
         out = np.empty((self.X.shape[0], n_rec))
-        newmark_batch_tables(
-            np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
-            np.ascontiguousarray(load), self.k, self.kf, self.tooth, self.fg, self.fp,
-            self.fpf, self.span, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
-            integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef, rec_start, out)
+        newmark_tables(
+            np.ascontiguousarray(load, dtype=float),
+            np.ascontiguousarray(motor_acc, dtype=float), count, wgt,
+            pair_id % self.fg.shape[1], pair_id % self.fp.shape[1], k_h, cell, frac,
+            self.kf, self.tooth, self.fg, self.fp, self.fpf, integ.mc, integ.sc, self.X,
+            self.V, self.A, rec_start, out)
         return out
 
 
