@@ -152,130 +152,174 @@ def _interp_table(tab, u):
 
 
 @nb.njit(cache=True, inline="always")
-def _modal_step(x, vel, acc, y, kk, fex, ld, ma, mc, sc):
-    """One Newmark step (beta 1/4, gamma 1/2) in modal coordinates, in place; returns
-    the output (vertical acceleration, g). ``sc`` = (a0, a2, a3, a6, a7, k_mean,
-    sum vt^2 / D)."""
-    ndof = x.shape[0]
-    proj = 0.0
+def _modal_step(x, vel, acc, y, corr, kk, fex, ld, ma, mc, sc, o):
+    """One Newmark step (beta 1/4, gamma 1/2) in modal coordinates for a group of
+    signals (the last axis, ``lanes``), in place; ``o`` receives the output (vertical
+    acceleration, g). ``sc`` = (a0, a2, a3, a6, a7, k_mean, sum vt^2 / D). The signals of
+    a group are independent: their arithmetic runs side by side (SIMD lanes), which
+    hides the latency of the step's dependency chain."""
+    ndof, lanes = x.shape
+    for g in range(lanes):
+        corr[g] = 0.0
     for i in range(ndof):
-        r = (mc[i, _ALPHA] * x[i] + mc[i, _BETA] * vel[i] + mc[i, _GAMMA] * acc[i]
-             + mc[i, _VT] * fex + mc[i, _LOAD] * ld + mc[i, _MOTOR] * ma)
-        y[i] = r * mc[i, _INVD]
-        proj += mc[i, _VT] * y[i]
-    dk = kk - sc[5]
-    corr = dk * proj / (1.0 + dk * sc[6])
+        al, be, ga = mc[i, _ALPHA], mc[i, _BETA], mc[i, _GAMMA]
+        vt, invd = mc[i, _VT], mc[i, _INVD]
+        ext = mc[i, _LOAD] * ld + mc[i, _MOTOR] * ma
+        for g in range(lanes):
+            yy = (al * x[i, g] + be * vel[i, g] + ga * acc[i, g] + vt * fex[g] + ext) * invd
+            y[i, g] = yy
+            corr[g] += vt * yy
+    k_mean, s_vd = sc[5], sc[6]
+    for g in range(lanes):
+        dk = kk[g] - k_mean
+        corr[g] = dk * corr[g] / (1.0 + dk * s_vd)
+        o[g] = 0.0
     a0, a2, a3, a6, a7 = sc[0], sc[1], sc[2], sc[3], sc[4]
-    out = 0.0
     for i in range(ndof):
-        xn = y[i] - corr * mc[i, _G]
-        an = a0 * (xn - x[i]) - a2 * vel[i] - a3 * acc[i]
-        vel[i] = vel[i] + a6 * acc[i] + a7 * an
-        acc[i] = an
-        x[i] = xn
-        out += mc[i, _OUT] * an
-    return out
+        gi, oi = mc[i, _G], mc[i, _OUT]
+        for g in range(lanes):
+            xn = y[i, g] - corr[g] * gi
+            an = a0 * (xn - x[i, g]) - a2 * vel[i, g] - a3 * acc[i, g]
+            vel[i, g] = vel[i, g] + a6 * acc[i, g] + a7 * an
+            acc[i, g] = an
+            x[i, g] = xn
+            o[g] += oi * an
+
+
+@nb.njit(cache=True, inline="always")
+def _load_group(X, V, A, b0, lanes):
+    ndof = X.shape[1]
+    x = np.empty((ndof, lanes))
+    vel = np.empty((ndof, lanes))
+    acc = np.empty((ndof, lanes))
+    for g in range(lanes):
+        for i in range(ndof):
+            x[i, g] = X[b0 + g, i]
+            vel[i, g] = V[b0 + g, i]
+            acc[i, g] = A[b0 + g, i]
+    return x, vel, acc
+
+
+@nb.njit(cache=True, inline="always")
+def _store_group(X, V, A, b0, x, vel, acc):
+    ndof, lanes = x.shape
+    for g in range(lanes):
+        for i in range(ndof):
+            X[b0 + g, i] = x[i, g]
+            V[b0 + g, i] = vel[i, g]
+            A[b0 + g, i] = acc[i, g]
+
+
+@nb.njit(cache=True, inline="always")
+def _record(out, b0, o, r):
+    if r >= 0 and r < out.shape[1]:
+        for g in range(o.shape[0]):
+            out[b0 + g, r] = o[g]
 
 
 @nb.njit(cache=True, parallel=True, fastmath=True)
 def newmark_spur(load, motor_acc, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_frac,
                  trig, kf_tab, ef_tab, f_tooth, g_slope, g_wa, g_wb, g_noise, p_slope, p_wa,
-                 p_wb, p_noise, mc, sc, X, V, A, rec_start, out):
-    """Integrate ``out.shape[0]`` spur signals over the steps of :func:`contact_slots`.
+                 p_wb, p_noise, mc, sc, X, V, A, lanes, rec_start, out):
+    """Integrate ``X.shape[0]`` spur signals (a multiple of ``lanes``, integrated
+    ``lanes`` at a time) over the steps of :func:`contact_slots`.
 
     Per signal ``b``: faulty gear tooth ``f_tooth[b]`` (-1: none) with stiffness
     ``kf_tab[b]`` and displacement excitation ``ef_tab[b]`` over the contact position;
-    profile errors of tooth t at position s: ``slope[t] s + wa[t] sin(2 pi n s) +
-    wb[t] cos(2 pi n s) + noise[t](s)`` (``wa, wb`` = half the waviness times cos, sin of
-    the tooth's phase). The modal state ``X, V, A`` (n_batch, ndof) is updated in place
-    and the output of steps ``rec_start ... rec_start + out.shape[1] - 1`` is written
-    into ``out``."""
-    n_batch = out.shape[0]
+    profile errors of tooth t at position s: ``slope[t, b] s + wa[t, b] sin(2 pi n s) +
+    wb[t, b] cos(2 pi n s) + noise[t, :, b](s)`` (``wa, wb`` = half the waviness times
+    cos, sin of the tooth's phase; tooth-major, signals last). The modal state ``X, V, A``
+    (n_batch, ndof) is updated in place and the output of steps ``rec_start ...
+    rec_start + out.shape[1] - 1`` is written into ``out``."""
     n_steps = count.shape[0]
-    n_rec = out.shape[1]
-    ndof = X.shape[1]
-    for b in nb.prange(n_batch):
-        x = X[b].copy()
-        vel = V[b].copy()
-        acc = A[b].copy()
-        y = np.zeros(ndof)
-        ft = f_tooth[b]
-        gs, gwa, gwb, gn = g_slope[b], g_wa[b], g_wb[b], g_noise[b]
-        ps, pwa, pwb, pn = p_slope[b], p_wa[b], p_wb[b], p_noise[b]
-        kf, ef = kf_tab[b], ef_tab[b]
+    for grp in nb.prange(X.shape[0] // lanes):
+        b0 = grp * lanes
+        x, vel, acc = _load_group(X, V, A, b0, lanes)
+        y = np.empty_like(x)
+        corr = np.empty(lanes)
+        kk = np.empty(lanes)
+        fex = np.empty(lanes)
+        o = np.empty(lanes)
         for n in range(n_steps):
-            kk = 0.0
-            fex = 0.0
+            for g in range(lanes):
+                kk[g] = 0.0
+                fex[g] = 0.0
             for c in range(count[n]):
                 u = pos[n, c]
                 gt = gtooth[n, c]
                 pt = ptooth[n, c]
                 i = n_cell[n, c]
                 f = n_frac[n, c]
-                e = (gs[gt] * u + gwa[gt] * trig[n, c, 0] + gwb[gt] * trig[n, c, 1]
-                     + gn[gt, i] * (1.0 - f) + gn[gt, i + 1] * f
-                     + ps[pt] * u + pwa[pt] * trig[n, c, 2] + pwb[pt] * trig[n, c, 3]
-                     + pn[pt, i] * (1.0 - f) + pn[pt, i + 1] * f)
-                if gt == ft:
-                    k = _interp_table(kf, u)
-                    e += _interp_table(ef, u)
-                else:
-                    k = k_h[n, c]
+                fm = 1.0 - f
                 w = wgt[n, c]
-                kk += w * k
-                fex += w * k * e
-            o = _modal_step(x, vel, acc, y, kk, fex, load[n], motor_acc[n], mc, sc)
-            r = n - rec_start
-            if r >= 0 and r < n_rec:
-                out[b, r] = o
-        X[b] = x
-        V[b] = vel
-        A[b] = acc
+                sg, cg, sp, cp = trig[n, c, 0], trig[n, c, 1], trig[n, c, 2], trig[n, c, 3]
+                kh = k_h[n, c]
+                hit = False
+                for g in range(lanes):
+                    if f_tooth[b0 + g] == gt:
+                        hit = True
+                for g in range(lanes):
+                    b = b0 + g
+                    e = (g_slope[gt, b] * u + g_wa[gt, b] * sg + g_wb[gt, b] * cg
+                         + g_noise[gt, i, b] * fm + g_noise[gt, i + 1, b] * f
+                         + p_slope[pt, b] * u + p_wa[pt, b] * sp + p_wb[pt, b] * cp
+                         + p_noise[pt, i, b] * fm + p_noise[pt, i + 1, b] * f)
+                    k = kh
+                    if hit and f_tooth[b] == gt:
+                        k = _interp_table(kf_tab[b], u)
+                        e += _interp_table(ef_tab[b], u)
+                    kk[g] += w * k
+                    fex[g] += w * k * e
+            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
+            _record(out, b0, o, n - rec_start)
+        _store_group(X, V, A, b0, x, vel, acc)
 
 
 @nb.njit(cache=True, parallel=True, fastmath=True)
 def newmark_tables(load, motor_acc, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_tab,
-                   f_tooth, fg_tab, fp_tab, fpf_tab, mc, sc, X, V, A, rec_start, out):
+                   f_tooth, fg_tab, fp_tab, fpf_tab, mc, sc, X, V, A, lanes, rec_start, out):
     """As :func:`newmark_spur`, with every tooth pair's stiffness and error force read
     from tables over the delay since the pair's first contact: ``k_h`` (healthy, per
     contact) or ``kf_tab[b]`` (the faulty gear tooth ``f_tooth[b]``); force
-    ``fg_tab[b, gear tooth] + fp_tab[b, pinion tooth]`` (``fpf_tab`` when the gear tooth
-    is the faulty one). Used for helical pairs."""
-    n_batch = out.shape[0]
+    ``fg_tab[gear tooth, :, b] + fp_tab[pinion tooth, :, b]`` (``fpf_tab[b, pinion
+    tooth]`` instead of ``fp_tab`` when the gear tooth is the faulty one; tables
+    tooth-major, signals last). Used for helical pairs."""
     n_steps = count.shape[0]
-    n_rec = out.shape[1]
-    ndof = X.shape[1]
-    for b in nb.prange(n_batch):
-        x = X[b].copy()
-        vel = V[b].copy()
-        acc = A[b].copy()
-        y = np.zeros(ndof)
-        ft = f_tooth[b]
-        kf, fg, fp, fpf = kf_tab[b], fg_tab[b], fp_tab[b], fpf_tab[b]
+    for grp in nb.prange(X.shape[0] // lanes):
+        b0 = grp * lanes
+        x, vel, acc = _load_group(X, V, A, b0, lanes)
+        y = np.empty_like(x)
+        corr = np.empty(lanes)
+        kk = np.empty(lanes)
+        fex = np.empty(lanes)
+        o = np.empty(lanes)
         for n in range(n_steps):
-            kk = 0.0
-            fex = 0.0
+            for g in range(lanes):
+                kk[g] = 0.0
+                fex[g] = 0.0
             for c in range(count[n]):
                 gt = gtooth[n, c]
                 pt = ptooth[n, c]
                 i = cell[n, c]
                 f = frac[n, c]
-                g = 1.0 - f
-                if gt == ft:
-                    k = kf[i] * g + kf[i + 1] * f
-                    fo = (fg[gt, i] * g + fg[gt, i + 1] * f) + (fpf[pt, i] * g
-                                                                + fpf[pt, i + 1] * f)
-                else:
-                    k = k_h[n, c]
-                    fo = (fg[gt, i] * g + fg[gt, i + 1] * f) + (fp[pt, i] * g
-                                                                + fp[pt, i + 1] * f)
+                fm = 1.0 - f
                 w = wgt[n, c]
-                kk += w * k
-                fex += w * fo
-            o = _modal_step(x, vel, acc, y, kk, fex, load[n], motor_acc[n], mc, sc)
-            r = n - rec_start
-            if r >= 0 and r < n_rec:
-                out[b, r] = o
-        X[b] = x
-        V[b] = vel
-        A[b] = acc
+                kh = k_h[n, c]
+                hit = False
+                for g in range(lanes):
+                    if f_tooth[b0 + g] == gt:
+                        hit = True
+                for g in range(lanes):
+                    b = b0 + g
+                    fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                        fp_tab[pt, i, b] * fm + fp_tab[pt, i + 1, b] * f)
+                    k = kh
+                    if hit and f_tooth[b] == gt:
+                        k = kf_tab[b, i] * fm + kf_tab[b, i + 1] * f
+                        fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                            fpf_tab[b, pt, i] * fm + fpf_tab[b, pt, i + 1] * f)
+                    kk[g] += w * k
+                    fex[g] += w * fo
+            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
+            _record(out, b0, o, n - rec_start)
+        _store_group(X, V, A, b0, x, vel, acc)

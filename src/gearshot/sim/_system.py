@@ -25,6 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._ftff_batch import ftff_cached, is_ftff
+from ._helical import helical_batch_tables
 from ._kernel import (
     G0,
     contact_slots,
@@ -33,11 +35,10 @@ from ._kernel import (
     spur_shared,
     table_shared,
 )
-from ._slices import box
 from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors
-from .stiffness import _N_TABLE, _pair_table, band_arrays, fault_tables, helical_tables
+from .stiffness import _N_TABLE, _pair_table, fault_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
            "make_batch", "warmup_time"]
@@ -159,6 +160,7 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
     """Per-signal tables over the contact position u of the faulty pair's stiffness and
     displacement excitation (from the fault's hooks), and the faulty tooth index."""
     n = len(faults)
+    prefetch_ftff(pair, faults)
     kf = np.empty((n, _N_TABLE))
     ef = np.zeros((n, _N_TABLE))
     tooth = np.full(n, -1, dtype=np.int64)
@@ -172,6 +174,15 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
     return kf, ef, tooth
 
 
+def prefetch_ftff(pair: GearPair, faults) -> None:
+    """Compute the tables of every FTFF among ``faults`` (and their face bands) in one
+    batch (:func:`._ftff_batch.ftff_cached`)."""
+    todo = [band for f in faults if f is not None and not f.is_healthy
+            for _, _, band in f.face_bands(pair) if is_ftff(band)]
+    if todo:
+        ftff_cached(pair, todo)
+
+
 def _stack_errors(errs: list[ToothProfileErrors]):
     """Slope, the waviness as sine/cosine amplitudes (half the waviness times cos/sin of
     each tooth's phase) and noise knots of every signal; the waves per profile."""
@@ -180,6 +191,27 @@ def _stack_errors(errs: list[ToothProfileErrors]):
     return ((np.stack([e.slope for e in errs]), half * np.cos(phase), half * np.sin(phase),
              np.ascontiguousarray(np.stack([e.noise for e in errs]))),
             float(errs[0].n_waves))
+
+
+LANES = 8      # signals integrated side by side by one thread (_kernel._modal_step)
+
+
+def _lanes(n: int) -> tuple[int, int]:
+    """(lanes, padded batch size) for ``n`` signals."""
+    lanes = min(LANES, n)
+    return lanes, -(-n // lanes) * lanes
+
+
+def _pad(a: np.ndarray, n_pad: int) -> np.ndarray:
+    """``a`` with its first axis padded to ``n_pad`` by repeating the last row."""
+    if a.shape[0] == n_pad:
+        return a
+    return np.concatenate([a, np.repeat(a[-1:], n_pad - a.shape[0], axis=0)])
+
+
+def _signals_last(a: np.ndarray, n_pad: int) -> np.ndarray:
+    """Per-signal array (n, ...) padded and moved to (..., n_pad), contiguous."""
+    return np.ascontiguousarray(np.moveaxis(_pad(a, n_pad), 0, -1))
 
 
 def _contacts(mesh_pos, span, k_tab):
@@ -197,15 +229,25 @@ class Batch:
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
         self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
-        self.g, self.g_nw = _stack_errors(gear_errs)
-        self.p, self.p_nw = _stack_errors(pin_errs)
-        self._init_state(len(faults))
+        n = len(faults)
+        self.lanes, n_pad = _lanes(n)
+        tooth = np.full(n_pad, -1, dtype=np.int64)
+        tooth[:n] = self.tooth
+        self.tooth = tooth
+        self.kf, self.ef = _pad(self.kf, n_pad), _pad(self.ef, n_pad)
+        g, self.g_nw = _stack_errors(gear_errs)
+        p, self.p_nw = _stack_errors(pin_errs)
+        self.g = tuple(_signals_last(a, n_pad) for a in g)
+        self.p = tuple(_signals_last(a, n_pad) for a in p)
+        self._init_state(n)
 
     def _init_state(self, n):
         x0 = self.integ.x_static
-        self.X = np.tile(x0, (n, 1))          # modal coordinates
-        self.V = np.zeros((n, x0.size))
-        self.A = np.zeros((n, x0.size))
+        self.n = n
+        n_pad = _lanes(n)[1]
+        self.X = np.tile(x0, (n_pad, 1))          # modal coordinates
+        self.V = np.zeros((n_pad, x0.size))
+        self.A = np.zeros((n_pad, x0.size))
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
         """Advance over the given steps; return the vertical acceleration (g) of steps
@@ -213,15 +255,15 @@ class Batch:
         pair, integ = self.pair, self.integ
         pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, pair.contact_ratio,
                                                         _pair_table(pair, None))
-        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[2], self.g_nw,
+        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[1], self.g_nw,
                                            self.p_nw)
         out = np.empty((self.X.shape[0], n_rec))
         newmark_spur(np.ascontiguousarray(load, dtype=float),
                      np.ascontiguousarray(motor_acc, dtype=float), count, wgt, pos,
-                     pair_id % self.g[0].shape[1], pair_id % self.p[0].shape[1], k_h,
+                     pair_id % self.g[0].shape[0], pair_id % self.p[0].shape[0], k_h,
                      n_cell, n_frac, trig, self.kf, self.ef, self.tooth, *self.g, *self.p,
-                     integ.mc, integ.sc, self.X, self.V, self.A, rec_start, out)
-        return out
+                     integ.mc, integ.sc, self.X, self.V, self.A, self.lanes, rec_start, out)
+        return out[:self.n]
 
 
 class HelicalBatch(Batch):
@@ -230,37 +272,16 @@ class HelicalBatch(Batch):
 
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
-        ea, eb = pair.contact_ratio, pair.overlap_ratio
-        self.span, self.k, _ = helical_tables(pair)
-        tau = np.linspace(0.0, self.span, self.k.size)
-        u = np.linspace(0.0, 1.0, _N_TABLE)
-        k_sp = _pair_table(pair, None)
         n = len(faults)
-
-        def errors(errs):
-            teeth = np.arange(errs[0].slope.size)[:, None]
-            return np.stack([e(teeth, u[None, :]) for e in errs])
-
-        e_g, e_p = errors(gear_errs), errors(pin_errs)
-        self.fg = box(k_sp * e_g, ea, eb, 0.0, eb, tau)
-        self.fp = box(k_sp * e_p, ea, eb, 0.0, eb, tau)
-        self.fpf = self.fp.copy()
-        self.kf = np.tile(self.k, (n, 1))
-        self.tooth = np.full(n, -1, dtype=np.int64)
-        for i, f in enumerate(faults):
-            if f is None or f.is_healthy:
-                continue
-            t = f.tooth % pair.z_gear
-            _, self.kf[i], bands = helical_tables(pair, f)
-            self.tooth[i] = t
-            if not bands:
-                continue
-            # every band in one call each; added band by band (the order of the sums)
-            lo, hi, dk, kd = band_arrays(bands)
-            for part in box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau):
-                self.fg[i, t] += part
-            for part in box(dk[:, None, :] * e_p[i][None], ea, eb, lo, hi, tau):
-                self.fpf[i] += part
+        prefetch_ftff(pair, faults)
+        (self.span, self.k, self.kf, self.tooth, self.fg, self.fp,
+         self.fpf) = helical_batch_tables(pair, faults, gear_errs, pin_errs)
+        self.lanes, n_pad = _lanes(n)
+        tooth = np.full(n_pad, -1, dtype=np.int64)
+        tooth[:n] = self.tooth
+        self.tooth = tooth
+        self.kf, self.fpf = _pad(self.kf, n_pad), _pad(self.fpf, n_pad)
+        self.fg, self.fp = _signals_last(self.fg, n_pad), _signals_last(self.fp, n_pad)
         self._init_state(n)
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
@@ -270,10 +291,10 @@ class HelicalBatch(Batch):
         newmark_tables(
             np.ascontiguousarray(load, dtype=float),
             np.ascontiguousarray(motor_acc, dtype=float), count, wgt,
-            pair_id % self.fg.shape[1], pair_id % self.fp.shape[1], k_h, cell, frac,
+            pair_id % self.fg.shape[0], pair_id % self.fp.shape[0], k_h, cell, frac,
             self.kf, self.tooth, self.fg, self.fp, self.fpf, integ.mc, integ.sc, self.X,
-            self.V, self.A, rec_start, out)
-        return out
+            self.V, self.A, self.lanes, rec_start, out)
+        return out[:self.n]
 
 
 def make_batch(pair, integ, faults, gear_errs, pin_errs) -> Batch:
