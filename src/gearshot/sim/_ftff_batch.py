@@ -29,26 +29,60 @@ __all__ = ["bridge_batch", "ftff_gear_compliance"]
 _N_KNOTS = 129      # bridge samples across the cut
 _MARGIN = 0.04      # FullToothFaceFault._flank_points defaults
 _N_ARC = 80
+_N_INVOLUTE = 5     # involute points beyond each edge of the cut
 
 
-def _flank_points(pair: GearPair, fault):
-    """:meth:`FullToothFaceFault._flank_points` (scalar geometry per fault)."""
-    return fault._flank_points(pair, _MARGIN, _N_ARC)
+def _arcs(pair: GearPair, faults):
+    """:meth:`FullToothFaceFault._arc` of every fault, as arrays (n,): window s0, s1 and
+    the cut's xa, xb, cx, ch, radius."""
+    z = pair.z_gear
+    rb = pair.base_radius(z)
+    _, (l_lo, l_hi) = pair.roll_limits
+    size = np.array([f.size for f in faults], dtype=float)
+    centre = np.array([f.center for f in faults], dtype=float)
+    depth = np.array([f.depth for f in faults], dtype=float)
+    s0, s1 = centre - 0.5 * size, centre + 0.5 * size
+    ends = []
+    for sv in (s0, s1):
+        r = np.hypot(rb, l_lo + sv * (l_hi - l_lo))
+        psi = involute_half_angle(z, pair.transverse_pressure_angle, r, rb)
+        ends.append((r * np.cos(psi), r * np.sin(psi)))
+    (xa, ha), (xb, hb) = ends
+    chord = np.hypot(xb - xa, hb - ha)
+    radius = chord / 4 * (depth + 1 / depth)
+    sag = depth * chord / 2
+    tx, th = (xb - xa) / chord, (hb - ha) / chord
+    sign = np.where(-tx > 0, -1.0, 1.0)       # normal pointing into the tooth
+    nx, nh = sign * th, sign * -tx
+    mx, mh = 0.5 * (xa + xb), 0.5 * (ha + hb)
+    cx, ch = mx - nx * (radius - sag), mh - nh * (radius - sag)
+    return s0, s1, np.column_stack([xa, xb, cx, ch, radius])
 
 
-def bridge_batch(pair: GearPair, faults):
+def _flank_points(pair: GearPair, s0, s1, arcs):
+    """:meth:`FullToothFaceFault._flank_points` of every fault: (n, 90) radius and angle
+    from the tooth centre line."""
+    z = pair.z_gear
+    rb = pair.base_radius(z)
+    _, (l_lo, l_hi) = pair.roll_limits
+    pieces = [np.linspace(np.maximum(s0 - _MARGIN, -0.02), s0, _N_INVOLUTE, axis=-1),
+              np.linspace(s1, np.minimum(s1 + _MARGIN, 1.0), _N_INVOLUTE, axis=-1)]
+    ls = l_lo + np.concatenate(pieces, axis=-1) * (l_hi - l_lo)
+    r = np.hypot(rb, np.maximum(ls, 0.0))
+    psi = involute_half_angle(z, pair.transverse_pressure_angle, r, rb)
+    xa, xb, cx, ch, radius = (arcs[:, m:m + 1] for m in range(5))
+    xx = np.linspace(xa[:, 0], xb[:, 0], _N_ARC, axis=-1)
+    hh = ch - np.sqrt(np.maximum(radius ** 2 - (xx - cx) ** 2, 0.0))
+    return (np.concatenate([r, np.hypot(xx, hh)], axis=-1),
+            np.concatenate([psi, np.arctan2(hh, xx)], axis=-1))
+
+
+def bridge_batch(pair: GearPair, faults, geometry=None):
     """:meth:`FullToothFaceFault.bridge` of every fault: arrays (n, 129) of knots,
-    retreat (m) and touched roll fraction."""
-    n = len(faults)
-    knots = np.empty((n, _N_KNOTS))
-    flank = [_flank_points(pair, f) for f in faults]
-    n_pts = flank[0][0].size
-    r = np.empty((n, n_pts))
-    ang = np.empty((n, n_pts))
-    for i, f in enumerate(faults):
-        s0, s1 = f.window
-        knots[i] = np.linspace(s0, s1, _N_KNOTS)
-        r[i], ang[i] = flank[i]
+    retreat (m) and touched roll fraction (``geometry``: :func:`_arcs` of the faults)."""
+    s0, s1, arcs = _arcs(pair, faults) if geometry is None else geometry
+    knots = np.linspace(s0, s1, _N_KNOTS, axis=-1)
+    r, ang = _flank_points(pair, s0, s1, arcs)
     ret, radius = _retreat(pair, 1.0 - knots, r, ang)
     rb = pair.base_radius(pair.z_gear)
     _, (l_lo, l_hi) = pair.roll_limits
@@ -257,7 +291,10 @@ def ftff_tables(pair: GearPair, faults):
     from .stiffness import _N_SEGMENT, _N_TABLE, _healthy_compliances
 
     n = len(faults)
-    parts = [bridge_batch(pair, faults[i:i + _RETREAT_CHUNK])
+    s0s, s1s, arcs_all = _arcs(pair, faults)
+    parts = [bridge_batch(pair, faults[i:i + _RETREAT_CHUNK],
+                          (s0s[i:i + _RETREAT_CHUNK], s1s[i:i + _RETREAT_CHUNK],
+                           arcs_all[i:i + _RETREAT_CHUNK]))
              for i in range(0, n, _RETREAT_CHUNK)]
     knots, ret, contact = (np.concatenate([p[m] for p in parts]) for m in range(3))
     u = np.linspace(0.0, 1.0, _N_TABLE)
@@ -265,13 +302,12 @@ def ftff_tables(pair: GearPair, faults):
     inv_p, inv_g = _healthy_compliances(pair)
     _, (g_lo, g_hi) = pair.roll_limits
     rolls, arcs, segs = [], [], []
-    for i, f in enumerate(faults):
+    for i in range(n):
         kn, ct = knots[i], contact[i]
         j = int(np.argmax(np.abs(np.diff(ct))))          # FullToothFaceFault._switch
         sw = 0.5 * (kn[j] + kn[j + 1])
-        s0, s1 = f.window
+        s0, s1 = s0s[i], s1s[i]
         edges = np.unique(np.clip(np.concatenate([[s0, 1.0], [s0, sw, s1]]), s0, 1.0))
-        (xa, xb), (cx, ch), radius, _ = f._arc(pair)
         k_hi, k_lo = kn > sw, kn <= sw
         for a, b in zip(edges[:-1], edges[1:]):
             if b - a <= 0:
@@ -289,7 +325,7 @@ def ftff_tables(pair: GearPair, faults):
             if lo.any():
                 cr[lo] = np.interp(kts[lo], kn[k_lo], ct[k_lo])
             rolls.append(g_lo + cr * (g_hi - g_lo))
-            arcs.append(np.tile([xa, xb, cx, ch, radius], (_N_SEGMENT, 1)))
+            arcs.append(np.broadcast_to(arcs_all[i], (_N_SEGMENT, 5)))
             segs.append((i, sel, kts))
     vals = ftff_gear_compliance(pair, np.concatenate(rolls), np.concatenate(arcs))
     inv = np.tile(inv_g, (n, 1))
@@ -299,7 +335,7 @@ def ftff_tables(pair: GearPair, faults):
     k = 1.0 / (1.0 / k_h + inv_p + inv)
     ef = np.zeros((n, _N_TABLE))
     for i, f in enumerate(faults):                        # FullToothFaceFault.displacement
-        s0, s1 = f.window
+        s0, s1 = s0s[i], s1s[i]
         inside = (s > s0) & (s < s1)
         if inside.any():
             ef[i, inside] = -f.transmission * np.interp(s[inside], knots[i], ret[i])
