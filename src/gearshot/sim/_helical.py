@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ._slices import box
 from .geometry import GearPair
@@ -54,14 +55,23 @@ def _params(errs) -> np.ndarray:
                            np.stack([e.noise for e in errs])], axis=-1)
 
 
-def _forces(pair: GearPair, errs) -> np.ndarray:
-    """Boxed error force (n, z, n_tau) of every tooth of every signal."""
+def _forces(pair: GearPair, errs, n_pad: int) -> np.ndarray:
+    """Boxed error force (z, n_tau, n_pad) of every tooth of every signal (signals last,
+    padded by repeating the last signal)."""
     p = _params(errs)
+    p = np.concatenate([p, np.repeat(p[-1:], n_pad - p.shape[0], axis=0)])
     basis = _error_basis(pair, float(errs[0].n_waves), errs[0].noise.shape[1])
-    return (p.reshape(-1, p.shape[-1]) @ basis).reshape(p.shape[:2] + (basis.shape[1],))
+    p = np.ascontiguousarray(p.transpose(1, 2, 0))               # (z, n_basis, n_pad)
+    out = np.empty((p.shape[0], basis.shape[1], n_pad))
+    bt = np.ascontiguousarray(basis.T)
+    # small products: a threaded BLAS only spins (x30 CPU time measured), so one thread
+    with threadpool_limits(1, user_api="blas"):
+        for t in range(p.shape[0]):                              # one product per tooth
+            np.dot(bt, p[t], out=out[t])
+    return out
 
 
-def helical_batch_tables(pair: GearPair, faults, gear_errs, pin_errs):
+def helical_batch_tables(pair: GearPair, faults, gear_errs, pin_errs, n_pad: int):
     """Tables of a helical batch.
 
     Returns
@@ -82,8 +92,8 @@ def helical_batch_tables(pair: GearPair, faults, gear_errs, pin_errs):
     tau = np.linspace(0.0, span, k.size)
     u = np.linspace(0.0, 1.0, _N_TABLE)
     n = len(faults)
-    fg, fp = _forces(pair, gear_errs), _forces(pair, pin_errs)
-    fpf = fp.copy()
+    fg, fp = _forces(pair, gear_errs, n_pad), _forces(pair, pin_errs, n_pad)
+    fpf = np.ascontiguousarray(fp[:, :, :n].transpose(2, 0, 1))
     kf = np.tile(k, (n, 1))
     tooth = np.full(n, -1, dtype=np.int64)
     groups: dict = {}
@@ -112,10 +122,10 @@ def helical_batch_tables(pair: GearPair, faults, gear_errs, pin_errs):
         for part in box(dk, ea, eb, lo, hi, tau):       # added band by band, in order
             k_rows += part
         kf[rows] = np.maximum(k_rows, 0.0)
-        g_rows = fg[rows, teeth]
+        g_rows = fg[teeth, :, rows]                     # (n_f, n_tau)
         for part in box(dk * e_g[None] + kd, ea, eb, lo, hi, tau):
             g_rows += part
-        fg[rows, teeth] = g_rows
+        fg[teeth, :, rows] = g_rows
         p_rows = fpf[rows]
         for part in box(dk[:, :, None, :] * e_p[None], ea, eb, lo, hi, tau):
             p_rows += part

@@ -273,15 +273,13 @@ class HelicalBatch(Batch):
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
         n = len(faults)
-        prefetch_ftff(pair, faults)
-        (self.span, self.k, self.kf, self.tooth, self.fg, self.fp,
-         self.fpf) = helical_batch_tables(pair, faults, gear_errs, pin_errs)
         self.lanes, n_pad = _lanes(n)
-        tooth = np.full(n_pad, -1, dtype=np.int64)
-        tooth[:n] = self.tooth
-        self.tooth = tooth
+        prefetch_ftff(pair, faults)
+        (self.span, self.k, self.kf, tooth, self.fg, self.fp,
+         self.fpf) = helical_batch_tables(pair, faults, gear_errs, pin_errs, n_pad)
+        self.tooth = np.full(n_pad, -1, dtype=np.int64)
+        self.tooth[:n] = tooth
         self.kf, self.fpf = _pad(self.kf, n_pad), _pad(self.fpf, n_pad)
-        self.fg, self.fp = _signals_last(self.fg, n_pad), _signals_last(self.fp, n_pad)
         self._init_state(n)
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
