@@ -154,3 +154,17 @@ def test_modified_chunk_is_rebuilt_on_resume(store, monkeypatch):
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
     build_database(store, **KW)
     np.testing.assert_array_equal(load_database(store, speed=15, load=10).sa.values, ref)
+
+
+@pytest.mark.parametrize("helical", [False, True])
+def test_cut_from_the_lowest_contact_point_has_no_retreat_at_its_edge(helical):
+    """A cut starting at the lowest contact point (s0 = 0): at that edge the pinion tip
+    touches the intact involute, so the retreat is 0 there (the flank point at the
+    pinion tip counts; it was kept or dropped by rounding before, a 0.5 mm spike)."""
+    import math
+
+    pair = GearPair.helical(math.radians(20)) if helical else GearPair.paper()
+    for fault in (Fault.ftff(1.0), Fault.ftff(0.3, center=0.15)):
+        knots, ret, _ = fault.bridge(pair)
+        assert knots[0] == 0.0
+        assert ret[0] < 1e-9 and ret.max() > 1e-6

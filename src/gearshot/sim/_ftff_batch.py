@@ -128,13 +128,17 @@ def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     ``atan2(P) + inv(|P|)``, ``inv(rho) = tan(acos(rb1/rho)) - acos(rb1/rho)``, computed as
     the angle of P turned back by ``acos(rb1/rho)`` (one arctangent) plus
     ``sqrt(1 - c^2) / c``, c = rb1/|P|; the gap is wrapped to one base pitch circle as in
-    :meth:`FullToothFaceFault._retreat` (equal up to rounding)."""
+    :meth:`FullToothFaceFault._retreat` (equal up to rounding). Points on the pinion's
+    flank ends (base and tip circle) count within a relative 1e-12."""
     n, n_u = cc.shape
     n_pts = r.shape[1]
     ret = np.empty((n, n_u))
     rad = np.empty((n, n_u))
     circ = 2.0 * math.pi * rb1
     half = math.pi * rb1
+    # the pinion flank's ends count (rounding of the rotated points must not drop the
+    # point at the pinion tip, where the contact at u = 1 lies)
+    lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
     for f in range(n):
         for m in range(n_u):
             best = np.inf
@@ -145,8 +149,8 @@ def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
                 sth = sm * ca[f, k] + cm * sa[f, k]
                 px = o2x + r[f, k] * cth
                 py = r[f, k] * sth
-                rp = math.sqrt(px * px + py * py)
-                if rp < rb1 or rp > ra1:
+                rp = math.hypot(px, py)
+                if rp < lo_r or rp > hi_r:
                     continue
                 c = rb1 / rp
                 s = math.sqrt(max(1.0 - c * c, 0.0))

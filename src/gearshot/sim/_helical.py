@@ -61,13 +61,13 @@ def _forces(pair: GearPair, errs, n_pad: int) -> np.ndarray:
     p = _params(errs)
     p = np.concatenate([p, np.repeat(p[-1:], n_pad - p.shape[0], axis=0)])
     basis = _error_basis(pair, float(errs[0].n_waves), errs[0].noise.shape[1])
-    p = np.ascontiguousarray(p.transpose(1, 2, 0))               # (z, n_basis, n_pad)
+    p = p.transpose(1, 2, 0).copy()                              # (z, n_basis, n_pad)
     out = np.empty((p.shape[0], basis.shape[1], n_pad))
     bt = np.ascontiguousarray(basis.T)
     # small products: a threaded BLAS only spins (x30 CPU time measured), so one thread
     with threadpool_limits(1, user_api="blas"):
         for t in range(p.shape[0]):                              # one product per tooth
-            np.dot(bt, p[t], out=out[t])
+            out[t] = bt @ p[t]
     return out
 
 
@@ -93,7 +93,7 @@ def helical_batch_tables(pair: GearPair, faults, gear_errs, pin_errs, n_pad: int
     u = np.linspace(0.0, 1.0, _N_TABLE)
     n = len(faults)
     fg, fp = _forces(pair, gear_errs, n_pad), _forces(pair, pin_errs, n_pad)
-    fpf = np.ascontiguousarray(fp[:, :, :n].transpose(2, 0, 1))
+    fpf = fp[:, :, :n].transpose(2, 0, 1).copy()       # a copy even for size-1 axes
     kf = np.tile(k, (n, 1))
     tooth = np.full(n, -1, dtype=np.int64)
     groups: dict = {}
