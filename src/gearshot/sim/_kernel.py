@@ -17,7 +17,7 @@ The Newmark update runs in the mass-normalised modal coordinates of the mean-sti
 system, where mass and (modal) damping are diagonal and the mesh stiffness is a rank-one
 change along the line-of-action vector: the effective stiffness is diagonal plus rank one
 and is solved exactly by the Sherman-Morrison formula in O(ndof) per step
-(:func:`gearshot.sim._system.modal_integrator` builds the coefficients).
+(:func:`gearshot.sim._system.integrator` builds the coefficients).
 """
 
 from __future__ import annotations

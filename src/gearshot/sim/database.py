@@ -36,6 +36,7 @@ from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, describe
+from ._block_read import read_block, resume_problem
 from .dynamics import simulate_sa
 from .fault_types import FAULT_MODEL_VERSIONS, FAULT_TYPES, check_fault_type
 from .geometry import GearPair
@@ -206,78 +207,6 @@ def _legacy_block_problem(path: Path) -> str | None:
     if not (np.all(np.isfinite(ds["sa"].values))
             and np.all(np.isfinite(ds["fault_size"].values))):
         return "a chunk of it is missing (its arrays hold fill values)"
-    return None
-
-
-def _read_block(path: Path):
-    """Read a built block once: ``(dataset, None)`` or ``(None, problem)``.
-
-    Every file of the checksum list is read into memory once, its size and CRC-32
-    checked on those bytes, and the block decoded from them (a zarr memory store); a
-    block from before checksum lists is decoded from disk and checked for holes."""
-    import xarray as xr
-    import zarr.storage
-    from zarr.core.buffer import default_buffer_prototype
-
-    try:
-        root = (path / _ROOT).read_bytes()
-        record = json.loads(root).get("attributes", {}).get(_ATTR, {})
-        if not isinstance(record, dict):
-            raise ValueError(f"attribute {_ATTR!r} is not a mapping")
-    except FileNotFoundError:
-        return None, f"its metadata file {_ROOT!r} is missing"
-    except (OSError, ValueError) as exc:
-        return None, f"its metadata file {_ROOT!r} is unreadable ({exc})"
-    if not record:
-        problem = _legacy_block_problem(path)
-        if problem is not None:
-            return None, problem
-        return xr.open_zarr(path, consolidated=False).load(), None
-    files = record.get("files")
-    if not isinstance(files, dict) or not files:
-        return None, f"its checksum list (attribute {_ATTR!r}) is damaged"
-    buf = default_buffer_prototype().buffer
-    content = {_ROOT: buf.from_bytes(root)}
-    for rel, want in sorted(files.items()):
-        try:
-            data = (path / rel).read_bytes()
-        except FileNotFoundError:
-            return None, f"file {rel!r} is missing"
-        except OSError as exc:
-            return None, f"file {rel!r} cannot be read ({exc.strerror or exc})"
-        got = [len(data), zlib.crc32(data)]
-        if got != list(want):
-            return None, (f"file {rel!r} is corrupt (size/CRC-32 {got} != recorded "
-                          f"{list(want)})")
-        content[rel] = buf.from_bytes(data)
-    try:
-        ds = xr.open_zarr(zarr.storage.MemoryStore(content), consolidated=False).load()
-    except Exception as exc:  # a decoder's error on a damaged chunk
-        return None, f"it cannot be decoded ({type(exc).__name__}: {exc})"
-    return ds, None
-
-
-def _resume_problem(path: Path) -> str | None:
-    """What is wrong with a built block, by file sizes and times only (resuming a build
-    reads no chunk): every listed file present with its recorded size and not modified
-    after the checksum list was written; a block failing that is checked in full
-    (:func:`_block_problem`). A damage that keeps a file's size and time (bit rot) is
-    caught when the block is read (:func:`_read_block`)."""
-    try:
-        record = _block_record(path)
-        stamp = (path / _ROOT).stat().st_mtime_ns
-    except (OSError, ValueError):
-        return _block_problem(path)
-    files = record.get("files") if record else None
-    if not isinstance(files, dict) or not files:
-        return _block_problem(path)
-    for rel, want in files.items():
-        try:
-            st = (path / rel).stat()
-        except OSError:
-            return _block_problem(path)
-        if [st.st_size] != list(want)[:1] or st.st_mtime_ns > stamp:
-            return _block_problem(path)
     return None
 
 
@@ -454,7 +383,7 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     for t in tasks:
         path = blocks / _block_name(*t[:3], t[6])
         if path.exists():
-            problem = _resume_problem(path)
+            problem = resume_problem(path)
             if problem is None:
                 if not _block_record(path):   # a block from before checksum lists
                     _write_checksums(path, manifest)
@@ -597,7 +526,7 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
                      f"grade={man['grades'][k]!r}, fault_type={ft!r}) of store {str(store)!r}")
             if not path.exists():
                 raise GearshotError(f"{where} is not built yet; {_rebuild_hint(store, man)}")
-            part, problem = _read_block(path)
+            part, problem = read_block(path)
             if part is not None and (
                     "sa" not in part or any(
                         name in part and not np.all(np.isfinite(part[name].values))
