@@ -6,6 +6,8 @@
     python benchmarks/bench_speed.py scheduler           # the same through --scheduler ADDRESS
     python benchmarks/bench_speed.py estimator           # fit + predict of one rig dataset
     python benchmarks/bench_speed.py sweep --conditions 8   # a measured fraction of the sweep
+    python benchmarks/bench_speed.py compare             # CPU of a small paired machine db
+    PYTHONPATH=OLD/src python benchmarks/bench_speed.py compare   # ... with older code
 
 Prints numbers (no asserts). The box is shared, so every timing is printed with the load
 average and, for the simulator, as a ratio to a fixed numpy FFT workload timed in the same
@@ -107,6 +109,12 @@ def _timed_build(store, pair, client=None, **kw):
     return wall, cpu, l0
 
 
+def children_cpu() -> float:
+    """CPU seconds of the finished child processes (e.g. a closed LocalCluster's workers)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def _local_client(workers=2):
     from dask.distributed import Client, LocalCluster
 
@@ -125,8 +133,9 @@ def bench_machine(args):
     kw = dict(speeds=speeds, loads=[10.0], grades=range(1, 13), n_healthy=20, n_faulty=140,
               seed=0)
     with tempfile.TemporaryDirectory(dir=args.tmp) as tmp:
-        for paired in (True, False):
+        for paired in (True, False)[:1 if args.paired_only else 2]:
             t0 = time.perf_counter()
+            k0 = children_cpu()
             client, cluster = _local_client()
             start = time.perf_counter() - t0
             try:
@@ -135,10 +144,12 @@ def bench_machine(args):
             finally:
                 client.close()
                 cluster.close()
+            workers_cpu = children_cpu() - k0
             print(f"PHM09 spur machine database, {len(speeds)} speeds x 12 grades x 160 "
                   f"{'+ twins' if paired else '(unpaired)'} = {n} signals, LocalCluster 2 x 1 "
-                  f"thread: {wall:.1f} s wall (+ {start:.1f} s cluster start); load avg "
-                  f"before {l0}, after {load_avg()}; {peak_mb()}")
+                  f"thread: {wall:.1f} s wall (+ {start:.1f} s cluster start), workers' CPU "
+                  f"{workers_cpu:.1f} s (/2 = {workers_cpu / 2:.1f} s on 2 free cores); load "
+                  f"avg before {l0}, after {load_avg()}; {peak_mb()}")
 
 
 def bench_condition(args):
@@ -224,6 +235,27 @@ def bench_estimator(args):
               f"%; load avg {load_avg()}; {peak_mb()}")
 
 
+def bench_compare(args):
+    """CPU seconds of a small paired machine database built in-process on one thread:
+    run once with this tree and once with an older one (PYTHONPATH=OLD/src) to compare
+    the code on the same box at the same time."""
+    import numba
+
+    from gearshot.machine import Machine
+
+    numba.set_num_threads(1)
+    mach = Machine.from_toml(PHM09_SPUR)
+    with tempfile.TemporaryDirectory(dir=args.tmp) as tmp:
+        wall, cpu, l0 = _timed_build(
+            Path(tmp) / "db", mach.gear_pair(), False, speeds=[mach.sim_speed(40)],
+            loads=[10.0], grades=range(1, 13), n_healthy=20, n_faulty=140, seed=0,
+            paired=True)
+    ref_w, ref_c = fft_ref()
+    print(f"PHM09 spur, 40 Hz x 12 grades x 160 + twins, in-process, one thread: {cpu:.1f} s "
+          f"CPU ({wall:.1f} s wall), = {cpu / ref_c:.0f} fft_ref (fft_ref {1e3 * ref_c:.1f} "
+          f"ms CPU); load avg before {l0}, after {load_avg()}; {peak_mb()}")
+
+
 def bench_sweep(args):
     """The paper sweep's two parts on a measured fraction: the paired grade-7 database of
     ``--conditions`` conditions and the Sec. 4.1 datasets of those conditions, on a
@@ -236,6 +268,7 @@ def bench_sweep(args):
     k = max(1, args.conditions // len(PAPER_LOADS))      # speeds spread over 10 ... 35 rps
     speeds = [PAPER_SPEEDS[i] for i in np.linspace(0, len(PAPER_SPEEDS) - 1, k).astype(int)]
     loads = list(PAPER_LOADS)
+    k0 = children_cpu()
     client, cluster = _local_client()
     try:
         with tempfile.TemporaryDirectory(dir=args.tmp) as tmp:
@@ -254,6 +287,8 @@ def bench_sweep(args):
     finally:
         client.close()
         cluster.close()
+    workers_cpu = children_cpu() - k0
+    print(f"workers' CPU {workers_cpu:.1f} s for database + datasets")
     n_sets = len(frame) // frame["variant"].nunique()
     full_db = t_db / n_cond * len(conds)
     full_sweep = t_sweep / n_sets * 2392
@@ -271,7 +306,8 @@ def bench_sweep(args):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("part", choices=["sim", "machine", "condition", "scheduler", "estimator",
-                                     "sweep"])
+                                     "sweep", "compare"])
+    ap.add_argument("--paired-only", action="store_true")
     ap.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "gearshot-bench"))
     ap.add_argument("--tmp", default=None, help="folder for temporary stores")
     ap.add_argument("--repeat", type=int, default=3)
