@@ -37,6 +37,7 @@ from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, check_load, check_speed, describe
+from ._block_read import read_block, resume_problem
 from ._integrity import (
     block_content_problem,
     block_draws,
@@ -461,7 +462,7 @@ def _build_locked(store, pair, manifest, speeds, loads, grades, fault_types, n_h
     for t in tasks:
         path = blocks / _block_name(*t[:3], t[6])
         if path.exists():
-            problem = _block_problem(path) or _ownership_problem(path, manifest, *t[:3],
+            problem = resume_problem(path) or _ownership_problem(path, manifest, *t[:3],
                                                                  t[6])
             if problem is None:
                 continue
@@ -628,19 +629,18 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
             if not path.exists():
                 raise GearshotError(f"{where} is not built yet; "
                                     f"{_rebuild_hint(store, man, [path.name])}")
-            problem = _block_problem(path)
-            if problem is None:
-                try:
-                    part = xr.open_zarr(path, consolidated=False).load()
-                except Exception as exc:  # a decoder's error on a damaged chunk
-                    problem = f"it cannot be decoded ({type(exc).__name__}: {exc})"
-                else:
-                    if any(name in part and not np.all(np.isfinite(part[name].values))
-                           for name in ("sa", "sa_twin")) or "sa" not in part:
-                        problem = "its SA array is incomplete (non-finite values)"
-                    else:
-                        _check_against_manifest(store, path, part, man, where, i, j, k, ft)
+            part, problem = read_block(path)
+            if part is not None and (
+                    "sa" not in part or any(
+                        name in part and not np.all(np.isfinite(part[name].values))
+                        for name in ("sa", "sa_twin"))):
+                problem = "its SA array is incomplete (non-finite values)"
+            elif part is not None and problem is None:
+                _check_against_manifest(store, path, part, man, where, i, j, k, ft)
             if problem is not None:
+                if "is corrupt" in problem:   # resuming checks sizes and times only
+                    problem += (f" (should the rebuild find nothing to do, remove "
+                                f"{str(path)!r} first)")
                 raise GearshotError(f"{where} is damaged: {problem}; "
                                     f"{_rebuild_hint(store, man, [path.name])}")
             part.attrs.pop(_ATTR, None)
