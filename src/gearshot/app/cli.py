@@ -14,6 +14,14 @@ import typer
 from .. import __version__
 from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
+from ..paper import (
+    CYCLES_PER_SEGMENT,
+    GEAR_TEETH,
+    PAPER_LOADS,
+    PAPER_SPEEDS,
+    PINION_TEETH,
+    TABLE1_SIZES,
+)
 
 app = typer.Typer(
     name="gearshot",
@@ -25,9 +33,6 @@ app = typer.Typer(
 experiment_app = typer.Typer(help="Run the paper's experiments (Sec. 4.1 and 4.2).",
                              no_args_is_help=True)
 app.add_typer(experiment_app, name="experiment")
-
-PAPER_SPEEDS = [float(s) for s in range(10, 36)]
-PAPER_LOADS = [5.0, 10.0, 15.0, 20.0]
 
 
 def _version_callback(value: bool) -> None:
@@ -76,13 +81,14 @@ def _early(path: Path | None, option: str, *, folder: bool = False) -> None:
 
 
 #: Gear revolutions averaged per SA segment by the experiments and ``predict`` (the paper's 50)
-SEGMENT_REVOLUTIONS = 50
+SEGMENT_REVOLUTIONS = CYCLES_PER_SEGMENT
 MAX_DURATION = 1200.0   # s per recording (60 s in the paper)
 MAX_COUNT = 10_000      # recordings per campaign size / simulated signals are bounded below
 
 
 def _check_duration(duration: float, speed: float, *, option: str = "--duration",
-                    gear_teeth: int = 38, pinion_teeth: int = 17) -> None:
+                    gear_teeth: int = GEAR_TEETH,
+                    pinion_teeth: int = PINION_TEETH) -> None:
     """A recording must hold one SA segment (50 gear revolutions) at this speed."""
     if not (0 < speed <= 1000):
         raise GearshotError(f"--speed must lie in (0, 1000] rps; got {speed!r}")
@@ -262,7 +268,7 @@ def rig(
     load: float = typer.Option(10.0, "--load"),
     duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
     healthy: int = typer.Option(6, "--healthy"),
-    size: list[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
+    size: list[float] = typer.Option(list(TABLE1_SIZES), "--size", help="Fault size(s)."),
     repetitions: int = typer.Option(6, "--repetitions"),
     seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
@@ -420,7 +426,7 @@ def experiment_rig(
     inputs: dict[str, Any] = {"seed": seed, "speed": speed, "load": load, "rig_grade": rig_grade,
               "attenuation_db": attenuation_db, "duration": duration,
               "frf_sha256": _folder_digest(frf_folder), "healthy": 6,
-              "sizes": [0.32, 0.56, 0.66], "repetitions": 6, "fs": 50_000.0}
+              "sizes": list(TABLE1_SIZES), "repetitions": 6, "fs": 50_000.0}
 
     def record(folder: Path) -> None:
         rig_obj = _make_rig(seed, frf_folder, rig_grade)
@@ -554,8 +560,11 @@ def predict(
     load: float = typer.Option(..., "--load", help="Nm."),
     out: Path = typer.Option(Path("predictions.csv"), "--out", help="CSV or JSON output."),
     coverage: float = typer.Option(0.9, "--coverage", help="Prediction-interval coverage."),
-    gear_teeth: int = typer.Option(38, "--gear-teeth"),
-    pinion_teeth: int = typer.Option(17, "--pinion-teeth"),
+    gear_teeth: int | None = typer.Option(None, "--gear-teeth", help="Teeth of the gear whose "
+                                          "revolution is the SA cycle (default: the "
+                                          "database's gear pair; another count is refused)."),
+    pinion_teeth: int | None = typer.Option(None, "--pinion-teeth", help="Teeth of its mate "
+                                            "(tacho shaft; default: the database's)."),
     seed: int = typer.Option(0, "--seed"),
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): SAs of the monitored gear's shaft through "

@@ -149,8 +149,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
                                    "mesh_order": meshes})
     selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
+    # the database must be of the machine's monitored pair (refused otherwise)
     est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
-            selection_tf=selection_tf)
+            selection_tf=selection_tf, gear_teeth=machine.monitored.teeth,
+            pinion_teeth=machine.mate()[1])
     frame = pd.DataFrame([r[:4] for r in rows],
                          columns=["recording", "role", "segment", "speed_hz"])
     if rows:

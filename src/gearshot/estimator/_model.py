@@ -28,6 +28,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from .._errors import GearshotError, NotFittedError
 from .._validation import as_signal_array, check_in_range
 from ..features import PAPER_FEATURES, available_features
+from ..paper import GEAR_TEETH
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
 from ._params import (
@@ -144,6 +145,60 @@ def _database_twins(database: Any, by_grade: Mapping[int, tuple[FloatArray, Floa
                                 f"the SAs have {sa.shape}")
         out[g] = tw
     return out
+
+
+def _database_teeth(database: Any) -> tuple[int, int] | None:
+    """(pinion, gear) teeth of a database's gear pair (attributes ``pinion_teeth`` and
+    ``gear_teeth``, set by :func:`gearshot.sim.load_database`), or None without them."""
+    attrs: Any = getattr(database, "attrs", None)
+    try:
+        return int(attrs["pinion_teeth"]), int(attrs["gear_teeth"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def _check_declared_teeth(have: tuple[int, int] | None, gear_teeth: int | None,
+                          pinion_teeth: int | None) -> None:
+    """Refuse target SAs segmented for another pair than the database's."""
+    for name, value in (("gear_teeth", gear_teeth), ("pinion_teeth", pinion_teeth)):
+        if value is not None and (isinstance(value, bool)
+                                  or not isinstance(value, numbers.Integral) or value < 1):
+            raise GearshotError(f"{name} must be a whole number of teeth >= 1; got {value!r}")
+    if have is None:
+        return
+    pinion, gear = have
+    if gear_teeth is not None and int(gear_teeth) != gear:
+        raise GearshotError(
+            f"gear_teeth={int(gear_teeth)}: the target SAs are segmented for a "
+            f"{int(gear_teeth)}-tooth gear, but the database was simulated for the "
+            f"{pinion}/{gear} pair (gear_teeth={gear}); simulate a database of the "
+            f"recordings' pair, or segment them for the {gear}-tooth gear")
+    if pinion_teeth is not None and int(pinion_teeth) != pinion:
+        raise GearshotError(
+            f"pinion_teeth={int(pinion_teeth)}: the target SAs are segmented for a "
+            f"{int(pinion_teeth)}-tooth pinion, but the database was simulated for the "
+            f"{pinion}/{gear} pair (pinion_teeth={pinion}); simulate a database of the "
+            f"recordings' pair, or segment them for the {pinion}-tooth pinion")
+
+
+def _as_orders(mesh_order: int | Sequence[int]) -> tuple[int, ...]:
+    if isinstance(mesh_order, (int, np.integer)):
+        return (int(mesh_order),)
+    return tuple(int(v) for v in mesh_order)
+
+
+def _resolve_mesh_orders(mesh_order: int | Sequence[int] | None, database: Any,
+                         gear_teeth: int | None, pinion_teeth: int | None) -> tuple[int, ...]:
+    """The mesh orders a fit uses: ``mesh_order`` when given, else the database's gear
+    teeth, else the declared ``gear_teeth``, else the paper's gear (38); declared teeth
+    that differ from the database's pair are refused."""
+    have = _database_teeth(database)
+    _check_declared_teeth(have, gear_teeth, pinion_teeth)
+    if mesh_order is not None:
+        return _as_orders(mesh_order)
+    if have is not None:
+        return (have[1],)
+    return (int(gear_teeth) if gear_teeth is not None else GEAR_TEETH,)
 
 
 def _step_seeds(random_state: Any) -> dict[str, int]:
@@ -264,12 +319,16 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     n_neighbors : iterable of int >= 1, default range(1, 101)
         Candidate K of step 8.
     validation_fraction : float in (0, 1), default 0.3
-    mesh_order : int >= 1 or sequence of int >= 1, default 38
+    mesh_order : None, int >= 1 or sequence of int >= 1, default None
         Gear-mesh order(s) in the SA cycle whose harmonics and sidebands the difference
-        signal removes (step 7). Several for a shaft whose SA holds several synchronous
-        meshes, e.g. ``[32, 16]`` for the PHM09 spur input shaft, where the second stage's
-        mesh falls at order 16 (:meth:`gearshot.Machine.mesh_orders`); the simulated and
-        target signals are treated alike.
+        signal removes (step 7). ``None``: from the database's gear pair (its
+        ``gear_teeth`` attribute, set by :func:`gearshot.sim.load_database`: the SA cycle
+        is one revolution of that gear); a database without pair attributes (one built
+        by hand) falls back to ``fit``'s ``gear_teeth`` and then to the paper's 38.
+        Several for a shaft whose SA holds several synchronous meshes, e.g. ``[32, 16]``
+        for the PHM09 spur input shaft, where the second stage's mesh falls at order 16
+        (:meth:`gearshot.Machine.mesh_orders`); the simulated and target signals are
+        treated alike. The orders used are ``mesh_orders_``.
     zero_shot : bool, default False
         No faulty example: choose the grade by matching healthy-signal statistics
         (:func:`~gearshot.estimator.match_grade`). With soft weighting the grades are
@@ -362,6 +421,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         The seeds the random steps used.
     simulated_reference_ : {"first_healthy", "twin"}
         The simulated reference step 6 used (``simulated_reference`` with "auto" resolved).
+    mesh_orders_ : tuple of int
+        The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -376,7 +437,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "transfer_function": [Options(("estimate", "none")), ArrayOrObject("to_signal_grid")],
         "n_neighbors": [IntegerSequence(1, None)],
         "validation_fraction": [Interval(float, 0, 1, closed="neither")],
-        "mesh_order": [Interval(int, 1, None), IntegerSequence(1, None)],
+        "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
         "zero_shot": [Boolean()],
         "upsample": [Interval(int, 1, None)],
         "tuning_smoothing": [Options(("isotonic", "none"))],
@@ -395,7 +456,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  nominal_grade: int = 7, rms_normalization: bool = True,
                  transfer_function: str | ArrayLike | Any = "estimate",
                  n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
-                 mesh_order: int | Sequence[int] = 38, zero_shot: bool = False, upsample: int = 100,
+                 mesh_order: int | Sequence[int] | None = None, zero_shot: bool = False,
+                 upsample: int = 100,
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
                  model_discrepancy: float = 0.12, random_state: Any = None,
                  fault_type: str | None = None,
@@ -424,14 +486,19 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.random_state = random_state
 
     def _mesh_orders(self) -> int | list[int]:
-        """``mesh_order`` as the signal functions take it (an int or a list of ints)."""
-        m = self.mesh_order
-        return int(m) if isinstance(m, (int, np.integer)) else [int(v) for v in m]
+        """The mesh orders as the signal functions take them (an int or a list of ints):
+        those of the fit under way, else ``mesh_orders_`` (else, for an estimator saved
+        before ``mesh_orders_`` existed, ``mesh_order``)."""
+        orders = self.__dict__.get("_fitting_orders") or self.__dict__.get("mesh_orders_")
+        if orders is None:
+            orders = _as_orders(GEAR_TEETH if self.mesh_order is None else self.mesh_order)
+        return orders[0] if len(orders) == 1 else list(orders)
 
     # ------------------------------------------------------------------ fit
     def fit(self, database: Any, target_healthy: ArrayLike,
             faulty_example: ArrayLike | None = None, faulty_size: float | None = None,
-            healthy_long: ArrayLike | None = None, *, selection_tf: Any = None) -> Self:
+            healthy_long: ArrayLike | None = None, *, selection_tf: Any = None,
+            gear_teeth: int | None = None, pinion_teeth: int | None = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters
@@ -451,6 +518,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         selection_tf : array_like of complex or TransferFunction
             The held-out TF for feature selection (on the SA grid, one-sided, or an object
             with ``to_signal_grid(n)``); needed when ``select_features``.
+        gear_teeth, pinion_teeth : int, optional
+            The pair the target SAs were segmented for (the gear whose revolution is the
+            SA cycle, and its mate); SAs of another pair than the database's are refused.
 
         Returns
         -------
@@ -459,10 +529,24 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         Raises
         ------
         GearshotError
-            On a bad parameter or argument (the message names it and quotes the value).
+            On a bad parameter or argument (the message names it and quotes the value),
+            or target SAs declared for another tooth count than the database's pair.
             The estimator is left as it was before the call.
         """
         validate_params(self.get_params(deep=False), self._parameter_constraints)
+        orders = _resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
+        self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
+        try:
+            return self._fit(database, target_healthy, faulty_example, faulty_size,
+                             healthy_long, selection_tf, orders)
+        finally:
+            del self._fitting_orders
+
+    def _fit(self, database: Any, target_healthy: ArrayLike,
+             faulty_example: ArrayLike | None, faulty_size: float | None,
+             healthy_long: ArrayLike | None, selection_tf: Any,
+             orders: tuple[int, ...]) -> Self:
+        """``fit`` with checked parameters and resolved mesh orders."""
         inputs = self._check_fit_inputs(target_healthy, faulty_example, faulty_size,
                                         healthy_long, selection_tf)
         database = _select_fault_type(database, self.fault_type)
@@ -501,7 +585,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             grade_strategy_=strategy, grade_=choice.grade, grade_weights_=choice.weights,
             grade_models_=models, model_=best, tuning_curve_=choice.tuning_curve,
             n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
-            step_seeds_=seeds, simulated_reference_=reference)
+            step_seeds_=seeds, simulated_reference_=reference, mesh_orders_=orders)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
