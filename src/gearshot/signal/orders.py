@@ -2,18 +2,38 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import cast
+
 import numpy as np
 import scipy.fft
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import BoolArray, FloatArray, IntArray
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
 __all__ = ["harmonic_signal", "difference_signal", "order_mask", "mesh_band_orders",
            "check_mesh_order", "check_mesh_orders"]
 
 
-def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int:
-    """Validate a mesh order against the Nyquist order of an ``n_points`` cycle."""
+#: One mesh order or several (a shaft carrying several gears).
+MeshOrders = int | Sequence[int] | ArrayLike
+
+
+def check_mesh_order(mesh_order: object, n_points: int, name: str = "mesh_order") -> int:
+    """Validate a mesh order against the Nyquist order of an ``n_points`` cycle.
+
+    Examples
+    --------
+    >>> from gearshot.signal.orders import check_mesh_order
+    >>> check_mesh_order(38, 2048)
+    38
+    >>> check_mesh_order(1024, 2048)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gearshot._errors.GearshotError: mesh_order=1024 is at or above the Nyquist order 1024 ...
+    """
     mesh_order = check_int(mesh_order, name, minimum=1)
     if mesh_order >= n_points / 2:
         raise GearshotError(
@@ -22,13 +42,22 @@ def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int
     return mesh_order
 
 
-def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tuple[int, ...]:
+def check_mesh_orders(mesh_order: MeshOrders, n_points: int,
+                      name: str = "mesh_order") -> tuple[int, ...]:
     """Validate one mesh order or a sequence of them (a shaft carrying several gears).
 
     Returns
     -------
     tuple of int
         The distinct orders, in the given order.
+
+    Examples
+    --------
+    >>> from gearshot.signal.orders import check_mesh_orders
+    >>> check_mesh_orders([38, 16, 38], 2048)
+    (38, 16)
+    >>> check_mesh_orders(38, 2048)
+    (38,)
     """
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
         orders = (mesh_order.ravel().tolist() if isinstance(mesh_order, np.ndarray)
@@ -44,7 +73,7 @@ def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tu
     return (check_mesh_order(mesh_order, n_points, name),)
 
 
-def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
+def mesh_band_orders(n_points: int, mesh_order: MeshOrders, n_sidebands: int) -> IntArray:
     """One-sided orders (0 … n_points//2) of the mesh harmonics and their sidebands.
 
     ``mesh_order`` may be a sequence (a shaft carrying several gears): the union of the
@@ -54,22 +83,32 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     ``±1 … ±n_sidebands`` sidebands. Orders beyond Nyquist or below zero are folded onto
     their mirror, as zeroing both halves of a two-sided spectrum would do. DC (order 0) is
     not a mesh harmonic and is kept unless a sideband folds onto it.
+
+    Examples
+    --------
+    Mesh order 10 in a 64-point cycle (Nyquist order 32), one sideband each side:
+
+    >>> from gearshot.signal import mesh_band_orders
+    >>> print(mesh_band_orders(64, 10, 1))
+    [ 9 10 11 19 20 21 29 30 31]
+    >>> print(mesh_band_orders(64, [10, 16], 0))    # two meshes on the shaft
+    [10 16 20 30 32]
     """
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
-        return np.unique(np.concatenate([
+        return cast(IntArray, np.unique(np.concatenate([
             mesh_band_orders(n_points, m, n_sidebands)
-            for m in check_mesh_orders(mesh_order, n_points)]))
-    mesh_order = check_mesh_order(mesh_order, n_points)
-    k = np.arange(1, (n_points // 2) // mesh_order + 1)
+            for m in check_mesh_orders(mesh_order, n_points)])))
+    order = check_mesh_order(mesh_order, n_points)
+    k = np.arange(1, (n_points // 2) // order + 1)
     s = np.arange(-n_sidebands, n_sidebands + 1)
-    idx = (k[:, None] * mesh_order + s[None, :]).ravel() % n_points
+    idx = (k[:, None] * order + s[None, :]).ravel() % n_points
     folded = np.minimum(idx, n_points - idx)
-    return np.unique(folded)
+    return cast(IntArray, np.unique(folded))
 
 
-def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def order_mask(n_points: int, mesh_order: MeshOrders, *, n_sidebands: int = 2) -> BoolArray:
     """Boolean mask over one-sided orders ``0 … n_points//2``; True on mesh bands.
 
     Parameters
@@ -85,6 +124,16 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     Returns
     -------
     mask : ndarray of bool, shape (n_points // 2 + 1,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import order_mask
+    >>> mask = order_mask(64, 10, n_sidebands=1)
+    >>> mask.shape
+    (33,)
+    >>> print(np.flatnonzero(mask))
+    [ 9 10 11 19 20 21 29 30 31]
     """
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     mesh_order = list(check_mesh_orders(mesh_order, n_points))
@@ -94,17 +143,19 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     return mask
 
 
-def _split(sa, mesh_order, n_sidebands, keep_mesh: bool):
+def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int,
+           keep_mesh: bool) -> FloatArray:
     sa = as_signal_array(sa, "sa", min_length=4)
     n = sa.shape[-1]
     mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
     spectrum = scipy.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
-    return scipy.fft.irfft(spectrum, n=n, axis=-1)
+    return cast(FloatArray, scipy.fft.irfft(spectrum, n=n, axis=-1))
 
 
 @finite_result
-def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def harmonic_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                    n_sidebands: int = 2) -> FloatArray:
     """The mesh harmonics of a synchronous average and their sidebands.
 
     Keeps orders ``k * mesh_order + s`` (``k >= 1``, ``|s| <= n_sidebands``) in both halves of
@@ -123,12 +174,26 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    A mesh tone at order 10 and a fault component at order 3:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import difference_signal, harmonic_signal, rms
+    >>> theta = np.arange(64) / 64
+    >>> sa = np.cos(2 * np.pi * 10 * theta) + 0.5 * np.cos(2 * np.pi * 3 * theta)
+    >>> print(round(float(rms(harmonic_signal(sa, 10))), 4))    # the unit mesh tone
+    0.7071
+    >>> bool(np.allclose(harmonic_signal(sa, 10) + difference_signal(sa, 10), sa))
+    True
     """
     return _split(sa, mesh_order, n_sidebands, keep_mesh=True)
 
 
 @finite_result
-def difference_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                      n_sidebands: int = 2) -> FloatArray:
     """A synchronous average with its mesh harmonics and sidebands removed.
 
     Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and
@@ -148,5 +213,19 @@ def difference_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    The mesh tone at order 10 goes, the order-3 component stays:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import difference_signal
+    >>> theta = np.arange(64) / 64
+    >>> fault = 0.5 * np.cos(2 * np.pi * 3 * theta)
+    >>> diff = difference_signal(np.cos(2 * np.pi * 10 * theta) + fault, 10)
+    >>> bool(np.allclose(diff, fault))
+    True
+    >>> print(np.round(diff[:3], 3))
+    [0.5   0.478 0.416]
     """
     return _split(sa, mesh_order, n_sidebands, keep_mesh=False)
