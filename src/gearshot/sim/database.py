@@ -101,7 +101,9 @@ def _pair_from_manifest(man: dict) -> GearPair | None:
         if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
                 and call.func.id == "GearPair" and not call.args):
             return None
-        fields = {k.arg: ast.literal_eval(k.value) for k in call.keywords}
+        fields = {k.arg: ast.literal_eval(k.value) for k in call.keywords if k.arg}
+        if len(fields) != len(call.keywords):   # a **mapping
+            return None
         return GearPair(**fields)   # fields absent from older texts take their defaults
     except (KeyError, SyntaxError, ValueError, TypeError, GearshotError):
         return None
