@@ -170,5 +170,14 @@ def synthetic_bank(n: int, **kwargs) -> TransferFunctionBank:
     The FRFs of :func:`gearshot.transfer.modal.synthetic_tfs` (same arguments: ``band``,
     ``n_lines``, ``rng`` — required —, ``n_modes``, ``damping``, ``attenuation``,
     ``nonminimum_fraction``) as a :class:`TransferFunctionBank`.
+
+    Examples
+    --------
+    >>> from gearshot.transfer import synthetic_bank
+    >>> bank = synthetic_bank(3, rng=0)
+    >>> bank.names
+    ('synthetic_000', 'synthetic_001', 'synthetic_002')
+    >>> bank["synthetic_000"].n_lines
+    1001
     """
     return TransferFunctionBank(synthetic_tfs(n, **kwargs))
