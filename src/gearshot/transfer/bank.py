@@ -32,9 +32,16 @@ class TransferFunctionBank:
 
     Examples
     --------
-    >>> bank = TransferFunctionBank.from_folder("../shared/data/frf")   # doctest: +SKIP
-    >>> selection_tf, rest = bank.hold_out(0)                          # doctest: +SKIP
-    >>> grid = rest.to_signal_grid(2048)   # (n_tf, 2048) complex       # doctest: +SKIP
+    A bank of measured TFs is read with ``TransferFunctionBank.from_folder(folder)``
+    (e.g. ``"../shared/data/frf"``); a seeded synthetic one works alike:
+
+    >>> from gearshot.transfer import TransferFunctionBank
+    >>> bank = TransferFunctionBank.synthetic(4, rng=0)
+    >>> selection_tf, rest = bank.hold_out(0)
+    >>> selection_tf.name == bank.names[0], len(rest)
+    (True, 3)
+    >>> rest.to_signal_grid(2048).shape       # complex, on the SA's DFT grid
+    (3, 2048)
     """
 
     def __init__(self, tfs: Iterable[TransferFunction], *, names: Iterable[str] | None = None):
