@@ -311,8 +311,8 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
             raise GearshotError("centred_features needs healthy_mean or a non-empty "
                                 "healthy_mask")
         healthy_mean = feats[np.asarray(healthy_mask)].mean(axis=0)
-    return (np.asarray(feats - healthy_mean, dtype=np.float64),
-            np.asarray(healthy_mean, dtype=np.float64))
+    mean = np.asarray(healthy_mean, dtype=np.float64)
+    return np.asarray(feats - mean, dtype=np.float64), mean
 
 
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
