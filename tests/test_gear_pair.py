@@ -114,18 +114,26 @@ def test_an_unreadable_manifest_pair_loads_without_pair_attributes():
 
 def test_cli_predict_refuses_recordings_of_another_tooth_count(db40, tmp_path):
     """`gearshot predict --gear-teeth 38` against a 17/40 database: one-line error
-    naming both tooth counts (the option used to be ignored by the estimator)."""
+    naming both tooth counts (the option used to be ignored by the estimator); without
+    the option the recordings are segmented for the database's pair and predicted."""
+    import pandas as pd
     from test_reliability import one_line_error, run_cli
 
     from gearshot.rig import VirtualRig
 
     idx = VirtualRig(seed=1, engine="surrogate").campaign(
-        tmp_path / "camp", speed=15, load=10, duration=8.0, healthy=1, sizes=(0.5,),
+        tmp_path / "camp", speed=15, load=10, duration=8.0, healthy=2, sizes=(0.5,),
         repetitions=1, progress=False)
-    healthy = idx.loc[idx.fault_size == 0, "path"].iloc[0]
+    healthy = list(idx.loc[idx.fault_size == 0, "path"])
     faulty = idx.loc[idx.fault_size > 0, "path"].iloc[0]
-    res = run_cli(["predict", "--database", db40, "--healthy", healthy, "--faulty", faulty,
-                   "--faulty-size", "0.5", "--recordings", faulty, "--speed", "15",
-                   "--load", "10", "--out", tmp_path / "p.csv", "--gear-teeth", "38"])
+    args = ["predict", "--database", db40, "--faulty", faulty, "--faulty-size", "0.5",
+            "--recordings", faulty, "--speed", "15", "--load", "10"]
+    for h in healthy:
+        args += ["--healthy", h]
+    res = run_cli([*args, "--out", tmp_path / "p38.csv", "--gear-teeth", "38"])
     one_line_error(res, "gear_teeth=38", "38-tooth", "17/40", "gear_teeth=40")
-    assert not (tmp_path / "p.csv").exists()
+    assert not (tmp_path / "p38.csv").exists()
+    ok = run_cli([*args, "--out", tmp_path / "p.csv"])   # the database's pair
+    assert ok.returncode == 0, ok.stderr
+    frame = pd.read_csv(tmp_path / "p.csv")
+    assert len(frame) >= 1 and frame["predicted"].between(0, 1).all()
