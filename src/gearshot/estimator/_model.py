@@ -28,9 +28,9 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from .._errors import GearshotError, NotFittedError
 from .._validation import as_signal_array, check_in_range
 from ..features import PAPER_FEATURES, available_features
-from ..paper import GEAR_TEETH
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
+from ._pair import as_orders, resolve_mesh_orders
 from ._params import (
     ArrayOrObject,
     Boolean,
@@ -145,60 +145,6 @@ def _database_twins(database: Any, by_grade: Mapping[int, tuple[FloatArray, Floa
                                 f"the SAs have {sa.shape}")
         out[g] = tw
     return out
-
-
-def _database_teeth(database: Any) -> tuple[int, int] | None:
-    """(pinion, gear) teeth of a database's gear pair (attributes ``pinion_teeth`` and
-    ``gear_teeth``, set by :func:`gearshot.sim.load_database`), or None without them."""
-    attrs: Any = getattr(database, "attrs", None)
-    try:
-        return int(attrs["pinion_teeth"]), int(attrs["gear_teeth"])
-    except (KeyError, TypeError, ValueError):
-        return None
-
-
-def _check_declared_teeth(have: tuple[int, int] | None, gear_teeth: int | None,
-                          pinion_teeth: int | None) -> None:
-    """Refuse target SAs segmented for another pair than the database's."""
-    for name, value in (("gear_teeth", gear_teeth), ("pinion_teeth", pinion_teeth)):
-        if value is not None and (isinstance(value, bool)
-                                  or not isinstance(value, numbers.Integral) or value < 1):
-            raise GearshotError(f"{name} must be a whole number of teeth >= 1; got {value!r}")
-    if have is None:
-        return
-    pinion, gear = have
-    if gear_teeth is not None and int(gear_teeth) != gear:
-        raise GearshotError(
-            f"gear_teeth={int(gear_teeth)}: the target SAs are segmented for a "
-            f"{int(gear_teeth)}-tooth gear, but the database was simulated for the "
-            f"{pinion}/{gear} pair (gear_teeth={gear}); simulate a database of the "
-            f"recordings' pair, or segment them for the {gear}-tooth gear")
-    if pinion_teeth is not None and int(pinion_teeth) != pinion:
-        raise GearshotError(
-            f"pinion_teeth={int(pinion_teeth)}: the target SAs are segmented for a "
-            f"{int(pinion_teeth)}-tooth pinion, but the database was simulated for the "
-            f"{pinion}/{gear} pair (pinion_teeth={pinion}); simulate a database of the "
-            f"recordings' pair, or segment them for the {pinion}-tooth pinion")
-
-
-def _as_orders(mesh_order: int | Sequence[int]) -> tuple[int, ...]:
-    if isinstance(mesh_order, (int, np.integer)):
-        return (int(mesh_order),)
-    return tuple(int(v) for v in mesh_order)
-
-
-def _resolve_mesh_orders(mesh_order: int | Sequence[int] | None, database: Any,
-                         gear_teeth: int | None, pinion_teeth: int | None) -> tuple[int, ...]:
-    """The mesh orders a fit uses: ``mesh_order`` when given, else the database's gear
-    teeth, else the declared ``gear_teeth``, else the paper's gear (38); declared teeth
-    that differ from the database's pair are refused."""
-    have = _database_teeth(database)
-    _check_declared_teeth(have, gear_teeth, pinion_teeth)
-    if mesh_order is not None:
-        return _as_orders(mesh_order)
-    if have is not None:
-        return (have[1],)
-    return (int(gear_teeth) if gear_teeth is not None else GEAR_TEETH,)
 
 
 def _step_seeds(random_state: Any) -> dict[str, int]:
@@ -491,7 +437,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         before ``mesh_orders_`` existed, ``mesh_order``)."""
         orders = self.__dict__.get("_fitting_orders") or self.__dict__.get("mesh_orders_")
         if orders is None:
-            orders = _as_orders(GEAR_TEETH if self.mesh_order is None else self.mesh_order)
+            orders = as_orders(self.mesh_order)
         return orders[0] if len(orders) == 1 else list(orders)
 
     # ------------------------------------------------------------------ fit
@@ -534,7 +480,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             The estimator is left as it was before the call.
         """
         validate_params(self.get_params(deep=False), self._parameter_constraints)
-        orders = _resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
+        orders = resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
         self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
         try:
             return self._fit(database, target_healthy, faulty_example, faulty_size,
