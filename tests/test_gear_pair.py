@@ -107,7 +107,11 @@ def test_an_unreadable_manifest_pair_loads_without_pair_attributes():
     from gearshot.sim.database import _pair_from_manifest
 
     assert _pair_from_manifest({"pair": "GearPair(z_pinion=17, z_gear=40)"}).z_gear == 40
-    for text in ("not a pair", "os.system('x')", "GearPair(17, 38)", "GearPair(z_gear=3)"):
+    numpy2 = "GearPair(z_pinion=17, z_gear=np.int64(40), module=np.float64(0.004))"
+    assert (_pair_from_manifest({"pair": numpy2}).z_gear,
+            _pair_from_manifest({"pair": numpy2}).module) == (40, 0.004)
+    for text in ("not a pair", "os.system('x')", "GearPair(17, 38)", "GearPair(z_gear=3)",
+                 "GearPair(**{'z_gear': 40})", "GearPair(z_gear=np.sum(40))"):
         assert _pair_from_manifest({"pair": text}) is None, text
     assert _pair_from_manifest({}) is None
 

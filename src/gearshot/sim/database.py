@@ -101,12 +101,24 @@ def _pair_from_manifest(man: dict) -> GearPair | None:
         if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
                 and call.func.id == "GearPair" and not call.args):
             return None
-        fields = {k.arg: ast.literal_eval(k.value) for k in call.keywords if k.arg}
+        fields = {k.arg: _literal(k.value) for k in call.keywords if k.arg}
         if len(fields) != len(call.keywords):   # a **mapping
             return None
         return GearPair(**fields)   # fields absent from older texts take their defaults
     except (KeyError, SyntaxError, ValueError, TypeError, GearshotError):
         return None
+
+
+def _literal(node):
+    """A literal of a repr, numpy scalars (``np.float64(0.003)``, numpy >= 2) included."""
+    import ast
+
+    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+            and isinstance(node.func.value, ast.Name) and node.func.value.id in ("np", "numpy")
+            and node.func.attr in ("float64", "float32", "int64", "int32")
+            and len(node.args) == 1 and not node.keywords):
+        return ast.literal_eval(node.args[0])
+    return ast.literal_eval(node)
 
 
 def pair_attrs(pair: GearPair) -> dict:
