@@ -18,9 +18,9 @@ faulty per grade and condition) serves every rig. Results are appended to
 rigs on a Dask LocalCluster of N single-threaded processes.
 
 ``--param NAME=VALUE`` sets an estimator parameter for every variant (a new configuration:
-its rows are computed afresh; VALUE is parsed as JSON when it can be). ``--paired`` uses
-the database with healthy twins, which the default ``simulated_reference="auto"`` then
-subtracts (the configuration of record).
+its rows are computed afresh; VALUE is parsed as JSON when it can be). The database holds
+the healthy twins (paired, the default), which ``simulated_reference="auto"`` then
+subtracts; ``--no-paired`` uses the old unpaired one.
 
 The same run from the command line: ``gearshot experiment rig-family`` (same options).
 """
@@ -53,9 +53,9 @@ def main(argv=None):
     parser.add_argument("--data", default=None, help="default $GEARSHOT_DATA")
     parser.add_argument("--tag", default=None, help="results file name (default the range)")
     parser.add_argument("--param", action="append", default=[])
-    parser.add_argument("--paired", action="store_true", help="use the paired database "
-                        "(healthy twins stored; needed by simulated_reference=twin; its "
-                        "SAs equal the plain database's)")
+    parser.add_argument("--paired", action=argparse.BooleanOptionalAction, default=True,
+                        help="use the paired database (healthy twins stored; the default; "
+                        "its SAs equal the plain database's); --no-paired: the old one")
     parser.add_argument("--rigs-cache", default=None, help="folder of the rigs' cached SA "
                         "segments, shared by every range and tag (default DATA/family/rigs)")
     parser.add_argument("--workers", type=int, default=1)

@@ -130,11 +130,11 @@ def test_cli_rig_family_runs_resumes_and_writes_tables(tmp_path, monkeypatch, pa
                         lambda folder, paired=False, **k: stores.append(paired) or tmp_path)
     out = tmp_path / "summary.json"
     args = ["experiment", "rig-family", "--n-rigs", "3", "--draws", "2", "--variant", "full",
-            "--variant", "rms_only", "--paired", "--param", "model_discrepancy=0.16",
+            "--variant", "rms_only", "--param", "model_discrepancy=0.16",
             "--json", str(out)]
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 0, res.output
-    assert calls == [100, 101, 102] and stores == [True]
+    assert calls == [100, 101, 102] and stores == [True]   # paired by default (#19)
     assert (tmp_path / "family" / "dev.jsonl").is_file()
     summary = json.loads(out.read_text())
     assert summary["seeds"] == [100, 101, 102] and summary["params"] == {
@@ -143,6 +143,9 @@ def test_cli_rig_family_runs_resumes_and_writes_tables(tmp_path, monkeypatch, pa
     mean = cond["data"][cond["index"].index("full")][cond["columns"].index("mean")]
     assert mean == pytest.approx(10.0)
     assert "MAE % by condition" in res.output
+    res = CliRunner().invoke(app, args + ["--no-paired"])      # the explicit opt-out
+    assert res.exit_code == 0, res.output
+    assert stores == [True, False]
     res = CliRunner().invoke(app, args)   # resumed: nothing recomputed
     assert res.exit_code == 0, res.output
     assert calls == [100, 101, 102]

@@ -144,8 +144,8 @@ PAIR_KW = dict(speeds=[15], loads=[10], grades=[9], n_healthy=2, n_faulty=3, see
 def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
     from gearshot.sim import GearPair, simulate_sa
 
-    build_database(tmp_path / "plain", client=False, progress=False, **PAIR_KW)
-    build_database(tmp_path / "paired", client=False, progress=False, paired=True, **PAIR_KW)
+    build_database(tmp_path / "plain", client=False, progress=False, paired=False, **PAIR_KW)
+    build_database(tmp_path / "paired", client=False, progress=False, **PAIR_KW)  # default
     plain = load_database(tmp_path / "plain", speed=15, load=10)
     paired = load_database(tmp_path / "paired", speed=15, load=10)
     assert "sa_twin" not in plain and paired.sa_twin.shape == paired.sa.shape
@@ -162,9 +162,17 @@ def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
     own = np.std(paired.sa.values[~healthy] - paired.sa_twin.values[~healthy], axis=1)
     cross = np.std(paired.sa.values[~healthy] - other, axis=1)
     assert np.all(own < 0.5 * cross), (own, cross)
-    with pytest.raises(GearshotError, match="differs in paired"):
-        build_database(tmp_path / "plain", client=False, progress=False, paired=True,
-                       **PAIR_KW)
+    # an old unpaired store: the default (paired) build refuses it and says how to finish
+    # it; with paired=False it still loads and resumes
+    with pytest.raises(GearshotError, match=r"differs in paired.*without healthy twins: "
+                       r"finish it with paired=False / --no-paired"):
+        build_database(tmp_path / "plain", client=False, progress=False, **PAIR_KW)
+    build_database(tmp_path / "plain", client=False, progress=False, paired=False, **PAIR_KW)
+    # the repair command of a damaged store rebuilds the same layout
+    from gearshot.sim.database import _read_manifest, _rebuild_hint
+    assert "--no-paired" in _rebuild_hint(tmp_path / "plain", _read_manifest(tmp_path / "plain"))
+    assert "--no-paired" not in _rebuild_hint(tmp_path / "paired",
+                                              _read_manifest(tmp_path / "paired"))
     with pytest.raises(GearshotError, match="paired must be True or False; got 'yes'"):
         build_database(tmp_path / "other", client=False, progress=False, paired="yes",
                        **PAIR_KW)

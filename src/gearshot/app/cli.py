@@ -197,12 +197,12 @@ def simulate(
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
-    paired: bool | None = typer.Option(None, "--paired/--no-paired", help="Also store each "
-                                       "signal's healthy twin (same profile errors, no "
-                                       "fault): the estimator then subtracts each signal's "
-                                       "own twin (simulated_reference 'auto' -> 'twin'). "
-                                       "Twice the simulation time. Default: on with "
-                                       "--machine, off otherwise."),
+    paired: bool = typer.Option(True, "--paired/--no-paired", help="Store each signal's "
+                                "healthy twin (same profile errors, no fault): the "
+                                "estimator subtracts each signal's own twin "
+                                "(simulated_reference 'auto' -> 'twin') and calibrates "
+                                "fault gain and width on it. Default on; --no-paired "
+                                "builds the old layout (half the simulation time)."),
 ) -> None:
     """Build (or finish) a simulated database; resumable."""
     from .._paths import data_home
@@ -213,7 +213,7 @@ def simulate(
     if machine is not None:
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
-                          scheduler, workers, fault_type, paired=paired is not False)
+                          scheduler, workers, fault_type, paired=bool(paired))
         return
     store = store or data_home(create=False) / "databases" / "sim-db"  # default_database_path
     _early(store, "--store", folder=True)
@@ -388,10 +388,10 @@ def experiment_rig(
     workers: int = typer.Option(2, "--workers"),
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
-    paired: bool = typer.Option(False, "--paired", help="Build and use the database with "
-                                "healthy twins: the estimator's default "
+    paired: bool = typer.Option(True, "--paired/--no-paired", help="Build and use the "
+                                "database with healthy twins (default): the estimator's "
                                 "simulated_reference='auto' then subtracts each signal's "
-                                "own twin (steps 1 and 6)."),
+                                "own twin (steps 1 and 6). --no-paired: the old layout."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
     if frf_folder is not None and not frf_folder.is_dir():
@@ -465,8 +465,9 @@ def experiment_rig(
 @experiment_app.command("rig-family")
 def experiment_rig_family(
     seed_range: str = typer.Option("dev", "--range", help="Seed range: dev (100–123; every "
-                                   "choice is made here) or heldout (9000–9023; evaluate "
-                                   "once, at the end)."),
+                                   "choice is made here), heldout (9500–9523; evaluate "
+                                   "once, at the end) or spent (9000–9023, issue #12's "
+                                   "held-out range, evaluated twice)."),
     seeds: list[int] = typer.Option([], "--seed", help="Explicit rig seed(s) instead of "
                                     "--range (results file 'seeds.jsonl')."),
     n_rigs: int | None = typer.Option(None, "--n-rigs", help="The first N seeds only."),
@@ -481,9 +482,10 @@ def experiment_rig_family(
     repetitions: int = typer.Option(2, "--repetitions", help="Recordings per fault size."),
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
-    paired: bool = typer.Option(False, "--paired", help="Use the database with healthy "
-                                "twins (the configuration of record: the default "
-                                "simulated_reference='auto' then uses them)."),
+    paired: bool = typer.Option(True, "--paired/--no-paired", help="Use the database with "
+                                "healthy twins (default; the estimator's "
+                                "simulated_reference='auto' then uses them). --no-paired: "
+                                "the old layout."),
     results: Path | None = typer.Option(None, "--results", help="JSON-lines results file "
                                            "(appended, resumable; default "
                                            "DATA_HOME/family/RANGE.jsonl)."),

@@ -55,10 +55,10 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
     home = data_home()
-    store = home / f"demo-db-h{n_healthy}-f{n_faulty}-s{seed}"
+    store = home / f"demo-db-h{n_healthy}-f{n_faulty}-s{seed}-paired"
     console.rule("1. simulated database (15 rps, 10 Nm, DIN grades 1–12)")
     build_database(store, GearPair.paper(), speeds=[SPEED], loads=[LOAD], grades=range(1, 13),
-                   n_healthy=n_healthy, n_faulty=n_faulty, seed=seed)
+                   n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, paired=True)
     database = load_database(store, speed=SPEED, load=LOAD)
     console.print(f"{database.sizes['signal']} simulated SAs in {store}")
 

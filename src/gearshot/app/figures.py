@@ -91,10 +91,20 @@ def estimator_figures(estimator, out) -> dict:
                                          estimator.feature_errors_)
         figs["Feature invariance (step 1): estimated vs held-out TF, Fig. 11"] = \
             plotting.save_figure(plt.gcf(), out / "fig11_feature_invariance")[0]
-    if estimator.tuning_curve_ is not None:
-        fig, ax = plt.subplots(figsize=(5, 3.5))
-        plotting.plot_tuning_curve(estimator.tuning_curve_, estimator.faulty_size_, ax=ax)
-        figs["Simulation tuning: example prediction per DIN grade"] = \
+    calibration = getattr(estimator, "calibration_", None)
+    if estimator.tuning_curve_ is not None or (calibration is not None
+                                               and calibration["strategy"] == "joint"):
+        # left: the example's predicted size per grade (when the grade was tuned);
+        # right: the weighted calibration settings (issue #19)
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.5), squeeze=False)
+        if estimator.tuning_curve_ is not None:
+            plotting.plot_tuning_curve(estimator.tuning_curve_, estimator.faulty_size_,
+                                       ax=axes[0, 0])
+        else:
+            axes[0, 0].set_axis_off()
+        plotting.plot_calibration(calibration, ax=axes[0, 1])
+        fig.tight_layout()
+        figs["Simulation tuning: example prediction per DIN grade; calibration weights"] = \
             plotting.save_figure(fig, out / "tuning_curve")[0]
     return figs
 

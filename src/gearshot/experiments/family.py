@@ -45,15 +45,20 @@ from ..paper import (
     TABLE1_SIZES,
 )
 
-__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SA_PIPELINE_VERSION", "FamilyRig",
+__all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS",
+           "SA_PIPELINE_VERSION", "FamilyRig",
            "family_paths", "draw_family", "rig_family_experiment", "family_tables", "path_kind",
            "family_database", "parse_params", "format_family_tables", "RANGES"]
 
 PAPER_CONDITIONS = ((15.0, 10.0), (15.0, 5.0), (30.0, 5.0), (30.0, 10.0))
 DEV_SEEDS = range(100, 124)
-HELDOUT_SEEDS = range(9000, 9024)
-#: the two seed ranges by name (``--range`` of the benchmark and of the CLI)
-RANGES = {"dev": DEV_SEEDS, "heldout": HELDOUT_SEEDS}
+#: The held-out range of issue #19 (fresh: never run before the decision of
+#: ``benchmarks/results/family_decision_session6.md`` was committed).
+HELDOUT_SEEDS = range(9500, 9524)
+#: Issue #12's held-out range, evaluated twice in session 5: spent, kept for reproduction.
+SPENT_HELDOUT_SEEDS = range(9000, 9024)
+#: the seed ranges by name (``--range`` of the benchmark and of the CLI)
+RANGES = {"dev": DEV_SEEDS, "heldout": HELDOUT_SEEDS, "spent": SPENT_HELDOUT_SEEDS}
 
 #: Version of the recording → SA pipeline (angular resampling, SA). Part of every rig
 #: cache's key and of the results' configuration key, so that SAs and rows made by an
@@ -223,9 +228,31 @@ def _hash(obj) -> str:
     return hashlib.sha1(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
-# Diagnostics only (they use the rig's hidden truth): the full algorithm with the true
-# transfer path instead of its blind estimate, or with the rig's true grade and no tuning.
-DIAGNOSTIC_VARIANTS = ("oracle_tf", "true_grade")
+# Diagnostics only (they use the rig's hidden truth or the test set): the full algorithm
+# with the true transfer path instead of its blind estimate (oracle_tf), with its
+# calibration chosen on every faulty test SA instead of the one example
+# (oracle_calibration), with both (oracle_both), or with the rig's true grade and no
+# tuning (true_grade). They make the error budget of issue #19.
+DIAGNOSTIC_VARIANTS = ("oracle_tf", "true_grade", "oracle_calibration", "oracle_both")
+
+
+def _calibration_oracle_class():
+    from ..estimator import OneFaultShotEstimator
+
+    class CalibrationOracle(OneFaultShotEstimator):
+        """Diagnostic: the joint calibration explains every faulty SA of ``oracle_sa``
+        (sizes ``oracle_size``) instead of the one example: the best calibration the
+        grid can give on this target (an in-sample oracle; never a product)."""
+
+        oracle_sa = None
+        oracle_size = None
+
+        def _calibration_examples(self, ctx):
+            keep = np.asarray(self.oracle_size) > 0
+            return (np.asarray(self.oracle_sa, float)[keep],
+                    np.asarray(self.oracle_size, float)[keep])
+
+    return CalibrationOracle
 
 
 def true_path_on_grid(rig: FamilyRig, paths, n_points=SAMPLES_PER_CYCLE,
@@ -252,8 +279,12 @@ def true_path_on_grid(rig: FamilyRig, paths, n_points=SAMPLES_PER_CYCLE,
 def _diagnostic_params(name, rig, paths):
     if name == "oracle_tf":
         return dict(transfer_function=true_path_on_grid(rig, paths))
+    if name == "oracle_both":
+        return dict(transfer_function=true_path_on_grid(rig, paths), calibration="joint")
     if name == "true_grade":
         return dict(tune_simulation=False, nominal_grade=int(rig.grade))
+    if name == "oracle_calibration":
+        return dict(calibration="joint")
     raise GearshotError(f"unknown diagnostic variant {name!r}")
 
 
@@ -267,17 +298,23 @@ def _interval_sweep(est, test_sa, test_size, coverage=0.9):
     from ..estimator.uncertainty import mixture_interval
 
     X = est.features_of(test_sa)
-    preds = {g: est.grade_models_[g].predict(X) for g in est.grade_weights_}
-    residuals = {g: est.grade_models_[g].validation_residuals for g in est.grade_weights_}
+    settings, models = est.calibration_["settings"], est.setting_models_
+    preds = {i: m.predict(X) for i, m in enumerate(models)}
+    residuals = {i: m.validation_residuals for i, m in enumerate(models)}
+    weights = {i: st["weight"] for i, st in enumerate(settings)}
     cov, width = {}, {}
     for d in DISCREPANCIES:
-        low, high = mixture_interval(preds, est.grade_weights_, residuals, coverage,
-                                     discrepancy=d)
+        low, high = mixture_interval(preds, weights, residuals, coverage, discrepancy=d)
         low, high = np.clip(low, 0, 1), np.clip(high, 0, 1)
         cov[f"{d:g}"] = float(np.mean((test_size >= low - 1e-12) & (test_size <= high + 1e-12)))
         width[f"{d:g}"] = float(np.mean(high - low))
+    floor = sum(st["weight"] * float(m.validation_mae[m.n_neighbors - 1])
+                for st, m in zip(settings, models))
     return {"coverage_by_discrepancy": cov, "width_by_discrepancy": width,
+            "simulated_floor": floor,
             "grade_weights": {str(g): round(float(w), 4) for g, w in est.grade_weights_.items()},
+            "calibration": [{k: (round(v, 4) if isinstance(v, float) else v)
+                             for k, v in st.items()} for st in settings],
             "n_selected": len(est.selected_features_)}
 
 
@@ -321,11 +358,17 @@ def _family_rows(spec: dict) -> list[dict]:
                                      keep_estimators=True, **spec["params"])
         for name in (v for v in todo if v in DIAGNOSTIC_VARIANTS):
             extra = _diagnostic_params(name, rig, paths)
+            factory = None
+            if name in ("oracle_calibration", "oracle_both"):
+                oracle = _calibration_oracle_class()
+                oracle.oracle_sa, oracle.oracle_size = ds.test_sa, ds.test_size
+                factory = oracle
             row, = evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=["full"], selection_tf=selection,
                                      fit_kwargs=ds.fit_kwargs(),
                                      random_state=1000 * rig.seed + draw,
-                                     keep_estimators=True, **{**spec["params"], **extra})
+                                     keep_estimators=True, estimator_class=factory,
+                                     **{**spec["params"], **extra})
             row["variant"] = name
             out.append(row)
         for row in out:
@@ -495,7 +538,7 @@ def _done_rows(results: Path, config: str) -> dict:
 
 
 # ------------------------------------------------------------------ shared by the CLI
-def family_database(folder, *, paired=False, client=False, progress=True) -> Path:
+def family_database(folder, *, paired=True, client=False, progress=True) -> Path:
     """The family's simulated database (built if missing; resumable).
 
     Grades 1–12 at the four paper conditions, 50 healthy + 350 faulty signals per block,

@@ -18,18 +18,20 @@ __all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summa
 
 
 def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
-                      random_state=0, keep_estimators=False, coverage=0.9, fit_kwargs=None,
-                      **params):
+                      random_state=0, keep_estimators=False, coverage=0.9,
+                      estimator_class=None, fit_kwargs=None, **params):
     """Fit every variant on one dataset and score it on its test set.
 
-    ``fit_args`` (and ``fit_kwargs``, e.g. the SAs' tooth counts) go to every ``fit``;
-    ``params`` to every estimator.
+    ``estimator_class`` (default :class:`OneFaultShotEstimator`) is what is fitted; the
+    family's diagnostics pass a subclass. ``fit_args`` (and ``fit_kwargs``, e.g. the SAs'
+    tooth counts) go to every ``fit``; ``params`` to every estimator.
 
     Returns
     -------
     list of dict
         One row per variant: ``variant``, ``mae``, ``grade``, ``selected``, ``n_neighbors``,
         ``coverage`` (share of test sizes inside the ``coverage`` prediction interval),
+        ``width`` (the mean width of those intervals),
         ``seconds``, plus ``prediction`` (array) and, with ``keep_estimators``, ``estimator``.
     """
     from ..estimator import OneFaultShotEstimator
@@ -37,8 +39,8 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
     rows = []
     for name in variants:
         t0 = time.perf_counter()
-        est = OneFaultShotEstimator(random_state=random_state,
-                                    **{**params, **variant_params(name)})
+        est = (estimator_class or OneFaultShotEstimator)(
+            random_state=random_state, **{**params, **variant_params(name)})
         est.fit(*fit_args, selection_tf=selection_tf, **dict(fit_kwargs or {}))
         pred = est.predict(test_sa)
         seconds = time.perf_counter() - t0
@@ -47,7 +49,7 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
         row = dict(variant=name, mae=float(np.mean(np.abs(pred - test_size))),
                    grade=est.grade_, selected=",".join(est.selected_features_),
                    n_neighbors=est.n_neighbors_, coverage=float(np.mean(inside)),
-                   seconds=seconds, prediction=pred)
+                   width=float(np.mean(high - low)), seconds=seconds, prediction=pred)
         if keep_estimators:
             row["estimator"] = est
         rows.append(row)

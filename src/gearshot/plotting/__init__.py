@@ -11,6 +11,7 @@ from .fault_types import plot_fault_signatures
 from .paper import (
     VARIANT_LABELS,
     plot_ablation,
+    plot_calibration,
     plot_error_vs,
     plot_feature_invariance,
     plot_predicted_vs_true,
@@ -29,6 +30,7 @@ __all__ = [
     "plot_spectrum_background",
     "plot_tf_estimate",
     "plot_tuning_curve",
+    "plot_calibration",
     "plot_feature_invariance",
     "plot_predicted_vs_true",
     "plot_ablation",

@@ -19,6 +19,7 @@ __all__ = [
     "plot_spectrum_background",
     "plot_tf_estimate",
     "plot_tuning_curve",
+    "plot_calibration",
     "plot_feature_invariance",
     "plot_predicted_vs_true",
     "plot_ablation",
@@ -123,6 +124,22 @@ def plot_tuning_curve(curve, true_size=None, *, ax=None):
     ax.set_ylabel("predicted size y")
     ax.legend(fontsize=8)
     return lines
+
+
+def plot_calibration(calibration, *, ax=None):
+    """What the example calibrated (``OneFaultShotEstimator.calibration_``): one bar per
+    weighted setting (grade, fault gain, fault width, TF mode), its weight as height."""
+    ax = _ax(ax, figsize=(5, 3.5))
+    settings = list(calibration["settings"])
+    labels = [f"G{s['grade']}" + ("" if s["gain"] == 1 and s["width"] == 1 else
+                                  f"\n×{s['gain']:g} w{s['width']:g}")
+              + ("" if s["tf"] == "tf" else "\nRMS") for s in settings]
+    bars = ax.bar(range(len(settings)), [s["weight"] for s in settings], color="C2")
+    ax.set_xticks(range(len(settings)), labels, fontsize=7)
+    ax.set_ylabel("weight")
+    ax.set_title(f"calibration ({calibration['strategy']}): settings that predict",
+                 fontsize=9)
+    return bars
 
 
 def plot_feature_invariance(train, test, names, errors, *, axes=None):

@@ -270,7 +270,7 @@ def _rebuild_hint(store: Path, man: dict) -> str:
            f"--n-healthy {man.get('n_healthy')} --n-faulty {man.get('n_faulty')} "
            f"--seed {man.get('seed')}"
            + "".join(f" --fault-type {t}" for t in man.get("fault_types", []))
-           + (" --paired" if man.get("paired") else ""))
+           + ("" if man.get("paired") else " --no-paired"))   # paired is the default
     return (f"run `{cmd}` (or build_database with the same arguments): it rebuilds only "
             f"the damaged block and reuses the rest")
 
@@ -349,7 +349,7 @@ def _healthy_twins(pair, sa, sizes, sig_seeds, *, speed, load, grade, n_points):
 def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades,
                    n_healthy: int = 100, n_faulty: int = 700, seed: int = 0,
                    n_points: int = 2048, client=None, progress: bool = True,
-                   fault_types=("ftff",), paired: bool = False) -> Path:
+                   fault_types=("ftff",), paired: bool = True) -> Path:
     """Simulate SAs for every (speed, load, grade) and store them as Zarr.
 
     Parameters
@@ -381,12 +381,15 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         Fault types (:data:`~gearshot.sim.FAULT_TYPES`): one block of ``n_healthy`` +
         ``n_faulty`` signals per type and (speed, load, grade); sizes mean the type's
         size (:mod:`gearshot.sim.fault_types`). Default the FTFF only.
-    paired : bool, default False
+    paired : bool, default True
         Also store, as ``sa_twin``, each signal's *healthy twin*: the SA of the same gear
         pair (same seed, hence the same profile errors) without the fault (a healthy
         signal is its own twin). The ``sa`` of a paired store equal those of the unpaired
         store of the same arguments; the twins cost one more simulation per faulty
-        signal. ``OneFaultShotEstimator(simulated_reference="twin")`` needs them.
+        signal. The estimator's default ``simulated_reference="auto"`` subtracts them and
+        its default ``calibration="joint"`` calibrates fault gain and width on them
+        (issue #19). ``False`` builds the old unpaired layout (stores built that way
+        still load; finish them with ``paired=False``).
 
     Returns
     -------
@@ -467,8 +470,14 @@ def _prepare_store(store: Path, manifest: dict) -> None:
             write_json_atomic(manifest, mpath, sort_keys=False)
         if old != manifest:
             diff = sorted(k for k in manifest if old.get(k) != manifest[k])
+            hint = ""
+            if diff == ["paired"]:
+                hint = (" (it was built without healthy twins: finish it with paired=False"
+                        " / --no-paired)" if manifest.get("paired") else
+                        " (it was built with healthy twins: finish it with paired=True"
+                        " / --paired)")
             raise GearshotError(f"store {str(store)!r} holds a different build "
-                                f"(differs in {', '.join(diff)}); use a new store "
+                                f"(differs in {', '.join(diff)}){hint}; use a new store "
                                 f"(--store / store=)")
     try:
         (store / "blocks").mkdir(parents=True, exist_ok=True)
