@@ -16,6 +16,7 @@ it was.
 
 from __future__ import annotations
 
+import functools
 import numbers
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -88,7 +89,7 @@ class _CalibrationValue(Constraint):
                 + ", a CalibrationOptions or a mapping of its fields")
 
 
-def _select_fault_type(database, fault_type):
+def _select_fault_type(database: Any, fault_type: str | None) -> Any:
     """The signals of one fault type (healthy ones included) of a database whose
     ``fault_type`` coordinate names each signal's type; databases without it hold FTFFs."""
     try:
@@ -274,7 +275,8 @@ class _FitContext:
     cache: dict[str, Any] = field(default_factory=dict)
 
 
-class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
+# scikit-learn ships no type information: its classes are Any to mypy
+class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc,unused-ignore]
     """Estimate FTFF size from SAs with one faulty example (Matania et al. 2023).
 
     Parameters
@@ -580,9 +582,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         options = resolve_calibration(self.calibration)
         if strategy == "soft" and options is not None and twins is not None:
             strategy = "joint"
-        choose = {"tuned": self._grade_tuned, "soft": self._grade_soft,
-                  "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot,
-                  "joint": lambda c: self._grade_joint(c, options)}[strategy]
+        strategies: dict[str, Callable[[_FitContext], _GradeChoice]] = {
+            "tuned": self._grade_tuned, "soft": self._grade_soft,
+            "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot,
+            "joint": functools.partial(self._grade_joint, options=options)}
+        choose = strategies[strategy]
         choice = choose(ctx)
         settings, setting_models = self._settings_of(choice, ctx)
         grade_w: dict[int, float] = {}
@@ -1052,4 +1056,5 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         """Load an estimator saved by :meth:`save`."""
         from .persistence import load_estimator
 
-        return load_estimator(path)
+        loaded: OneFaultShotEstimator = load_estimator(path)
+        return loaded
