@@ -109,3 +109,18 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     assert (frame["role"] == "faulty_rest").sum() == 3
     assert (frame["role"] == "test").sum() == 4
     assert (frame["role"] == "healthy_holdout").sum() == 1
+    # issue #19 item 5: every estimate says whether the segment looks like the fitted
+    # machine; spur1 (another build) does not, spur3 held out and spur2's rest do
+    assert frame["comparable"].dtype == bool and frame["comparability"].ge(0).all()
+    assert not frame.loc[frame["role"] == "test", "comparable"].any()
+    assert frame.loc[frame["role"] != "test", "comparable"].all()
+    assert "comparable: 4 segment(s), not comparable: 4" in res.stdout
+    out_json = tmp_path / "pred.json"
+    res = run("predict", "--machine", str(SPUR), "--database", str(store), "--healthy",
+              str(small["spur3"]), "--faulty", str(small["spur2"]), "--faulty-size", "0.5",
+              "--recordings", str(small["spur1"]), "--speed", "30", "--load", "10",
+              "--cycles-per-segment", "10", "--out", str(out_json), env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    records = json.loads(out_json.read_text())
+    assert [r["comparable"] for r in records] == frame["comparable"].tolist()
+    assert all(isinstance(r["comparable"], bool) for r in records)

@@ -549,6 +549,19 @@ def experiment_rig_family(
     _write_json(json_out, payload)
 
 
+def _comparable_summary(frame) -> str:
+    """One line counting the comparable segments of a predict table (issue #19)."""
+    if "comparable" not in frame or not len(frame):
+        return "comparable: no segment estimated"
+    n_yes = int(frame["comparable"].sum())
+    n_no = len(frame) - n_yes
+    line = f"comparable: {n_yes} segment(s), not comparable: {n_no}"
+    if n_no:
+        line += (" (they do not look like the fitted machine — another build, speed, load "
+                 "or sensor? — do not act on their estimates)")
+    return line
+
+
 @app.command()
 def predict(
     database: Path = typer.Option(..., "--database", help="Simulated database store."),
@@ -607,6 +620,7 @@ def predict(
             frame.to_csv(tmp, index=False)
     by = ["recording", "role"] if "role" in frame else "recording"
     typer.echo(frame.groupby(by)["predicted"].mean().to_string())
+    typer.echo(_comparable_summary(frame))
     typer.echo(f"predictions written to {out}")
 
 

@@ -42,7 +42,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     Returns
     -------
     pandas.DataFrame
-        ``recording, segment, predicted, low, high``.
+        ``recording, segment, predicted, low, high, comparability, comparable``
+        (:meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
     """
     from ..estimator import OneFaultShotEstimator
     from ..io import recording_segments
@@ -81,6 +82,9 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frames = []
     for path, sa in targets:
         low, high = est.predict_interval(sa, coverage=coverage)
+        comp = est.comparability(sa)
         frames.append(pd.DataFrame(dict(recording=str(path), segment=np.arange(len(sa)),
-                                        predicted=est.predict(sa), low=low, high=high)))
+                                        predicted=est.predict(sa), low=low, high=high,
+                                        comparability=comp.score,
+                                        comparable=comp.comparable)))
     return pd.concat(frames, ignore_index=True)

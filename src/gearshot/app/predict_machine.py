@@ -55,6 +55,12 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
+def _comparability_columns(est, sas) -> tuple[np.ndarray, np.ndarray]:
+    """The ``comparability`` (score) and ``comparable`` columns of a predict table."""
+    result = est.comparability(sas)
+    return result.score, result.comparable
+
+
 def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                          faulty: str | Path, faulty_size: float,
                          recordings: Sequence[str | Path] = (), *, speed: float, load: float,
@@ -101,7 +107,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, speed_hz, predicted, low, high``.
+        ``recording, role, segment, speed_hz, predicted, low, high, comparability,
+        comparable`` (:meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`:
+        the score and whether the segment looks like the fitted machine).
     """
     from ..estimator import OneFaultShotEstimator
     from ..sim import load_database
@@ -160,6 +168,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         low, high = est.predict_interval(sas, coverage=coverage)
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
+        frame["comparability"], frame["comparable"] = _comparability_columns(est, sas)
     frame.attrs["grade"] = getattr(est, "grade_", None)
     frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame

@@ -4,14 +4,16 @@
 ``steps``                      the paper's steps 1–8, in order, one function each
 ``uncertainty``                grade weights and prediction intervals (not paper steps)
 ``zero_shot``                  grade choice from healthy data alone
+``comparability``              does a segment look like the fitted machine (issue #19)
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
 ``save_estimator`` / ``load``  persistence with version metadata
 =============================  ======================================================
 """
 
 from .._errors import NotFittedError
-from . import steps, uncertainty
+from . import comparability, steps, uncertainty
 from ._model import STEP_SEEDS, OneFaultShotEstimator
+from .comparability import Comparability, ComparabilityReference, harmonic_profile
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -34,6 +36,10 @@ __all__ = [
     "STEP_SEEDS",
     "steps",
     "uncertainty",
+    "comparability",
+    "Comparability",
+    "ComparabilityReference",
+    "harmonic_profile",
     "select_features",
     "tune_grade",
     "estimate_tf",

@@ -52,6 +52,7 @@ from .calibration import (
     setting_differences,
     setting_log_likelihoods,
 )
+from .comparability import Comparability, ComparabilityReference, fit_comparability
 from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
@@ -429,6 +430,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         weight; else None) and ``options`` (the joint grid's options or None).
     setting_models_ : list of KnnModel
         One model per entry of ``calibration_["settings"]``.
+    comparability_reference_ : ComparabilityReference
+        The fitted machine's harmonic profiles (healthy mean, the example's direction,
+        healthy spread) that :meth:`comparability` measures segments against
+        (:mod:`gearshot.estimator.comparability`).
     mesh_orders_ : tuple of int
         The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
     """
@@ -601,6 +606,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                            settings=settings, grid=choice.grid,
                            options=None if options is None or choice.settings is None
                            else options.as_dict())
+        comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
+                                          faulty_example=inputs.faulty_example,
+                                          faulty_size=inputs.faulty_size)
 
         learned = dict(
             n_points_=inputs.n_points, transfer_function_=target.transfer_function,
@@ -615,7 +623,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
             grade_models_=models, model_=best, tuning_curve_=choice.tuning_curve,
             calibration_=calibration, setting_models_=setting_models,
             n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
-            step_seeds_=seeds, simulated_reference_=reference, mesh_orders_=orders)
+            step_seeds_=seeds, simulated_reference_=reference,
+            comparability_reference_=comparability, mesh_orders_=orders)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
@@ -998,6 +1007,39 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         return sum((st["weight"] * m.predict(X) for st, m in
                     zip(self.calibration_["settings"], self.setting_models_)),
                    np.zeros(len(X)))
+
+    def comparability(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
+        """Whether target SAs look like the fitted machine (know when not to answer).
+
+        Compares each SA's regular part — the unit-norm amplitudes of its mesh-harmonic
+        orders (:func:`~gearshot.estimator.comparability.harmonic_profile`) — with the
+        fitted machine's states: the healthy SAs' mean profile, moved toward the faulty
+        example's profile as a fault grows to size 1. The score is the distance from
+        those states in units of the healthy SAs' own spread; a segment of another build,
+        another speed or load than the database's, or another sensor lies far from them
+        and is not comparable: its estimate should not be acted on.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        threshold : float > 0, optional
+            Largest score of a comparable segment; default
+            :data:`~gearshot.estimator.comparability.DEFAULT_THRESHOLD` (3.0, chosen on
+            the PHM 2009 spur subset's 30 Hz cells, benchmarks/RESULTS.md).
+
+        Returns
+        -------
+        Comparability
+            ``score`` (n_signals,), ``comparable`` (bool, ``score <= threshold``) and
+            ``threshold``.
+        """
+        self._check_fitted("comparability")
+        reference: ComparabilityReference | None = getattr(self, "comparability_reference_",
+                                                            None)
+        if reference is None:  # an estimator saved before comparability existed
+            raise GearshotError("this estimator was fitted by an older gearshot without "
+                                "a comparability reference; fit it again")
+        return reference.evaluate(sa, threshold)
 
     def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
                          ) -> tuple[FloatArray, FloatArray]:
