@@ -48,16 +48,19 @@ def small(tmp_path_factory):
 def test_indicators_json_layout_and_figures(small, tmp_path):
     out = tmp_path / "ind.json"
     figs = tmp_path / "figs"
-    res = run("indicators", "--machine", str(SPUR), "--shaft", "idler", str(small["spur2"]),
-              str(small["spur3"]), "--json", str(out), "--out", str(figs))
+    res = run("indicators", "--machine", str(SPUR), "--shaft", "idler", "--sensor",
+              "acc_input", str(small["spur2"]), str(small["spur3"]), "--json", str(out),
+              "--out", str(figs))
     assert res.returncode == 0, res.stderr
     payload = json.loads(out.read_text())
-    assert list(payload) == ["records"] and len(payload["records"]) == 2
+    assert payload["kind"] == "indicators" and len(payload["records"]) == 2
     want = {*available_features(), "rms_raw", "rms_residual"}
     for rec, name in zip(payload["records"], ("spur2", "spur3")):
-        assert list(rec) == ["file", "speed_hz", "n_cycles", "indicators"]
-        assert rec["file"] == f"{name}_30hz_High_1.zip"
-        assert 29.0 < rec["speed_hz"] < 30.0  # read from the tacho, input shaft
+        assert list(rec) == ["file", "sensor", "tacho_speed_hz", "shaft_speed_hz", "n_cycles",
+                             "indicators"]
+        assert rec["file"] == f"{name}_30hz_High_1.zip" and rec["sensor"] == "acc_input"
+        assert 29.0 < rec["tacho_speed_hz"] < 30.0  # read from the tacho, input shaft
+        assert rec["shaft_speed_hz"] == pytest.approx(rec["tacho_speed_hz"] / 3)  # 32 -> 96
         assert rec["n_cycles"] == 14  # 1.5 s at ~29.9 Hz: 44 whole input revs, 14 idler revs
         assert set(rec["indicators"]) == want
         assert all(isinstance(v, float) for v in rec["indicators"].values())
@@ -67,7 +70,7 @@ def test_indicators_json_layout_and_figures(small, tmp_path):
               "acc_output", str(small["spur2"]), "--baseline", str(small["spur3"]),
               "--json", str(out))
     assert res.returncode == 0, res.stderr
-    assert json.loads(out.read_text())["records"][0]["n_cycles"] == 44
+    assert [r["n_cycles"] for r in json.loads(out.read_text())["records"]] == [44]
 
 
 @pytest.mark.parametrize("args, words", [
@@ -91,7 +94,8 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--grade", "6", "--grade", "7", "--n-healthy", "6", "--n-faulty", "24",
               "--store", str(store), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    assert "pair 96 -> 32 teeth" in res.stdout and "[10.0]" in res.stdout
+    assert "pair 96 -> 32 teeth" in res.stdout and "input (tacho) shaft 30 Hz" in res.stdout
+    assert "rev/s" not in res.stdout     # no internal (idler) speeds
     # a machine's database is paired by default (each signal's healthy twin stored)
     assert json.loads((store / "manifest.json").read_text()).get("paired") is True
     out = tmp_path / "pred.csv"

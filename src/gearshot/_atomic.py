@@ -94,6 +94,26 @@ def check_writable(path: str | os.PathLike, name: str, *, folder: bool = False) 
     return path
 
 
+def _umask() -> int:
+    """The process's file-creation mask: from ``/proc/self/status`` where there is one (no
+    race with other threads), else by setting and restoring it."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _user_mode(path: Path, *, folder: bool = False) -> None:
+    """Give a temporary file (0600 from :func:`tempfile.mkstemp`) or folder (0700 from
+    :func:`tempfile.mkdtemp`) the mode a plain ``open``/``mkdir`` would have: 0666 or 0777
+    less the user's umask, so that the renamed result is as readable as any other file."""
+    os.chmod(path, (0o777 if folder else 0o666) & ~_umask())
+
+
 def _fsync_file(path: Path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
@@ -149,6 +169,7 @@ def atomic_path(path: str | os.PathLike, *, make_parents: bool = False) -> Itera
     os.close(fd)
     tmp_path = Path(tmp)
     try:
+        _user_mode(tmp_path)
         yield tmp_path
         _fsync_file(tmp_path)
         os.replace(tmp_path, path)
@@ -195,6 +216,7 @@ def atomic_dir(path: str | os.PathLike, *, exist_ok: bool = False) -> Iterator[P
     except OSError as exc:
         raise _fail(path, exc) from None
     try:
+        _user_mode(tmp, folder=True)
         yield tmp
         for root, _dirs, files in os.walk(tmp):
             for f in files:

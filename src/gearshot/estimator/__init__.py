@@ -12,7 +12,7 @@
 
 from .._errors import NotFittedError
 from . import comparability, steps, uncertainty
-from ._model import STEP_SEEDS, OneFaultShotEstimator
+from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from .comparability import Comparability, ComparabilityReference, harmonic_profile
 from .persistence import load_estimator, save_estimator
 from .steps import (
@@ -34,6 +34,7 @@ __all__ = [
     "OneFaultShotEstimator",
     "NotFittedError",
     "STEP_SEEDS",
+    "default_selection_tf",
     "steps",
     "uncertainty",
     "comparability",

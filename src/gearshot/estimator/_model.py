@@ -57,7 +57,7 @@ from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
 
-__all__ = ["OneFaultShotEstimator", "STEP_SEEDS"]
+__all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -194,6 +194,21 @@ def _step_seeds(random_state: Any) -> dict[str, int]:
         root = np.random.SeedSequence(int(random_state))
     children = root.spawn(len(STEP_SEEDS))
     return {name: int(child.generate_state(1)[0]) for name, child in zip(STEP_SEEDS, children)}
+
+
+def default_selection_tf(random_state: Any = 0) -> Any:
+    """Step 1's held-out TF when none is given: one TF of
+    :meth:`gearshot.transfer.TransferFunctionBank.synthetic`, drawn with
+    ``numpy.random.default_rng([random_state, 99])`` for an int ``random_state`` (the TF
+    ``gearshot predict`` and ``gearshot experiment rig`` use with ``--seed``), else from
+    the ``select_features`` step seed of ``random_state``."""
+    from ..transfer import TransferFunctionBank
+
+    if isinstance(random_state, numbers.Integral) and not isinstance(random_state, bool):
+        rng = np.random.default_rng([int(random_state), 99])
+    else:
+        rng = np.random.default_rng(_step_seeds(random_state)["select_features"])
+    return TransferFunctionBank.synthetic(1, rng=rng)[0]
 
 
 def _on_grid(tf: Any, n_points: int, name: str) -> ComplexArray:
@@ -531,9 +546,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
             Its size.
         healthy_long : array_like (n_samples,)
             Long healthy angle-domain target signal (≥ 2**15 samples) for the TF estimate.
-        selection_tf : array_like of complex or TransferFunction
+        selection_tf : array_like of complex or TransferFunction, optional
             The held-out TF for feature selection (on the SA grid, one-sided, or an object
-            with ``to_signal_grid(n)``); needed when ``select_features``.
+            with ``to_signal_grid(n)``). Default: :func:`default_selection_tf` of
+            ``random_state`` (one TF of the synthetic bank, as the command line uses): on a
+            real machine no second measured path is at hand, and step 1 only needs a
+            plausible path other than the estimated one.
         gear_teeth, pinion_teeth : int, optional
             The pair the target SAs were segmented for (the gear whose revolution is the
             SA cycle, and its mate); SAs of another pair than the database's are refused.
@@ -662,8 +680,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         sel_tf = None
         if self.select_features:
             if selection_tf is None:
-                raise GearshotError("selection_tf is required with select_features=True "
-                                    "(the held-out TF of step 1)")
+                selection_tf = default_selection_tf(self.random_state)
             sel_tf = _on_grid(selection_tf, n_points, "selection_tf")
         return _FitInputs(healthy, example, size, long, sel_tf, n_points)
 

@@ -479,26 +479,26 @@ def _effective_params(params: dict) -> dict:
 
 
 def _run(specs, results: Path, client, progress, total):
-    from rich.progress import Progress
+    from .._progress import progress as progress_of
 
     def append(rows):
         with open(results, "a") as fh:
             for row in rows:
                 fh.write(json.dumps(row, default=_json_default) + "\n")
 
-    with Progress(transient=False, disable=not progress) as bar:
-        job = bar.add_task("rig family", total=total, completed=total - len(specs))
+    with progress_of("rig family", total, completed=total - len(specs),
+                     enabled=progress) as bar:
         if client is None:
             for spec in specs:
                 append(_family_task(spec))
-                bar.advance(job)
+                bar.advance()
         else:
             from dask.distributed import as_completed
 
             futures = [client.submit(_family_task, spec, pure=False) for spec in specs]
             for fut in as_completed(futures):
                 append(fut.result())
-                bar.advance(job)
+                bar.advance()
 
 
 def _json_default(value):

@@ -26,7 +26,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-import h5py
 import numpy as np
 
 from .._errors import GearshotError
@@ -61,6 +60,7 @@ def _split_2d(name: str, arr: np.ndarray, out: dict[str, np.ndarray]) -> None:
 
 def read_hdf5(path: Path) -> RawFile:
     """Read a native (or generic) HDF5 recording file."""
+    import h5py  # imported on use: text/zip readers never pay for it
     with h5py.File(path, "r") as f:
         attrs = {k: _attr(v) for k, v in f.attrs.items()}
         if attrs.get("gearshot_format") == FORMAT_NAME:
@@ -103,6 +103,7 @@ def read_hdf5(path: Path) -> RawFile:
 
 def write_hdf5(rec: Any, path: Path, *, dtype: Any = np.float64) -> None:
     """Write ``rec`` (a Recording) in the native layout, atomically."""
+    import h5py
     dtype = np.dtype(dtype)
     if dtype not in (np.dtype(np.float64), np.dtype(np.float32)):
         raise GearshotError(f"dtype for HDF5 must be float64 or float32; got {dtype}")

@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.io.wavfile
 
 from .._errors import GearshotError
 from ._fileio import RawFile, atomic_path, read_sidecar, sidecar_path, write_json_atomic
@@ -27,6 +26,7 @@ WAV_DTYPES = ("float32", "int16", "int32")
 
 def read_wav(path: Path) -> RawFile:
     """Read a WAV file (and its sidecar) into channels, fs and metadata."""
+    import scipy.io.wavfile  # imported on use
     path = Path(path)
     side = read_sidecar(path)
     with warnings.catch_warnings():
@@ -74,6 +74,7 @@ def write_wav(rec: Any, path: Path, *, dtype: Any = "float32") -> None:
     ``dtype`` is the sample type: "float32", "int16" or "int32" (integer channels are scaled
     to their peak; the factor goes to the sidecar).
     """
+    import scipy.io.wavfile
     path = Path(path)
     dtype = str(np.dtype(dtype))
     if dtype not in WAV_DTYPES:

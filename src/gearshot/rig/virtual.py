@@ -290,10 +290,9 @@ class VirtualRig:
         check_writable(folder, "folder", folder=True)
         with staging_dir(folder) as staging:
             rows = []
-            from rich.progress import track
+            from .._progress import track
 
-            for y, r in track(jobs, description=f"rig {speed:g} rev/s {load:g} N m",
-                              disable=not progress):
+            for y, r in track(jobs, f"rig {speed:g} rev/s {load:g} N m", enabled=progress):
                 rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
                                   repetition=r)
                 name = self.file_name(speed, load, y, r)

@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import cast
 
 import numpy as np
-import scipy.signal
 from numpy.typing import ArrayLike
 
 from .._typing import FloatArray
@@ -41,5 +40,7 @@ def envelope(x: ArrayLike) -> FloatArray:
     >>> print(round(float(env.max()), 3), round(float(env.min()), 3))
     1.5 0.5
     """
+    import scipy.signal  # a slow import (0.5-1 s): only when an envelope is asked for
+
     x = as_signal_array(x, "x", min_length=2)
     return cast(FloatArray, np.abs(scipy.signal.hilbert(x, axis=-1)))

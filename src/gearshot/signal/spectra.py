@@ -8,7 +8,6 @@ import numpy as np
 import scipy.fft
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
-from scipy.interpolate import PchipInterpolator
 
 from .._errors import GearshotError
 from .._typing import FloatArray
@@ -117,6 +116,8 @@ def acs_background(spectrum: ArrayLike, *, segment_size: int = 200, overlap: flo
     if values.shape[-1] == 1:
         background = np.broadcast_to(values, spectrum.shape).copy()
     else:
+        from scipy.interpolate import PchipInterpolator
+
         background = PchipInterpolator(centres, values, axis=-1, extrapolate=False)(grid)
         before, after = grid < centres[0], grid > centres[-1]
         background[..., before] = values[..., :1]

@@ -492,24 +492,15 @@ def _prepare_store(store: Path, manifest: dict) -> None:
 
 def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
                progress, paired=False):
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+    from .._progress import progress as progress_of
 
-    columns = (TextColumn("simulating blocks"), BarColumn(), MofNCompleteColumn(),
-               TimeElapsedColumn(), TimeRemainingColumn())
-    with Progress(*columns, disable=not progress) as bar:
-        task = bar.add_task("blocks", total=n_total, completed=n_total - len(todo))
+    with progress_of("simulating blocks", n_total, completed=n_total - len(todo),
+                     enabled=progress) as bar:
         if client is None:
             for t in todo:
                 _build_block(str(store), pair, *t[:6], n_healthy, n_faulty, seed, n_points,
                              fault_type=t[6], paired=paired)
-                bar.advance(task)
+                bar.advance()
             return
         from dask.distributed import as_completed
         futures = [client.submit(_build_block, str(store), pair, *t[:6], n_healthy,
@@ -518,7 +509,7 @@ def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, 
                    for t in todo]
         for fut in as_completed(futures):
             fut.result()
-            bar.advance(task)
+            bar.advance()
 
 
 def load_database(store, *, speed: float, load: float, grade: int | None = None,
