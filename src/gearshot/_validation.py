@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 import numbers
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -109,8 +110,14 @@ def as_signal_array(
         raise GearshotError(
             f"{name} must have at least {min_length} samples along its last axis; "
             f"got {arr.shape[-1]}")
-    check_finite(arr, name)
-    peak = float(np.max(np.abs(arr)))
+    if np.iscomplexobj(arr):
+        check_finite(arr, name)
+        peak = float(np.max(np.abs(arr)))
+    else:  # two reductions without temporaries: NaN and inf show in the min or the max
+        lo, hi = float(arr.min()), float(arr.max())
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            check_finite(arr, name)
+        peak = max(-lo, hi)
     if max_abs is not None and peak > max_abs:
         raise GearshotError(f"{name} holds a value of magnitude {peak:.3g}; values up to "
                             f"{max_abs:g} are accepted (rescale the units)")

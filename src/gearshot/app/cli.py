@@ -262,9 +262,10 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
         if client is not None:
             client.close()
     mate_shaft, _ = mach.mate()
+    ref_kind = "tacho" if mach.tacho is not None else "reference"
     typer.echo(f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
-               f"gear, its mate on the {mate_shaft} shaft); conditions: {mach.tacho.shaft} "
-               f"(tacho) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "
+               f"gear, its mate on the {mate_shaft} shaft); conditions: {mach.reference_shaft} "
+               f"({ref_kind}) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "
                f"{', '.join(f'{x:g}' for x in loads)} N m")
     typer.echo(f"database ready: {store}")
 

@@ -141,9 +141,13 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
     dict
         ``{"kind": "indicators", "machine", "machine_file", "shaft", "tacho_shaft",
         "shaft_speed_ratio", "units", "records": [...]}``; one record per file and
-        sensor: ``{"file", "sensor", "tacho_speed_hz", "shaft_speed_hz", "n_cycles",
-        "indicators"}``. ``tacho_speed_hz`` is the mean speed of the tacho shaft read
-        from the tacho, ``shaft_speed_hz`` that of ``shaft`` (through the gear train).
+        sensor: ``{"file", "sensor", "tacho_speed_hz", "shaft_speed_hz", "speed_source",
+        "speed_uncertainty_hz", "n_cycles", "indicators"}``. ``tacho_speed_hz`` is the mean
+        speed of the machine's reference (tacho) shaft, read from the tacho
+        (``speed_source="tacho"``) or, for a machine without ``[tacho]``, estimated from the
+        vibration (``"vibration"``, with the standard uncertainty of the instantaneous
+        speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
+        the gear train).
     """
     from ..io import Recording
 
@@ -166,11 +170,13 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
                                    baseline=baselines[name])[name]
             records.append({"file": Path(path).name, "sensor": name,
                             "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
+                            "speed_source": rec.speed_source,
+                            "speed_uncertainty_hz": rec.speed_uncertainty,
                             "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
     units = {n: indicator_units(machine, n) for n in names}
     return {"kind": "indicators", "machine": machine.name,
             "machine_file": None if machine_file is None else str(machine_file),
-            "shaft": shaft, "tacho_shaft": machine.tacho.shaft, "shaft_speed_ratio": ratio,
+            "shaft": shaft, "tacho_shaft": machine.reference_shaft, "shaft_speed_ratio": ratio,
             "units": {"speeds": "Hz (revolutions per second)", "indicators": units},
             "records": records}
 
@@ -205,15 +211,17 @@ def indicator_table(payload: dict[str, Any]):
     rows = []
     for r in payload["records"]:
         case, cond = _case_of(r["file"])
+        extra = {k: r[k] for k in ("speed_source", "speed_uncertainty_hz") if k in r}
         rows.append({"file": r["file"], "case": case, "condition": cond,
                      "sensor": r.get("sensor", ""),
                      "tacho_speed_hz": r.get("tacho_speed_hz", r.get("speed_hz")),
                      "shaft_speed_hz": r.get("shaft_speed_hz", r.get("speed_hz")),
-                     "n_cycles": r["n_cycles"], **r["indicators"]})
+                     **extra, "n_cycles": r["n_cycles"], **r["indicators"]})
     return pd.DataFrame(rows)
 
 
 _META = ("file", "case", "condition", "sensor", "tacho_speed_hz", "shaft_speed_hz",
+         "speed_source", "speed_uncertainty_hz",
          "n_cycles")
 
 
@@ -236,6 +244,8 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
     markers = "osD^v<>pP*X"
     paths = []
     for col in cols:
+        source = (table["speed_source"].iloc[0] if "speed_source" in table.columns
+                  and table["speed_source"].nunique() == 1 else "tacho")
         fig = Figure(figsize=(4.2 * len(sensors) + 1.3, 3.8), layout="constrained")
         axes = fig.subplots(1, len(sensors), squeeze=False)[0]
         for ax, sensor in zip(axes, sensors):
@@ -247,7 +257,8 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
                             markers[conds.index(cond) % len(markers)],
                             color=f"C{ci % 10}", ms=6)
             unit = units.get(sensor, {}).get(col, "")
-            ax.set_xlabel("tacho-shaft speed (Hz), read from the tacho")
+            ax.set_xlabel("tacho-shaft speed (Hz), read from the tacho" if source == "tacho"
+                          else "reference-shaft speed (Hz), estimated from the vibration")
             ax.set_ylabel(f"{col} [{unit}]" if unit and unit != "1" else f"{col} (ratio)")
             ax.set_title(f"sensor {sensor}" if sensor else "", fontsize=9)
         handles = [axes[0].plot([], [], "o", color=f"C{ci % 10}", label=case)[0]

@@ -26,8 +26,13 @@ def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty:
 
 
 def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
-                     sensor: str | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+                     sensor: str | None = None, info: dict | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, float]:
     """SA segments of the monitored gear's shaft for one recording file.
+
+    ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
+    machine without ``[tacho]``) and ``speed_uncertainty_hz`` (rev/s of the reference
+    shaft, ``None`` with a tacho).
 
     Returns
     -------
@@ -53,6 +58,8 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
                             f"{machine.monitored.shaft!r}; --cycles-per-segment="
                             f"{cycles_per_segment} is too many")
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
+    if info is not None:
+        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
@@ -118,12 +125,15 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     -------
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, predicted, low, high,
-        comparability, comparable`` (``speed_hz``: the recording's tacho speed;
-        ``database_speed_hz``: the condition it is estimated at, both tacho-shaft Hz;
+        comparability, comparable, speed_source, speed_uncertainty_hz`` (``speed_hz``: the
+        recording's reference-shaft speed; ``database_speed_hz``: the condition it is
+        estimated at, both in Hz of the tacho (reference) shaft;
         ``comparability``/``comparable``: the score of
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
-        segment looks like the fitted machine); ``attrs`` hold the condition
-        (``speed_hz``, ``load``), the grade and the simulated reference.
+        segment looks like the fitted machine; ``speed_source``: ``tacho`` or
+        ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
+        ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``), the grade and
+        the simulated reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
@@ -142,10 +152,12 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             raise GearshotError(f"recording {str(p)!r} does not exist")
     db_speeds, _ = database_conditions(database, machine)   # a bad --database fails now
     rows = []
+    sources: dict[str, dict] = {}
     train, long = [], None
     speeds: dict[str, float] = {}
     for p in healthy:
-        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
+                                     info=sources.setdefault(str(p), {}))
         speeds[str(p)] = sp
         n_hold = int(np.floor(holdout * sa.shape[0]))
         n_fit = sa.shape[0] - n_hold
@@ -157,7 +169,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
         for k in range(n_fit, sa.shape[0]):
             rows.append((str(p), "healthy_holdout", k, sp, sa[k]))
-    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor)
+    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor,
+                                   info=sources.setdefault(str(faulty), {}))
     speeds.setdefault(str(faulty), fsp)
     example_segment = check_int(example_segment, "example_segment", minimum=0,
                                 maximum=fsa.shape[0] - 1)
@@ -165,7 +178,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         if k != example_segment:
             rows.append((str(faulty), "faulty_rest", k, fsp, fsa[k]))
     for p in recordings:
-        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor)
+        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
+                                     info=sources.setdefault(str(p), {}))
         speeds.setdefault(str(p), sp)
         rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
     cond_speed, cond_load = choose_condition(database, machine, speed=speed, load=load,
@@ -192,6 +206,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         frame["low"], frame["high"] = low, high
         frame["comparability"], frame["comparable"] = _comparability_columns(est, sas)
     frame.attrs["speed_hz"], frame.attrs["load"] = cond_speed, cond_load
+    frame["speed_source"] = [sources[r]["speed_source"] for r in frame["recording"]]
+    frame["speed_uncertainty_hz"] = [sources[r]["speed_uncertainty_hz"]
+                                     for r in frame["recording"]]
     frame.attrs["grade"] = getattr(est, "grade_", None)
     frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame

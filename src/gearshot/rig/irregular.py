@@ -44,7 +44,7 @@ from ..sim.fault_types import (
     check_fault_type,
     fault_of_type,
 )
-from ..sim.faults import ToothFault
+from ..sim.faults import FullToothFaceFault, ToothFault
 from .reality import RigReality
 from .sim_engine import IrregularFaceFault
 
@@ -86,7 +86,9 @@ class IrregularPartialFace(PartialFaceFault):
         super().__post_init__()
 
     @property
-    def transverse(self) -> IrregularFaceFault:
+    def transverse(self) -> FullToothFaceFault:
+        if not self.roughness:     # the nominal cut (and its batch tables, bit for bit)
+            return super().transverse
         return IrregularFaceFault(tooth=self.tooth, size=self.profile_size,
                                   center=self.center, depth=self.depth,
                                   roughness=self.roughness)

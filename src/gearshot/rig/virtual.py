@@ -45,7 +45,7 @@ from ..paper import GEAR_TEETH, PINION_TEETH, TABLE1_SIZES
 from ..signal.level import rms
 from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
-from .motion import load_torque, motor_angle
+from .motion import load_torque, motor_angle, ramp_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
 from .reality import RigReality, draw_reality
 from .sim_engine import SimulatorEngine
@@ -182,7 +182,8 @@ class VirtualRig:
 
     # ------------------------------------------------------------------ one recording
     def record(self, *, speed: float, load: float, fault_size: float = 0.0,
-               duration: float = 60.0, repetition: int = 0) -> Recording:
+               duration: float = 60.0, repetition: int = 0,
+               end_speed: float | None = None) -> Recording:
         """Run the rig once and record it.
 
         Parameters
@@ -197,6 +198,11 @@ class VirtualRig:
             Recorded length, s.
         repetition : int
             Repetition number (a different run of the same condition).
+        end_speed : float, optional
+            A run-up (or run-down): the input speed ramps linearly from ``speed`` at the
+            start of the recorded span to ``end_speed`` at its end
+            (:func:`gearshot.rig.motion.ramp_angle`; the per-revolution ripple stays, the
+            slow drift is replaced by the ramp). ``speed`` in the metadata is the mean.
 
         Returns
         -------
@@ -218,8 +224,14 @@ class VirtualRig:
         # relative position of the wheels at the start: a whole number of pinion turns
         # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
         start = float(rng.integers(0, self.gear_teeth))
-        motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
-                            ripple=reality.speed_ripple, rng=rng, start=start)
+        if end_speed is None:
+            motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
+                                ripple=reality.speed_ripple, rng=rng, start=start)
+        else:
+            end_speed = check_positive(end_speed, "end_speed")
+            motor = ramp_angle(t, speed=speed, end_speed=end_speed, t_start=self.settle,
+                               t_end=float(t[-1]), ripple=reality.speed_ripple, rng=rng,
+                               start=start)
         torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
                              ripple=reality.load_ripple, rng=rng)
         engine = self._engine()
@@ -241,12 +253,16 @@ class VirtualRig:
         acc = apply_path(vib, fir)[n_settle:]
         acc = add_noise(acc, snr_db=reality.snr_db, rng=rng)
         tach = tacho_signal(motor[n_settle:], jitter=reality.tacho_jitter, rng=rng)
+        extras = {}
+        if end_speed is not None:
+            extras = {"start_speed": speed, "end_speed": end_speed}
+            speed = 0.5 * (speed + end_speed)
         return Recording(
             acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
             source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
             extras={"repetition": repetition, "rig_seed": int(self.seed),
                     "engine": type(getattr(engine, "func", engine)).__name__,
-                    "fault_type": self.fault_type})
+                    "fault_type": self.fault_type, **extras})
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod

@@ -1,4 +1,22 @@
-"""Order-domain separation of a synchronous average into mesh and residual parts."""
+"""Order-domain separation of a synchronous average into mesh and residual parts.
+
+The three classical parts of a synchronous average (SA), with the reference toolchain's
+names (MATLAB Predictive Maintenance Toolbox) for orientation:
+
+* :func:`regular_signal` -- the shaft orders and every mesh harmonic (with optional
+  sidebands), everything else zeroed: ``tsaregular`` with the shaft orders and the mesh
+  orders in its order list (here the shaft orders are listed one by one, since all
+  harmonics of order 1 would be every order).
+* :func:`difference_signal` -- the SA with the mesh harmonics and ``n_sidebands``
+  sidebands removed; with ``shaft_orders=`` also those shaft orders and DC, which is
+  ``tsadifference`` (regular signal and first-order sidebands removed: ``n_sidebands=1,
+  shaft_orders=(1, 2)``). Without ``shaft_orders`` it is the paper's difference signal.
+* :func:`residual_signal` -- the SA minus its regular signal (shaft orders, DC and mesh
+  harmonics removed, sidebands kept): ``tsaresidual``; NA4 is its normalized kurtosis.
+
+The *non-synchronous* part of the angle-domain signal -- what every revolution does
+differently, invisible in any SA -- is :func:`gearshot.signal.nonsynchronous_signal`.
+"""
 
 from __future__ import annotations
 
@@ -13,8 +31,8 @@ from .._errors import GearshotError
 from .._typing import BoolArray, FloatArray, IntArray
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
-__all__ = ["harmonic_signal", "difference_signal", "order_mask", "mesh_band_orders",
-           "check_mesh_order", "check_mesh_orders"]
+__all__ = ["harmonic_signal", "difference_signal", "regular_signal", "residual_signal",
+           "order_mask", "mesh_band_orders", "check_mesh_order", "check_mesh_orders"]
 
 
 #: One mesh order or several (a shaft carrying several gears).
@@ -143,11 +161,32 @@ def order_mask(n_points: int, mesh_order: MeshOrders, *, n_sidebands: int = 2) -
     return mask
 
 
-def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int,
-           keep_mesh: bool) -> FloatArray:
+def _shaft_orders(shaft_orders: int | Sequence[int], n: int) -> list[int]:
+    listed: object = shaft_orders
+    if isinstance(shaft_orders, (int, np.integer)) and not isinstance(shaft_orders, bool):
+        listed = [shaft_orders]
+    try:
+        orders = list(listed)  # type: ignore[call-overload]
+    except TypeError:
+        raise GearshotError(f"shaft_orders must be a sequence of integers; got "
+                            f"{shaft_orders!r}") from None
+    out = []
+    for i, o in enumerate(orders):
+        o = check_int(o, f"shaft_orders[{i}]", minimum=0)
+        if o > n // 2:
+            raise GearshotError(f"shaft_orders[{i}]={o} is above the Nyquist order {n // 2} "
+                                f"of a {n}-point cycle")
+        out.append(o)
+    return out
+
+
+def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int, keep_mesh: bool,
+           shaft_orders: int | Sequence[int] | None = None) -> FloatArray:
     sa = as_signal_array(sa, "sa", min_length=4)
     n = sa.shape[-1]
     mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
+    if shaft_orders is not None:
+        mask[[0, *_shaft_orders(shaft_orders, n)]] = True
     spectrum = scipy.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
     return cast(FloatArray, scipy.fft.irfft(spectrum, n=n, axis=-1))
@@ -192,8 +231,8 @@ def harmonic_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
 
 
 @finite_result
-def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
-                      n_sidebands: int = 2) -> FloatArray:
+def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *, n_sidebands: int = 2,
+                      shaft_orders: int | Sequence[int] | None = None) -> FloatArray:
     """A synchronous average with its mesh harmonics and sidebands removed.
 
     Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and
@@ -209,6 +248,10 @@ def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
         ``[96, 48]`` for an idler shaft: every mesh's harmonics and sidebands go).
     n_sidebands : int, default 2
         Sidebands removed on each side of every harmonic.
+    shaft_orders : sequence of int, optional
+        Shaft orders removed too, with DC (the regular signal's shaft part): with
+        ``n_sidebands=1, shaft_orders=(1, 2)`` this is Zakrajsek's difference signal (FM4),
+        the reference toolchain's ``tsadifference``. Default: none (the paper's).
 
     Returns
     -------
@@ -228,4 +271,84 @@ def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
     >>> print(np.round(diff[:3], 3))
     [0.5   0.478 0.416]
     """
-    return _split(sa, mesh_order, n_sidebands, keep_mesh=False)
+    return _split(sa, mesh_order, n_sidebands, keep_mesh=False, shaft_orders=shaft_orders)
+
+
+@finite_result
+def regular_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                   shaft_orders: int | Sequence[int] | None = (1, 2),
+                   n_sidebands: int = 0) -> FloatArray:
+    """The regular part of a synchronous average: shaft orders and mesh harmonics.
+
+    Keeps the listed shaft orders and every harmonic of every mesh order (with
+    ``n_sidebands`` sidebands each), zeroes everything else, DC included. The reference
+    toolchain's ``tsaregular`` with the shaft and mesh orders in its order list.
+    ``regular_signal(sa, m) + residual_signal(sa, m) == sa - mean(sa)``.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+        Synchronous average(s), one cycle each.
+    mesh_order : int or sequence of int
+        Mesh order(s) of the cycle (every mesh synchronous with the shaft,
+        :meth:`gearshot.Machine.mesh_orders`).
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders kept (each one alone, not its harmonics).
+    n_sidebands : int, default 0
+        Sidebands kept on each side of every mesh harmonic.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import regular_signal, residual_signal
+    >>> k = np.arange(64) / 64
+    >>> other = 0.1 * np.cos(2 * np.pi * 5 * k)  # order 5: neither shaft nor mesh
+    >>> sa = np.cos(2 * np.pi * 8 * k) + 0.5 * np.cos(2 * np.pi * k) + other
+    >>> bool(np.allclose(regular_signal(sa, 8), sa - other))
+    True
+    >>> bool(np.allclose(residual_signal(sa, 8), other))
+    True
+    """
+    out = _split(sa, mesh_order, n_sidebands, keep_mesh=True,
+                 shaft_orders=() if shaft_orders is None else shaft_orders)
+    return cast(FloatArray, out - out.mean(axis=-1, keepdims=True))
+
+
+@finite_result
+def residual_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                    shaft_orders: int | Sequence[int] = (1, 2)) -> FloatArray:
+    """The residual of a synchronous average: shaft orders, DC and mesh harmonics removed.
+
+    What is left of the SA once its regular signal (:func:`regular_signal`, no sidebands)
+    is taken out: the mesh sidebands and every other synchronous order. The reference
+    toolchain's ``tsaresidual``; the signal whose normalized kurtosis is NA4.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+    mesh_order : int or sequence of int
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders removed.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    The shaft orders 1–2, DC and the mesh go; an order that is neither stays:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import residual_signal
+    >>> k = np.arange(64) / 64
+    >>> other = 0.1 * np.cos(2 * np.pi * 5 * k)
+    >>> sa = 2.0 + np.cos(2 * np.pi * 8 * k) + 0.5 * np.cos(2 * np.pi * k) + other
+    >>> bool(np.allclose(residual_signal(sa, 8), other))
+    True
+    """
+    return _split(sa, mesh_order, 0, keep_mesh=False,
+                  shaft_orders=() if shaft_orders is None else shaft_orders)

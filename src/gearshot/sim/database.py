@@ -36,6 +36,7 @@ from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, describe
+from ._block_read import read_block, resume_problem
 from .dynamics import simulate_sa
 from .fault_types import FAULT_MODEL_VERSIONS, FAULT_TYPES, check_fault_type
 from .geometry import GearPair
@@ -428,7 +429,7 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     for t in tasks:
         path = blocks / _block_name(*t[:3], t[6])
         if path.exists():
-            problem = _block_problem(path)
+            problem = resume_problem(path)
             if problem is None:
                 if not _block_record(path):   # a block from before checksum lists
                     _write_checksums(path, manifest)
@@ -576,17 +577,16 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
                      f"grade={man['grades'][k]!r}, fault_type={ft!r}) of store {str(store)!r}")
             if not path.exists():
                 raise GearshotError(f"{where} is not built yet; {_rebuild_hint(store, man)}")
-            problem = _block_problem(path)
-            if problem is None:
-                try:
-                    part = xr.open_zarr(path, consolidated=False).load()
-                except Exception as exc:  # a decoder's error on a damaged chunk
-                    problem = f"it cannot be decoded ({type(exc).__name__}: {exc})"
-                else:
-                    if any(name in part and not np.all(np.isfinite(part[name].values))
-                           for name in ("sa", "sa_twin")) or "sa" not in part:
-                        problem = "its SA array is incomplete (non-finite values)"
+            part, problem = read_block(path)
+            if part is not None and (
+                    "sa" not in part or any(
+                        name in part and not np.all(np.isfinite(part[name].values))
+                        for name in ("sa", "sa_twin"))):
+                problem = "its SA array is incomplete (non-finite values)"
             if problem is not None:
+                if "is corrupt" in problem:   # resuming checks sizes and times only
+                    problem += (f" (should the rebuild find nothing to do, remove "
+                                f"{str(path)!r} first)")
                 raise GearshotError(f"{where} is damaged: {problem}; "
                                     f"{_rebuild_hint(store, man)}")
             part.attrs.pop(_ATTR, None)
