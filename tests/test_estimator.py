@@ -252,7 +252,7 @@ def test_zero_shot_soft_weights_are_a_distribution_over_grades(data):
 
 
 def test_save_and_load_round_trip(fitted, data, tmp_path):
-    path = tmp_path / "model.joblib"
+    path = tmp_path / "model.skops"
     fitted.save(path)
     again = OneFaultShotEstimator.load(path)
     assert_array_equal(again.predict(data[3]), fitted.predict(data[3]))

@@ -70,7 +70,7 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import GearshotError
-from ._validation import describe
+from ._validation import MAX_FS, describe
 
 __all__ = ["Machine", "GearStage", "Tacho", "VibrationSpeed", "Sensor", "FileLayout",
            "MonitoredGear", "parse_sensitivity"]
@@ -116,8 +116,12 @@ def _rate(value: Any, key: str) -> float:
                                 f"{value!r}") from None
         if frac <= 0:
             raise GearshotError(f"{key} must be > 0 Hz; got {value!r}")
-        return float(frac)
-    return _float(value, key)
+        rate = float(frac) if frac <= MAX_FS else math.inf
+    else:
+        rate = _float(value, key)
+    if rate > MAX_FS:
+        raise GearshotError(f"{key} must be <= {MAX_FS:g} Hz; got {value!r}")
+    return rate
 
 
 def parse_sensitivity(text: Any, *, key: str = "sensitivity") -> tuple[float, str]:
@@ -664,6 +668,17 @@ class Machine:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Machine:
         """Build a machine from the parsed TOML mapping."""
+        if not isinstance(data, Mapping):
+            raise GearshotError(f"a machine description must be a mapping; got "
+                                f"{describe(data)}")
+        try:
+            return cls._from_dict(data)
+        except (TypeError, AttributeError) as exc:   # a list or table where a value belongs
+            raise GearshotError(f"a value of the wrong type ({type(exc).__name__}: {exc}); "
+                                f"see the machine file format in gearshot.machine") from None
+
+    @classmethod
+    def _from_dict(cls, data: Mapping[str, Any]) -> Machine:
         _check_keys(data, {"name", "shafts", "stage", "tacho", "sensor", "file", "monitored",
                            "analysis", "speed"}, "the top level")
         name = data.get("name", "")
@@ -757,7 +772,7 @@ class Machine:
             if "fs" not in ft:
                 raise GearshotError("[file] needs 'fs' (sampling rate, Hz)")
             delim = ft.get("delimiter", "whitespace")
-            if delim not in _DELIMITERS:
+            if not isinstance(delim, str) or delim not in _DELIMITERS:
                 raise GearshotError(f"file.delimiter must be one of {sorted(_DELIMITERS)}; got "
                                     f"{delim!r}")
             header = ft.get("header", False)

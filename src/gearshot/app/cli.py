@@ -14,6 +14,7 @@ import typer
 from .. import __version__
 from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
+from .._validation import check_load, check_speed
 from ..paper import (
     CYCLES_PER_SEGMENT,
     GEAR_TEETH,
@@ -96,8 +97,7 @@ def _check_duration(duration: float, speed: float, *, option: str = "--duration"
                     gear_teeth: int = GEAR_TEETH,
                     pinion_teeth: int = PINION_TEETH) -> None:
     """A recording must hold one SA segment (50 gear revolutions) at this speed."""
-    if not (0 < speed <= 1000):
-        raise GearshotError(f"--speed must lie in (0, 1000] rps; got {speed!r}")
+    check_speed(speed, "--speed")
     if not (0 < duration <= MAX_DURATION):
         raise GearshotError(f"{option} must lie in (0, {MAX_DURATION:g}] s; got {duration!r}")
     revs = duration * speed * pinion_teeth / gear_teeth
@@ -107,6 +107,37 @@ def _check_duration(duration: float, speed: float, *, option: str = "--duration"
             f"{option} {duration:g} s holds {revs:.3g} gear revolution(s) at --speed "
             f"{speed:g} rps; one SA segment needs {SEGMENT_REVOLUTIONS} "
             f"(--duration >= {need:.3g} s)")
+
+
+def _check_condition(speeds, loads) -> None:
+    """Physical bounds on the --speed / --load values (rev/s, N m)."""
+    for v in speeds:
+        check_speed(v, "--speed")
+    for v in loads:
+        check_load(v, "--load")
+
+
+def _check_frf_folder(folder: Path | None, *, minimum: int = 1) -> None:
+    """The FRF folder exists and holds at least ``minimum`` readable FRFs (checked now,
+    before any database is built)."""
+    if folder is None:
+        return
+    if not folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(folder)!r} is not a folder")
+    from ..transfer import TransferFunctionBank
+
+    try:
+        bank = TransferFunctionBank.from_folder(folder)
+    except GearshotError as exc:
+        raise GearshotError(f"--frf-folder: {exc}") from None
+    if len(bank) < minimum:
+        raise GearshotError(f"--frf-folder {str(folder)!r} holds {len(bank)} FRF(s); "
+                            f"this needs at least {minimum}")
+
+
+def _check_rig_grade(rig_grade: int | None) -> None:
+    if rig_grade is not None and not 1 <= rig_grade <= 12:
+        raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
 
 
 def _check_count(value: int, option: str, *, minimum: int = 0,
@@ -217,6 +248,7 @@ def simulate(
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
+    _check_condition(speed, load)
     if machine is not None:
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
@@ -287,9 +319,10 @@ def rig(
                                             "surface grade (default: hidden, drawn)."),
 ) -> None:
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder)
     _check_duration(duration, speed)
+    _check_condition([speed], [load])
+    _check_rig_grade(rig_grade)
     _check_count(healthy, "--healthy")
     _check_count(repetitions, "--repetitions")
     _early(folder, "FOLDER", folder=True)
@@ -306,8 +339,7 @@ def _make_rig(seed, frf_folder, rig_grade):
     if frf_folder is not None:
         kwargs["tf_bank"] = str(frf_folder)
     if rig_grade is not None:
-        if not 1 <= rig_grade <= 12:
-            raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
+        _check_rig_grade(rig_grade)
         kwargs["grade"] = rig_grade
     return VirtualRig(seed=seed, **kwargs)
 
@@ -338,8 +370,11 @@ def experiment_simulated(
     workers: int = typer.Option(2, "--workers", help=HELP_WORKERS),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder, minimum=2)      # one held out for selection, one to test
+    if not full:
+        _check_condition(speed, load)
+    if not 1 <= grade <= 12:
+        raise GearshotError(f"--grade must be 1 … 12; got {grade}")
     _early(json_out, "--json")
     _early(out, "--out", folder=True)
     _early(store, "--store", folder=True)
@@ -410,9 +445,11 @@ def experiment_rig(
                                 "own twin (steps 1 and 6). --no-paired: the old layout."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder)
     _check_duration(duration, speed)
+    _check_condition([speed], [load])
+    _check_rig_grade(rig_grade)
+    _check_count(seed, "--seed", maximum=2**32 - 1)
     _check_count(repeats, "--repeats", minimum=1, maximum=1000)
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
@@ -642,6 +679,10 @@ def predict(
                                           "it the recording is refused)."),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    if out.suffix.lower() not in (".csv", ".json"):
+        raise GearshotError(f"--out {str(out)!r} must end in .csv or .json (the formats "
+                            f"predict writes); got suffix {out.suffix!r}")
+    _check_count(seed, "--seed", maximum=2**32 - 1)
     from .files import expand_recordings
 
     _early(out, "--out")
@@ -767,6 +808,11 @@ def report(
     typer.echo(f"report: {path}")
 
 
+def _one_line(exc: object) -> str:
+    """A message on one line (libraries' messages may span several)."""
+    return " ".join(str(exc).split())
+
+
 def _usage_line(exc) -> str:
     """A click usage error as one line, naming the command and where its help is."""
     text = " ".join(str(exc.format_message()).split())
@@ -783,15 +829,16 @@ def main() -> None:
         app(args=spread_file_options(sys.argv[1:]), prog_name="gearshot",
             standalone_mode=False)
     except GearshotError as exc:
-        typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
+        typer.secho(f"gearshot: error: {_one_line(exc)}", err=True, fg="red")
         sys.exit(2)
     except OSError as exc:  # disk full, file too large, permission, missing file
         where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
-        typer.secho(f"gearshot: error:{where} {os_error_text(exc)}", err=True, fg="red")
+        typer.secho(f"gearshot: error:{where} {_one_line(os_error_text(exc))}", err=True,
+                    fg="red")
         sys.exit(1)
     except MemoryError:
-        typer.secho("gearshot: error: out of memory; try smaller sizes (counts, --duration)",
-                    err=True, fg="red")
+        typer.secho("gearshot: error: out of memory; try fewer or shorter signals (smaller "
+                    "counts or sizes)", err=True, fg="red")
         sys.exit(1)
     except KeyboardInterrupt:
         typer.secho("gearshot: interrupted", err=True)

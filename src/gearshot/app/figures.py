@@ -132,9 +132,22 @@ def report_from_json(path, out) -> Path:
         raise GearshotError(f"results file {str(path)!r} does not exist")
     try:
         payload = json.loads(path.read_text())
-        rows = pd.DataFrame(payload["rows"])
-    except (ValueError, KeyError) as exc:
+    except (ValueError, UnicodeDecodeError) as exc:
         raise GearshotError(f"{str(path)!r} is not a gearshot results JSON ({exc})") from None
+    rows = payload.get("rows") if isinstance(payload, dict) else None
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        raise GearshotError(f"{str(path)!r} is not a gearshot results JSON: it needs an "
+                            f"object with 'rows', a non-empty list of objects (as written "
+                            f"by --json)")
+    need = {"variant", "mae"} | ({"speed", "load", "tf", "attenuation_db"}
+                                 if payload.get("experiment") == "simulated" else set())
+    missing = sorted(need - set().union(*rows))
+    if missing:
+        raise GearshotError(f"{str(path)!r}: its rows lack the key(s) {missing} (not a "
+                            f"results JSON written by --json)")
+    rows = pd.DataFrame(rows)
+    if not np.issubdtype(rows["mae"].dtype, np.number):
+        raise GearshotError(f"{str(path)!r}: its rows' 'mae' values are not numbers")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if payload.get("experiment") == "simulated":

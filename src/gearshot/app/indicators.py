@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 
 __all__ = ["shaft_indicators", "record_indicators", "indicator_table", "indicator_figures",
@@ -232,7 +233,6 @@ def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
     one marker per remaining condition; the unit on the axis. Written atomically."""
     from matplotlib.figure import Figure
 
-    from .._atomic import atomic_path
 
     table = indicator_table(payload)
     units = payload.get("units", {}).get("indicators", {})

@@ -1105,15 +1105,19 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
 
     # ------------------------------------------------------------------ persistence
     def save(self, path: str | Any) -> None:
-        """Save the fitted estimator (joblib) with version metadata, atomically."""
+        """Save the fitted estimator (skops format: loading it runs no code) with version
+        metadata, atomically."""
         from .persistence import save_estimator
 
         save_estimator(self, path)
 
     @classmethod
-    def load(cls, path: str | Any) -> OneFaultShotEstimator:
-        """Load an estimator saved by :meth:`save`."""
+    def load(cls, path: str | Any, *, trusted: bool = False) -> OneFaultShotEstimator:
+        """Load an estimator saved by :meth:`save`; a file that would construct other types
+        than an estimator's, or an old joblib pickle, needs ``trusted=True`` (which runs
+        the file's code: only for files you made; see
+        :func:`gearshot.estimator.persistence.load_estimator`)."""
         from .persistence import load_estimator
 
-        loaded: OneFaultShotEstimator = load_estimator(path)
+        loaded: OneFaultShotEstimator = load_estimator(path, trusted=trusted)
         return loaded

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 from .._validation import check_int
 from ..paper import (
@@ -183,7 +184,8 @@ def _rig_segments(rig: FamilyRig, paths, cache_dir: Path, campaign: dict):
     """
     from ..rig import VirtualRig
 
-    tag = _hash(dict(rig=asdict(rig), campaign=campaign, paths=[p.name for p in paths]))
+    tag = _hash(dict(rig=asdict(rig), campaign=campaign,
+                     paths=[[p.name, _tf_digest(p)] for p in paths]))
     file = cache_dir / f"rig-{rig.seed}-{tag}.npz"
     jobs = ([(0.0, r) for r in range(campaign["healthy"])]
             + [(float(y), r) for y in campaign["sizes"] for r in range(campaign["repetitions"])])
@@ -202,10 +204,8 @@ def _rig_segments(rig: FamilyRig, paths, cache_dir: Path, campaign: dict):
                 arrays[f"long__{key}"] = rec.angle_domain(
                     gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
                     samples_per_cycle=SAMPLES_PER_CYCLE).astype(np.float32)
-        cache_dir.mkdir(parents=True, exist_ok=True)
-        tmp = file.with_suffix(".tmp.npz")
-        np.savez(tmp, **arrays)
-        tmp.replace(file)
+        with atomic_path(file, make_parents=True) as tmp:   # a unique temporary name
+            np.savez(tmp, **arrays)
     with np.load(file) as data:
         segments = {k: (data[f"sa__{k}"].astype(float),
                         data[f"long__{k}"].astype(float) if f"long__{k}" in data else None)
@@ -222,6 +222,15 @@ def _duration(campaign, speed):
         return float(campaign["duration"])
     gear_revs_per_s = speed * PINION_TEETH / GEAR_TEETH
     return 1.02 * (campaign["segments"] * CYCLES_PER_SEGMENT + 1) / gear_revs_per_s
+
+
+def _tf_digest(tf) -> str:
+    """Content hash of a transfer function (its frequencies and values), not its name."""
+    h = hashlib.sha256()
+    for arr in (tf.freqs, tf.values):
+        a = np.ascontiguousarray(arr)
+        h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
+    return h.hexdigest()[:16]
 
 
 def _hash(obj) -> str:

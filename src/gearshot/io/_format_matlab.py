@@ -23,6 +23,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from ._fileio import FS_NAMES, RawFile, atomic_path
+from ._format_hdf5 import check_extent
 
 if TYPE_CHECKING:
     import h5py
@@ -108,6 +109,7 @@ def read_mat(path: Path) -> RawFile:
         with h5py.File(path, "r") as f:
             for name, obj in f.items():
                 if isinstance(obj, h5py.Dataset) and not name.startswith("#"):
+                    check_extent(path, obj)
                     variables[name] = _read_v73_dataset(obj)
         return _collect(path, variables)
     variables = scipy.io.loadmat(path, squeeze_me=True, chars_as_strings=True)

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int, check_positive, describe
+from .._validation import MAX_FS, as_signal_array, check_int, check_positive, describe
 from ..signal.angle import TACHO_SHAFTS, check_pulse_train, uniform_cycle_times
 from ._fileio import METADATA_KEYS, RawFile, reconcile_fs, select_channels
 from ._format_csv import read_csv, write_csv
@@ -124,6 +124,8 @@ class Recording:
                                     f"({acc.shape[-1]}); got {tac.size}")
             set_(self, "tacho", tac)
         set_(self, "fs", check_positive(self.fs, "fs"))
+        if self.fs > MAX_FS:
+            raise GearshotError(f"fs must be <= {MAX_FS:g} Hz; got {self.fs:g}")
         set_(self, "speed", _opt_float(self.speed, "speed"))
         if self.speed is not None and self.speed <= 0:
             raise GearshotError(f"speed must be > 0 rev/s; got {self.speed}")
@@ -245,7 +247,7 @@ class Recording:
             reader = {"hdf5": read_hdf5, "mat": read_mat, "wav": read_wav, "csv": read_csv,
                       "text": read_text, "tdms": read_tdms}[fmt]
         try:
-            raw: RawFile = reader(path)
+            raw: RawFile = _bounded_read(reader, path)
         except GearshotError:
             raise
         except Exception as exc:  # corrupt / truncated / not this format
@@ -724,6 +726,40 @@ class Recording:
         seg_len = per * samples_per_cycle
         blocks = x[..., : n_seg * seg_len].reshape(*x.shape[:-1], n_seg, seg_len)
         return np.asarray(synchronous_average(blocks, samples_per_cycle, n_cycles=per))
+
+
+#: Seconds a file read may take: this plus one per MB of file (a damaged file fails within
+#: it; a healthy one reads at far more than 1 MB/s).
+READ_BUDGET_S = 20.0
+
+
+def _bounded_read(reader: Any, path: Path) -> RawFile:
+    """Run ``reader(path)`` in a worker thread; the caller waits in short, interruptible
+    steps (Ctrl-C is honoured at once) and gives up with a :class:`GearshotError` after
+    :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file)."""
+    import threading
+    import time
+
+    budget = READ_BUDGET_S + path.stat().st_size / 1e6
+    box: dict[str, Any] = {}
+
+    def work() -> None:
+        try:
+            box["raw"] = reader(path)
+        except BaseException as exc:  # handed to the caller
+            box["exc"] = exc
+
+    worker = threading.Thread(target=work, name=f"gearshot-read-{path.name}", daemon=True)
+    worker.start()
+    deadline = time.monotonic() + budget
+    while worker.is_alive() and time.monotonic() < deadline:
+        worker.join(0.1)
+    if worker.is_alive():
+        raise GearshotError(f"reading {str(path)!r} did not finish within {budget:.0f} s: "
+                            f"a damaged file (or a stalled disk)")
+    if "exc" in box:
+        raise box["exc"]
+    return box["raw"]
 
 
 def _machine_channels(raw: RawFile, machine: Any

@@ -39,7 +39,7 @@ import pandas as pd
 
 from .._atomic import atomic_path, check_writable, staging_dir
 from .._errors import GearshotError
-from .._validation import check_in_range, check_int, check_positive
+from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
 from ..paper import GEAR_TEETH, PINION_TEETH, TABLE1_SIZES
 from ..signal.level import rms
@@ -210,8 +210,8 @@ class VirtualRig:
             Acceleration in g, the input-shaft tacho, metadata (no hidden parameters).
         """
         reality, fir, _ = self._build()
-        speed = check_positive(speed, "speed")
-        load = check_positive(load, "load")
+        speed = check_speed(speed)
+        load = check_load(load)
         fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
         duration = check_positive(duration, "duration")
         repetition = check_int(repetition, "repetition", minimum=0)
@@ -292,8 +292,8 @@ class VirtualRig:
             one row per recording of this condition.
         """
         folder = Path(folder)
-        speed = check_positive(speed, "speed")
-        load = check_positive(load, "load")
+        speed = check_speed(speed)
+        load = check_load(load)
         healthy = check_int(healthy, "healthy", minimum=0)
         repetitions = check_int(repetitions, "repetitions", minimum=0)
         sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]

@@ -115,15 +115,30 @@ def mesh_band_orders(n_points: int, mesh_order: MeshOrders, n_sidebands: int) ->
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
-        return cast(IntArray, np.unique(np.concatenate([
+        return _unique_orders(np.concatenate([
             mesh_band_orders(n_points, m, n_sidebands)
-            for m in check_mesh_orders(mesh_order, n_points)])))
+            for m in check_mesh_orders(mesh_order, n_points)]), n_points)
     order = check_mesh_order(mesh_order, n_points)
     k = np.arange(1, (n_points // 2) // order + 1)
-    s = np.arange(-n_sidebands, n_sidebands + 1)
-    idx = (k[:, None] * order + s[None, :]).ravel() % n_points
-    folded = np.minimum(idx, n_points - idx)
-    return cast(IntArray, np.unique(folded))
+    width = 2 * n_sidebands + 1
+    if width >= n_points:
+        return cast(IntArray, np.arange(n_points // 2 + 1))   # every order is in a band
+    else:   # the union of the bands k*m ± n_sidebands (mod n_points), in O(n_points) memory
+        diff = np.zeros(n_points + 1, dtype=np.int64)
+        lo = (k * order - n_sidebands) % n_points
+        hi = lo + width
+        wrap = hi > n_points
+        np.add.at(diff, lo, 1)
+        np.add.at(diff, np.minimum(hi, n_points), -1)
+        np.add.at(diff, np.zeros(int(wrap.sum()), dtype=np.int64), 1)
+        np.add.at(diff, hi[wrap] - n_points, -1)
+        idx = np.flatnonzero(np.cumsum(diff[:-1]) > 0)
+    return _unique_orders(np.minimum(idx, n_points - idx), n_points)
+
+
+def _unique_orders(orders: IntArray, n_points: int) -> IntArray:
+    """Sorted distinct orders in ``0 … n_points//2`` (a count, not a hash: linear time)."""
+    return cast(IntArray, np.flatnonzero(np.bincount(orders, minlength=n_points // 2 + 1)))
 
 
 def order_mask(n_points: int, mesh_order: MeshOrders, *, n_sidebands: int = 2) -> BoolArray:

@@ -20,12 +20,12 @@ def read_block(path: Path):
 
     Every file of the checksum list is read into memory once, its size and CRC-32
     checked on those bytes, and the block decoded from them (a zarr memory store); a
-    block from before checksum lists is decoded from disk and checked for holes."""
+    block without a checksum list is an error (it is rebuilt by the next build)."""
     import xarray as xr
     import zarr.storage
     from zarr.core.buffer import default_buffer_prototype
 
-    from .database import _ATTR, _ROOT, _legacy_block_problem
+    from .database import _ATTR, _ROOT
 
     try:
         root = (path / _ROOT).read_bytes()
@@ -36,11 +36,8 @@ def read_block(path: Path):
         return None, f"its metadata file {_ROOT!r} is missing"
     except (OSError, ValueError) as exc:
         return None, f"its metadata file {_ROOT!r} is unreadable ({exc})"
-    if not record:
-        problem = _legacy_block_problem(path)
-        if problem is not None:
-            return None, problem
-        return xr.open_zarr(path, consolidated=False).load(), None
+    if not record:     # never decoded unchecked (issue #22): rebuilt by the next build
+        return None, f"its checksum list (attribute {_ATTR!r}) is missing"
     files = record.get("files")
     if not isinstance(files, dict) or not files:
         return None, f"its checksum list (attribute {_ATTR!r}) is damaged"
