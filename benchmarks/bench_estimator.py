@@ -40,7 +40,8 @@ def main():
     times = []
     for r in range(args.repeat):
         t0 = time.perf_counter()
-        est = OneFaultShotEstimator(random_state=r).fit(*ds.fit_args(db), selection_tf=sel)
+        est = OneFaultShotEstimator(random_state=r).fit(*ds.fit_args(db), selection_tf=sel,
+                                                        **ds.fit_kwargs())
         pred = est.predict(ds.test_sa)
         times.append(time.perf_counter() - t0)
     print(f"load average: {os.getloadavg()}")

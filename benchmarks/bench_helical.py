@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gearshot.paper import GEAR_TEETH, PINION_TEETH
 from gearshot.signal import difference_signal
 from gearshot.sim import (
     GearPair,
@@ -34,7 +35,7 @@ REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "bgu_fault_
 
 
 def _diff_rms(sa):
-    return np.sqrt(np.mean(difference_signal(sa, 38, n_sidebands=2) ** 2, axis=-1))
+    return np.sqrt(np.mean(difference_signal(sa, GEAR_TEETH, n_sidebands=2) ** 2, axis=-1))
 
 
 def per_sa_ms(pair, batch=64, fault_type="ftff", repeats=3):
@@ -92,7 +93,7 @@ def main():
     if args.growth:
         growth(spur)
         return
-    theta = np.linspace(0, 2 * np.pi * 38 / 17, 20000, endpoint=False)
+    theta = np.linspace(0, 2 * np.pi * GEAR_TEETH / PINION_TEETH, 20000, endpoint=False)
     print("mesh stiffness: mean, (max-min)/mean, ISO 6336-1 c_gamma_alpha")
     for name, p in (("spur", spur), ("helical 20 deg", hel)):
         k = mesh_stiffness(p, theta)

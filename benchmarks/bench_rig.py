@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from gearshot.io import Recording
+from gearshot.paper import GEAR_TEETH, PINION_TEETH
 from gearshot.rig import VirtualRig
 
 
@@ -43,7 +44,7 @@ def main() -> None:
                      duration=args.duration)
     t_one = time.perf_counter() - t0
     t0 = time.perf_counter()
-    sa = rec.to_sa_segments(gear_teeth=38, pinion_teeth=17)
+    sa = rec.to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH)
     t_sa = time.perf_counter() - t0
     print(f"one recording: {t_one:.2f} s; to_sa_segments: {t_sa:.2f} s -> {sa.shape}")
 

@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from gearshot import features, signal, transfer
+from gearshot.paper import GEAR_TEETH
 
 
 def best_of(func, repeat=3):
@@ -39,9 +40,9 @@ def main():
 
     rows = [
         ("features, 10,000 SAs x 2048 (paper's four)", "< 2 s",
-         best_of(lambda: features.extract_features(sa, 38))),
+         best_of(lambda: features.extract_features(sa, GEAR_TEETH))),
         ("features, 10,000 SAs x 2048 (all ten)", "-",
-         best_of(lambda: features.extract_features(sa, 38,
+         best_of(lambda: features.extract_features(sa, GEAR_TEETH,
                                                    names=features.available_features()))),
         ("TF estimate, 60 s at 50 kHz (3e6 samples)", "< 1 s",
          best_of(lambda: transfer.estimate_transfer_function(x, 2048))),

@@ -18,6 +18,7 @@ import numpy as np
 
 from gearshot import Machine
 from gearshot.io import Recording
+from gearshot.paper import GEAR_TEETH, PINION_TEETH
 from gearshot.rig import VirtualRig
 from gearshot.signal import angular_resample, pulse_times, synchronous_average
 from gearshot.signal.trains import shaft_cycle_times
@@ -53,8 +54,9 @@ def analytic():
 
 def rig():
     rec = VirtualRig(seed=0).record(speed=15.0, load=10.0, duration=20.0)
-    on = rec.to_sa_segments(gear_teeth=38, pinion_teeth=17)
-    off = rec.to_sa_segments(gear_teeth=38, pinion_teeth=17, antialias=False)
+    on = rec.to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH)
+    off = rec.to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                              antialias=False)
     print(f"virtual rig 15 rps: orders < 0.9 Nyquist change by {below(on, off):.2%} "
           f"(fs {rec.fs:g} Hz, angular Nyquist {1024 * 15 * 17 / 38:.0f} Hz)")
 

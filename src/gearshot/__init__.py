@@ -26,6 +26,8 @@ Subpackages (imported on first use):
     Figures.
 ``gearshot.app``
     The ``gearshot`` command line, the demo and report writing.
+``gearshot.paper``
+    The paper's constants (gear pair 17/38, Table-1 fault sizes, speeds, loads).
 
 :class:`gearshot.Machine` describes a real gearbox (gear train, tacho, sensors, file
 layout, monitored gear) and is read from TOML.
@@ -46,7 +48,7 @@ except PackageNotFoundError:  # running from a source tree
     __version__ = "0.0.0+unknown"
 
 _SUBMODULES = {"signal", "features", "transfer", "sim", "io", "rig", "estimator",
-               "experiments", "plotting", "app"}
+               "experiments", "plotting", "app", "paper"}
 
 __all__ = ["GearshotError", "Machine", "data_home", "__version__", *sorted(_SUBMODULES)]
 

@@ -25,17 +25,20 @@ Moment ratios of signals whose RMS is below ``1e-10`` are 0 (the reference's con
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from functools import cached_property
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 import scipy.fft
+from numpy.typing import ArrayLike
 
 from ._errors import GearshotError
+from ._typing import ComplexArray, FloatArray, IntArray
 from ._validation import as_signal_array, check_int, check_positive, describe, finite_result
 from .signal.level import rms as _rms
-from .signal.orders import check_mesh_orders, mesh_band_orders
+from .signal.orders import MeshOrders, check_mesh_orders, mesh_band_orders
 
 __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features",
            "na4_baseline_variance"]
@@ -49,46 +52,50 @@ _WORKERS = None  # scipy.fft threads: one (Dask workers parallelize across proce
 class _Parts:
     """Lazily computed decompositions of a batch of SAs, shared between features."""
 
-    def __init__(self, sa, mesh_order, n_sidebands, baseline_variance,
-                 shaft_orders=_SHAFT_ORDERS):
+    def __init__(self, sa: FloatArray, mesh_order: int | tuple[int, ...], n_sidebands: int,
+                 baseline_variance: float | None,
+                 shaft_orders: Sequence[int] = _SHAFT_ORDERS) -> None:
         self.sa = sa
         self.n = sa.shape[-1]
         self.mesh_orders = tuple(mesh_order) if isinstance(mesh_order, tuple) else (mesh_order,)
-        self.mesh_order = self.mesh_orders if len(self.mesh_orders) > 1 else self.mesh_orders[0]
+        self.mesh_order: int | tuple[int, ...] = (self.mesh_orders if len(self.mesh_orders) > 1
+                                                  else self.mesh_orders[0])
         self.n_sidebands = n_sidebands
         self.baseline_variance = baseline_variance
         self.shaft_orders = tuple(shaft_orders)
 
     @cached_property
-    def spectrum(self):
-        return scipy.fft.rfft(self.sa, axis=-1, workers=_WORKERS)
+    def spectrum(self) -> ComplexArray:
+        return cast(ComplexArray, scipy.fft.rfft(self.sa, axis=-1, workers=_WORKERS))
 
-    def _keep(self, orders, *, invert=False):
+    def _keep(self, orders: IntArray, *, invert: bool = False) -> FloatArray:
         mask = np.zeros(self.n // 2 + 1, dtype=bool)
         mask[orders] = True
         if invert:
             mask = ~mask
-        return scipy.fft.irfft(self.spectrum * mask, n=self.n, axis=-1, workers=_WORKERS)
+        return cast(FloatArray, scipy.fft.irfft(self.spectrum * mask, n=self.n, axis=-1,
+                                                workers=_WORKERS))
 
-    def _mesh(self, n_sidebands):
+    def _mesh(self, n_sidebands: int) -> IntArray:
         return mesh_band_orders(self.n, self.mesh_order, n_sidebands)
 
     @cached_property
-    def diff_spectrum(self):
+    def diff_spectrum(self) -> ComplexArray:
         mask = np.ones(self.n // 2 + 1, dtype=bool)
         mask[self._mesh(self.n_sidebands)] = False
         return self.spectrum * mask
 
     @cached_property
-    def diff(self):
-        return scipy.fft.irfft(self.diff_spectrum, n=self.n, axis=-1, workers=_WORKERS)
+    def diff(self) -> FloatArray:
+        return cast(FloatArray, scipy.fft.irfft(self.diff_spectrum, n=self.n, axis=-1,
+                                                workers=_WORKERS))
 
     @cached_property
-    def rms_diff(self):
-        return np.sqrt(np.mean(self.diff ** 2, axis=-1))
+    def rms_diff(self) -> FloatArray:
+        return cast(FloatArray, np.sqrt(np.mean(self.diff ** 2, axis=-1)))
 
     @cached_property
-    def envelope(self):
+    def envelope(self) -> FloatArray:
         # |analytic signal| (as scipy.signal.hilbert): its real part is the difference
         # signal, its imaginary part the Hilbert transform, the real inverse FFT of
         # -i X_k over 0 < k < n/2 (DC and Nyquist give no imaginary part)
@@ -98,26 +105,27 @@ class _Parts:
         if n % 2 == 0:
             quad[..., n // 2] = 0.0
         hilb = scipy.fft.irfft(quad, n=n, axis=-1, workers=_WORKERS)
-        env = np.hypot(self.diff, hilb)
+        env: FloatArray = np.hypot(self.diff, hilb)
         env -= env.mean(axis=-1, keepdims=True)
         return env
 
     @cached_property
-    def regular_mesh(self):
+    def regular_mesh(self) -> FloatArray:
         return self._keep(self._mesh(1))
 
     @cached_property
-    def zakrajsek_diff(self):
+    def zakrajsek_diff(self) -> FloatArray:
         orders = np.union1d(self._mesh(1), [0, *self.shaft_orders])
         return self._keep(orders, invert=True)
 
     @cached_property
-    def residual(self):
+    def residual(self) -> FloatArray:
         orders = np.union1d(self._mesh(0), [0, *self.shaft_orders])
         return self._keep(orders, invert=True)
 
 
-def _moment_ratio(x, order, *, variance=None):
+def _moment_ratio(x: FloatArray, order: int, *,
+                  variance: float | FloatArray | None = None) -> FloatArray:
     """Biased normalized central moment ``mean(m^order) / var^(order/2)``; 0 if RMS tiny."""
     centred = x - x.mean(axis=-1, keepdims=True)
     square = centred * centred
@@ -130,42 +138,43 @@ def _moment_ratio(x, order, *, variance=None):
     small = np.sqrt(own_var) < _TINY_RMS
     with np.errstate(divide="ignore", invalid="ignore"):
         out = num / var ** (order / 2)
-    return np.where(small, 0.0, out)
+    return cast(FloatArray, np.where(small, 0.0, out))
 
 
-_REGISTRY: dict[str, Callable[[_Parts], np.ndarray]] = {}
+_Feature = Callable[[_Parts], FloatArray]
+_REGISTRY: dict[str, _Feature] = {}
 
 
-def _register(name):
-    def deco(func):
+def _register(name: str) -> Callable[[_Feature], _Feature]:
+    def deco(func: _Feature) -> _Feature:
         _REGISTRY[name] = func
         return func
     return deco
 
 
 @_register("rms_diff")
-def _rms_diff(p):
+def _rms_diff(p: _Parts) -> FloatArray:
     return p.rms_diff
 
 
 @_register("kurtosis_diff")
-def _kurtosis_diff(p):
-    return np.where(p.rms_diff < _TINY_RMS, 0.0, _moment_ratio(p.diff, 4))
+def _kurtosis_diff(p: _Parts) -> FloatArray:
+    return cast(FloatArray, np.where(p.rms_diff < _TINY_RMS, 0.0, _moment_ratio(p.diff, 4)))
 
 
 @_register("rms_env_diff")
-def _rms_env_diff(p):
+def _rms_env_diff(p: _Parts) -> FloatArray:
     return _rms(p.envelope)
 
 
 @_register("skewness_env_diff")
-def _skewness_env_diff(p):
+def _skewness_env_diff(p: _Parts) -> FloatArray:
     skew = _moment_ratio(p.envelope, 3)
-    return np.where(p.rms_diff < _TINY_RMS, 0.0, skew)
+    return cast(FloatArray, np.where(p.rms_diff < _TINY_RMS, 0.0, skew))
 
 
 @_register("fm0")
-def _fm0(p):
+def _fm0(p: _Parts) -> FloatArray:
     harmonics = np.unique(np.concatenate([np.arange(1, (p.n // 2) // m + 1) * m
                                           for m in p.mesh_orders]))
     amp = 2.0 * np.abs(p.spectrum[..., harmonics]) / p.n
@@ -173,34 +182,34 @@ def _fm0(p):
     total = amp.sum(axis=-1)
     ptp = np.ptp(p.sa, axis=-1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(total < _TINY_RMS, 0.0, ptp / total)
+        return cast(FloatArray, np.where(total < _TINY_RMS, 0.0, ptp / total))
 
 
 @_register("fm4")
-def _fm4(p):
+def _fm4(p: _Parts) -> FloatArray:
     return _moment_ratio(p.zakrajsek_diff, 4)
 
 
 @_register("m6a")
-def _m6a(p):
+def _m6a(p: _Parts) -> FloatArray:
     return _moment_ratio(p.zakrajsek_diff, 6)
 
 
 @_register("m8a")
-def _m8a(p):
+def _m8a(p: _Parts) -> FloatArray:
     return _moment_ratio(p.zakrajsek_diff, 8)
 
 
 @_register("na4")
-def _na4(p):
+def _na4(p: _Parts) -> FloatArray:
     return _moment_ratio(p.residual, 4, variance=p.baseline_variance)
 
 
 @_register("er")
-def _er(p):
+def _er(p: _Parts) -> FloatArray:
     den = _rms(p.regular_mesh)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(den < _TINY_RMS, 0.0, _rms(p.zakrajsek_diff) / den)
+        return cast(FloatArray, np.where(den < _TINY_RMS, 0.0, _rms(p.zakrajsek_diff) / den))
 
 
 FEATURES = MappingProxyType(_REGISTRY)
@@ -208,32 +217,41 @@ FEATURES = MappingProxyType(_REGISTRY)
 
 
 def available_features() -> tuple[str, ...]:
-    """Names of every registered feature, in registry order."""
+    """Names of every registered feature, in registry order.
+
+    Examples
+    --------
+    >>> from gearshot.features import available_features
+    >>> available_features()[:4]    # the paper's four come first
+    ('rms_diff', 'kurtosis_diff', 'rms_env_diff', 'skewness_env_diff')
+    >>> len(available_features())
+    10
+    """
     return tuple(_REGISTRY)
 
 
-def _check_names(names):
+def _check_names(names: str | Iterable[str] | None) -> tuple[str, ...]:
     if names is None:
         return PAPER_FEATURES
     if isinstance(names, str):
         names = (names,)
     try:
-        names = tuple(names)
+        listed = tuple(names)
     except TypeError:
         raise GearshotError(f"names must be a feature name or a sequence of them; got "
                             f"{describe(names)}") from None
-    if not all(isinstance(n, str) for n in names):
+    if not all(isinstance(n, str) for n in listed):
         raise GearshotError(f"names must be feature names (str); got {describe(names)}")
-    if not names:
+    if not listed:
         raise GearshotError("names must list at least one feature; got an empty list")
-    unknown = [n for n in names if n not in _REGISTRY]
+    unknown = [n for n in listed if n not in _REGISTRY]
     if unknown:
         raise GearshotError(
             f"unknown feature name(s) {unknown}; valid names are {list(_REGISTRY)}")
-    return names
+    return listed
 
 
-def _check_shaft_orders(shaft_orders, n):
+def _check_shaft_orders(shaft_orders: Iterable[int], n: int) -> tuple[int, ...]:
     if isinstance(shaft_orders, (int, np.integer)) or shaft_orders is None:
         raise GearshotError(f"shaft_orders must be a sequence of integers (may be empty); got "
                             f"{shaft_orders!r}")
@@ -244,13 +262,14 @@ def _check_shaft_orders(shaft_orders, n):
     return out
 
 
-def _mesh_arg(mesh_order, n):
+def _mesh_arg(mesh_order: MeshOrders, n: int) -> int | tuple[int, ...]:
     orders = check_mesh_orders(mesh_order, n)
     return orders if len(orders) > 1 else orders[0]
 
 
 @finite_result
-def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS) -> float:
+def na4_baseline_variance(healthy_sa: ArrayLike, mesh_order: MeshOrders, *,
+                          shaft_orders: Sequence[int] = _SHAFT_ORDERS) -> float:
     """Mean variance of the residual signal of healthy SAs: NA4's baseline.
 
     Parameters
@@ -264,18 +283,33 @@ def na4_baseline_variance(healthy_sa, mesh_order, *, shaft_orders=_SHAFT_ORDERS)
     Returns
     -------
     float
+
+    Examples
+    --------
+    Healthy SAs of a 38-tooth mesh with shaft orders 1 and 5: shaft orders 1–2 and the
+    mesh go, the order-5 component (amplitude 0.1, variance 0.005) is the residual.
+
+    >>> import numpy as np
+    >>> from gearshot.features import na4_baseline_variance
+    >>> theta = np.arange(2048) / 2048
+    >>> healthy = (np.cos(2 * np.pi * 38 * theta) + 0.3 * np.cos(2 * np.pi * theta)
+    ...            + 0.1 * np.cos(2 * np.pi * 5 * theta))
+    >>> print(round(na4_baseline_variance(np.vstack([healthy, healthy]), 38), 6))
+    0.005
     """
     sa = as_signal_array(healthy_sa, "healthy_sa", min_length=4)
-    mesh_order = _mesh_arg(mesh_order, sa.shape[-1])
-    shaft_orders = _check_shaft_orders(shaft_orders, sa.shape[-1])
-    residual = _Parts(sa, mesh_order, 0, None, shaft_orders).residual
+    orders = _mesh_arg(mesh_order, sa.shape[-1])
+    shafts = _check_shaft_orders(shaft_orders, sa.shape[-1])
+    residual = _Parts(sa, orders, 0, None, shafts).residual
     centred = residual - residual.mean(axis=-1, keepdims=True)
     return float(np.mean(centred ** 2))
 
 
 @finite_result
-def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_variance=None,
-                     shaft_orders=_SHAFT_ORDERS) -> np.ndarray:
+def extract_features(sa: ArrayLike, mesh_order: MeshOrders, *,
+                     names: str | Iterable[str] | None = None, n_sidebands: int = 2,
+                     baseline_variance: float | None = None,
+                     shaft_orders: Sequence[int] = _SHAFT_ORDERS) -> FloatArray:
     """Condition indicators of synchronous averages.
 
     Parameters
@@ -301,13 +335,38 @@ def extract_features(sa, mesh_order, *, names=None, n_sidebands=2, baseline_vari
     -------
     ndarray, shape (..., n_features)
         ``(n_signals, n_features)`` for a 2-D input.
+
+    Examples
+    --------
+    A pure 38-tooth mesh tone and the same tone with one tooth's impact: the mesh leaves
+    nothing in the difference signal (moment ratios of a near-zero signal are 0), the
+    impact is a spike there (kurtosis near the 2048 points of one sample's spike).
+
+    >>> import numpy as np
+    >>> from gearshot.features import PAPER_FEATURES, extract_features
+    >>> theta = np.arange(2048) / 2048
+    >>> mesh = np.cos(2 * np.pi * 38 * theta)
+    >>> impact = np.zeros(2048)
+    >>> impact[1000] = 1.0
+    >>> feats = extract_features(np.vstack([mesh, mesh + impact]), 38)
+    >>> feats.shape
+    (2, 4)
+    >>> for name, healthy, faulty in zip(PAPER_FEATURES, *feats):
+    ...     print(f"{name:18s} {healthy:6.2f} {faulty:9.2f}")
+    rms_diff             0.00      0.02
+    kurtosis_diff        0.00   1561.52
+    rms_env_diff         0.00      0.03
+    skewness_env_diff    0.00     20.95
+    >>> fm0, er = extract_features(mesh + impact, 38, names=["fm0", "er"])
+    >>> print(f"{fm0:.3f} {er:.3f}")
+    1.954 0.030
     """
-    names = _check_names(names)
-    sa = as_signal_array(sa, "sa", min_length=4)
-    mesh_order = _mesh_arg(mesh_order, sa.shape[-1])
-    shaft_orders = _check_shaft_orders(shaft_orders, sa.shape[-1])
-    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=sa.shape[-1])
+    wanted = _check_names(names)
+    x = as_signal_array(sa, "sa", min_length=4)
+    orders = _mesh_arg(mesh_order, x.shape[-1])
+    shafts = _check_shaft_orders(shaft_orders, x.shape[-1])
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=x.shape[-1])
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
-    parts = _Parts(sa, mesh_order, n_sidebands, baseline_variance, shaft_orders)
-    return np.stack([_REGISTRY[name](parts) for name in names], axis=-1)
+    parts = _Parts(x, orders, n_sidebands, baseline_variance, shafts)
+    return np.stack([_REGISTRY[name](parts) for name in wanted], axis=-1)

@@ -638,13 +638,17 @@ class Machine:
     def paper(cls) -> Machine:
         """The rig of Matania et al. (2023): 17 -> 38 teeth, tacho once per input
         revolution, one accelerometer in g, 50-cycle segments of the output shaft."""
-        stage = GearStage("input", 17, "output", 38, module=3e-3, face_width=15e-3,
-                          pressure_angle=math.radians(20.0))
+        from . import paper
+
+        stage = GearStage("input", paper.PINION_TEETH, "output", paper.GEAR_TEETH,
+                          module=paper.MODULE, face_width=paper.FACE_WIDTH,
+                          pressure_angle=math.radians(paper.PRESSURE_ANGLE_DEG))
         return cls(name="Matania et al. (2023) rig", shafts=("input", "output"),
                    stages=(stage,), tacho=Tacho("tacho", "input", 1),
                    sensors=(Sensor("acceleration", "acceleration", 1.0, "g"),),
-                   layout=None, monitored=MonitoredGear("output", 38),
-                   samples_per_cycle=2048, cycles_per_segment=50)
+                   layout=None, monitored=MonitoredGear("output", paper.GEAR_TEETH),
+                   samples_per_cycle=paper.SAMPLES_PER_CYCLE,
+                   cycles_per_segment=paper.CYCLES_PER_SEGMENT)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Machine:

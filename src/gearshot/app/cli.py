@@ -15,6 +15,14 @@ from .. import __version__
 from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
 from .._validation import check_load, check_speed
+from ..paper import (
+    CYCLES_PER_SEGMENT,
+    GEAR_TEETH,
+    PAPER_LOADS,
+    PAPER_SPEEDS,
+    PINION_TEETH,
+    TABLE1_SIZES,
+)
 
 app = typer.Typer(
     name="gearshot",
@@ -32,9 +40,6 @@ HELP_N_FAULTY = ("Simulated faulty signals per grade and condition (sizes drawn 
                  "in (0, 1]).")
 HELP_SCHEDULER = "Address of a running Dask scheduler (default: a LocalCluster of --workers)."
 HELP_WORKERS = "LocalCluster workers when no --scheduler is given."
-
-PAPER_SPEEDS = [float(s) for s in range(10, 36)]
-PAPER_LOADS = [5.0, 10.0, 15.0, 20.0]
 
 
 def _version_callback(value: bool) -> None:
@@ -83,13 +88,14 @@ def _early(path: Path | None, option: str, *, folder: bool = False) -> None:
 
 
 #: Gear revolutions averaged per SA segment by the experiments and ``predict`` (the paper's 50)
-SEGMENT_REVOLUTIONS = 50
+SEGMENT_REVOLUTIONS = CYCLES_PER_SEGMENT
 MAX_DURATION = 1200.0   # s per recording (60 s in the paper)
 MAX_COUNT = 10_000      # recordings per campaign size / simulated signals are bounded below
 
 
 def _check_duration(duration: float, speed: float, *, option: str = "--duration",
-                    gear_teeth: int = 38, pinion_teeth: int = 17) -> None:
+                    gear_teeth: int = GEAR_TEETH,
+                    pinion_teeth: int = PINION_TEETH) -> None:
     """A recording must hold one SA segment (50 gear revolutions) at this speed."""
     check_speed(speed, "--speed")
     if not (0 < duration <= MAX_DURATION):
@@ -304,7 +310,7 @@ def rig(
     load: float = typer.Option(10.0, "--load", help="Load torque of the rig, N m."),
     duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
     healthy: int = typer.Option(6, "--healthy", help="Number of healthy recordings."),
-    size: list[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
+    size: list[float] = typer.Option(list(TABLE1_SIZES), "--size", help="Fault size(s)."),
     repetitions: int = typer.Option(6, "--repetitions", help="Recordings per fault size."),
     seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
@@ -473,7 +479,7 @@ def experiment_rig(
     inputs: dict[str, Any] = {"seed": seed, "speed": speed, "load": load, "rig_grade": rig_grade,
               "attenuation_db": attenuation_db, "duration": duration,
               "frf_sha256": _folder_digest(frf_folder), "healthy": 6,
-              "sizes": [0.32, 0.56, 0.66], "repetitions": 6, "fs": 50_000.0}
+              "sizes": list(TABLE1_SIZES), "repetitions": 6, "fs": 50_000.0}
 
     def record(folder: Path) -> None:
         rig_obj = _make_rig(seed, frf_folder, rig_grade)
@@ -647,10 +653,13 @@ def predict(
                              "or (by suffix .json) JSON; one row per SA segment with its "
                              "role, estimate and interval."),
     coverage: float = typer.Option(0.9, "--coverage", help="Prediction-interval coverage."),
-    gear_teeth: int = typer.Option(38, "--gear-teeth", help="Without --machine: teeth of "
-                                   "the monitored (faulty) gear."),
-    pinion_teeth: int = typer.Option(17, "--pinion-teeth", help="Without --machine: teeth "
-                                     "of its pinion (whose speed is --speed)."),
+    gear_teeth: int | None = typer.Option(None, "--gear-teeth", help="Without --machine: "
+                                          "teeth of the monitored (faulty) gear, whose "
+                                          "revolution is the SA cycle (default: the "
+                                          "database's gear pair; another count is refused)."),
+    pinion_teeth: int | None = typer.Option(None, "--pinion-teeth", help="Without --machine: "
+                                            "teeth of its pinion, whose speed is --speed "
+                                            "(default: the database's)."),
     seed: int = typer.Option(0, "--seed", help="Random state of the fit (splits, step 1's "
                              "held-out TF)."),
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "

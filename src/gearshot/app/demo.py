@@ -176,7 +176,7 @@ def _figures(out, est, stats, full_pred, campaign, rig):
         plotting.save_figure(fig, out / "tf_estimate")[0]
     sa = recording_segments(faulty_path)[0]
     fig, ax = plt.subplots(figsize=(8, 3.5))
-    plotting.plot_sa_and_difference(sa, est.mesh_order, ax=ax,
+    plotting.plot_sa_and_difference(sa, list(est.mesh_orders_), ax=ax,
                                     fault_size=float(index["fault_size"].max()))
     figs["A faulty SA and its difference signal"] = \
         plotting.save_figure(fig, out / "sa_difference")[0]

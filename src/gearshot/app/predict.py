@@ -10,6 +10,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range
+from ..paper import GEAR_TEETH, PINION_TEETH
 
 __all__ = ["predict_from_files", "ROLES"]
 
@@ -30,9 +31,13 @@ def _recording_files(path: Path):
 
 
 def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, speed, load=None,
-                       coverage=0.9, gear_teeth=38, pinion_teeth=17, seed=0,
+                       coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
                        selection_tf=None):
     """Fit the estimator from files and predict every SA segment of ``recordings``.
+
+    The recordings are segmented for ``gear_teeth`` / ``pinion_teeth`` (default: the
+    database's gear pair); the estimator takes its mesh order from the database and
+    refuses tooth counts other than its pair's.
 
     Parameters
     ----------
@@ -69,11 +74,14 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         recordings = [recordings]
     files = expand_recordings(recordings, "--recordings")
     speed, load = choose_condition(database, None, speed=speed, load=load, measured=[])
-    kw = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
+    db = load_database(database, speed=speed, load=load)
+    # the pair is the database's unless declared (a declared other pair is refused by fit)
+    teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
+    kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
+          for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
     # every recording is read and segmented before the fit: a file too short for one SA
     # segment (or unreadable) fails now, not after minutes of fitting
     targets = [(path, recording_segments(path, **kw)) for path in files]
-    db = load_database(database, speed=speed, load=load)
     healthy_sa, long = [], None
     for i, p in enumerate(healthy):
         if i == 0:
@@ -85,7 +93,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, np.vstack(healthy_sa), example, faulty_size, long, selection_tf=selection_tf)
+    est.fit(db, np.vstack(healthy_sa), example, faulty_size, long, selection_tf=selection_tf,
+            **kw)
     fitted = {_key(p) for p in healthy}
     frames = []
     for path, sa in targets:

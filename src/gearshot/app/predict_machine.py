@@ -192,8 +192,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
                                    "mesh_order": meshes})
+    # the database must be of the machine's monitored pair (refused otherwise)
     est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
-            selection_tf=default_selection_tf(seed))
+            selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
+            pinion_teeth=machine.mate()[1])
     frame = pd.DataFrame([r[:4] for r in rows],
                          columns=["recording", "role", "segment", "speed_hz"])
     frame["database_speed_hz"] = cond_speed

@@ -16,6 +16,7 @@ it was.
 
 from __future__ import annotations
 
+import functools
 import numbers
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -30,6 +31,7 @@ from .._validation import as_signal_array, check_in_range
 from ..features import PAPER_FEATURES, available_features
 from ..transfer import mean_rms, resample_transfer_function
 from . import steps
+from ._pair import as_orders, resolve_mesh_orders
 from ._params import (
     ArrayOrObject,
     Boolean,
@@ -50,7 +52,7 @@ from .calibration import (
     setting_differences,
     setting_log_likelihoods,
 )
-from .comparability import Comparability, fit_comparability
+from .comparability import Comparability, ComparabilityReference, fit_comparability
 from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
@@ -88,7 +90,7 @@ class _CalibrationValue(Constraint):
                 + ", a CalibrationOptions or a mapping of its fields")
 
 
-def _select_fault_type(database, fault_type):
+def _select_fault_type(database: Any, fault_type: str | None) -> Any:
     """The signals of one fault type (healthy ones included) of a database whose
     ``fault_type`` coordinate names each signal's type; databases without it hold FTFFs."""
     try:
@@ -289,7 +291,8 @@ class _FitContext:
     cache: dict[str, Any] = field(default_factory=dict)
 
 
-class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
+# scikit-learn ships no type information: its classes are Any to mypy
+class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc,unused-ignore]
     """Estimate FTFF size from SAs with one faulty example (Matania et al. 2023).
 
     Parameters
@@ -320,12 +323,16 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
     n_neighbors : iterable of int >= 1, default range(1, 101)
         Candidate K of step 8.
     validation_fraction : float in (0, 1), default 0.3
-    mesh_order : int >= 1 or sequence of int >= 1, default 38
+    mesh_order : None, int >= 1 or sequence of int >= 1, default None
         Gear-mesh order(s) in the SA cycle whose harmonics and sidebands the difference
-        signal removes (step 7). Several for a shaft whose SA holds several synchronous
-        meshes, e.g. ``[32, 16]`` for the PHM09 spur input shaft, where the second stage's
-        mesh falls at order 16 (:meth:`gearshot.Machine.mesh_orders`); the simulated and
-        target signals are treated alike.
+        signal removes (step 7). ``None``: from the database's gear pair (its
+        ``gear_teeth`` attribute, set by :func:`gearshot.sim.load_database`: the SA cycle
+        is one revolution of that gear); a database without pair attributes (one built
+        by hand) falls back to ``fit``'s ``gear_teeth`` and then to the paper's 38.
+        Several for a shaft whose SA holds several synchronous meshes, e.g. ``[32, 16]``
+        for the PHM09 spur input shaft, where the second stage's mesh falls at order 16
+        (:meth:`gearshot.Machine.mesh_orders`); the simulated and target signals are
+        treated alike. The orders used are ``mesh_orders_``.
     zero_shot : bool, default False
         No faulty example: choose the grade by matching healthy-signal statistics
         (:func:`~gearshot.estimator.match_grade`). With soft weighting the grades are
@@ -442,6 +449,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         The fitted machine's harmonic profiles (healthy mean, the example's direction,
         healthy spread) that :meth:`comparability` measures segments against
         (:mod:`gearshot.estimator.comparability`).
+    mesh_orders_ : tuple of int
+        The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -456,7 +465,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         "transfer_function": [Options(("estimate", "none")), ArrayOrObject("to_signal_grid")],
         "n_neighbors": [IntegerSequence(1, None)],
         "validation_fraction": [Interval(float, 0, 1, closed="neither")],
-        "mesh_order": [Interval(int, 1, None), IntegerSequence(1, None)],
+        "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
         "zero_shot": [Boolean()],
         "upsample": [Interval(int, 1, None)],
         "tuning_smoothing": [Options(("isotonic", "none"))],
@@ -476,7 +485,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                  nominal_grade: int = 7, rms_normalization: bool = True,
                  transfer_function: str | ArrayLike | Any = "estimate",
                  n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
-                 mesh_order: int | Sequence[int] = 38, zero_shot: bool = False, upsample: int = 100,
+                 mesh_order: int | Sequence[int] | None = None, zero_shot: bool = False,
+                 upsample: int = 100,
                  tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
                  model_discrepancy: float = 0.12, random_state: Any = None,
                  fault_type: str | None = None,
@@ -507,14 +517,19 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         self.random_state = random_state
 
     def _mesh_orders(self) -> int | list[int]:
-        """``mesh_order`` as the signal functions take it (an int or a list of ints)."""
-        m = self.mesh_order
-        return int(m) if isinstance(m, (int, np.integer)) else [int(v) for v in m]
+        """The mesh orders as the signal functions take them (an int or a list of ints):
+        those of the fit under way, else ``mesh_orders_`` (else, for an estimator saved
+        before ``mesh_orders_`` existed, ``mesh_order``)."""
+        orders = self.__dict__.get("_fitting_orders") or self.__dict__.get("mesh_orders_")
+        if orders is None:
+            orders = as_orders(self.mesh_order)
+        return orders[0] if len(orders) == 1 else list(orders)
 
     # ------------------------------------------------------------------ fit
     def fit(self, database: Any, target_healthy: ArrayLike,
             faulty_example: ArrayLike | None = None, faulty_size: float | None = None,
-            healthy_long: ArrayLike | None = None, *, selection_tf: Any = None) -> Self:
+            healthy_long: ArrayLike | None = None, *, selection_tf: Any = None,
+            gear_teeth: int | None = None, pinion_teeth: int | None = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters
@@ -537,6 +552,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             ``random_state`` (one TF of the synthetic bank, as the command line uses): on a
             real machine no second measured path is at hand, and step 1 only needs a
             plausible path other than the estimated one.
+        gear_teeth, pinion_teeth : int, optional
+            The pair the target SAs were segmented for (the gear whose revolution is the
+            SA cycle, and its mate); SAs of another pair than the database's are refused.
 
         Returns
         -------
@@ -545,10 +563,24 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         Raises
         ------
         GearshotError
-            On a bad parameter or argument (the message names it and quotes the value).
+            On a bad parameter or argument (the message names it and quotes the value),
+            or target SAs declared for another tooth count than the database's pair.
             The estimator is left as it was before the call.
         """
         validate_params(self.get_params(deep=False), self._parameter_constraints)
+        orders = resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
+        self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
+        try:
+            return self._fit(database, target_healthy, faulty_example, faulty_size,
+                             healthy_long, selection_tf, orders)
+        finally:
+            del self._fitting_orders
+
+    def _fit(self, database: Any, target_healthy: ArrayLike,
+             faulty_example: ArrayLike | None, faulty_size: float | None,
+             healthy_long: ArrayLike | None, selection_tf: Any,
+             orders: tuple[int, ...]) -> Self:
+        """``fit`` with checked parameters and resolved mesh orders."""
         inputs = self._check_fit_inputs(target_healthy, faulty_example, faulty_size,
                                         healthy_long, selection_tf)
         database = _select_fault_type(database, self.fault_type)
@@ -573,9 +605,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         options = resolve_calibration(self.calibration)
         if strategy == "soft" and options is not None and twins is not None:
             strategy = "joint"
-        choose = {"tuned": self._grade_tuned, "soft": self._grade_soft,
-                  "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot,
-                  "joint": lambda c: self._grade_joint(c, options)}[strategy]
+        strategies: dict[str, Callable[[_FitContext], _GradeChoice]] = {
+            "tuned": self._grade_tuned, "soft": self._grade_soft,
+            "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot,
+            "joint": functools.partial(self._grade_joint, options=options)}
+        choose = strategies[strategy]
         choice = choose(ctx)
         settings, setting_models = self._settings_of(choice, ctx)
         grade_w: dict[int, float] = {}
@@ -608,7 +642,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             calibration_=calibration, setting_models_=setting_models,
             n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
             step_seeds_=seeds, simulated_reference_=reference,
-            comparability_reference_=comparability)
+            comparability_reference_=comparability, mesh_orders_=orders)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
@@ -1017,7 +1051,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             ``threshold``.
         """
         self._check_fitted("comparability")
-        reference = getattr(self, "comparability_reference_", None)
+        reference: ComparabilityReference | None = getattr(self, "comparability_reference_",
+                                                            None)
         if reference is None:  # an estimator saved before comparability existed
             raise GearshotError("this estimator was fitted by an older gearshot without "
                                 "a comparability reference; fit it again")
@@ -1084,4 +1119,5 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         :func:`gearshot.estimator.persistence.load_estimator`)."""
         from .persistence import load_estimator
 
-        return load_estimator(path, trusted=trusted)
+        loaded: OneFaultShotEstimator = load_estimator(path, trusted=trusted)
+        return loaded

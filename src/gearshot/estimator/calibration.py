@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -88,8 +88,9 @@ class CalibrationOptions:
     def __post_init__(self) -> None:
         for name in ("gains", "widths", "noise_scales"):
             values = tuple(float(v) for v in getattr(self, name))
-            low_ok = (lambda v: v >= 0) if name == "noise_scales" else (lambda v: v > 0)
-            if not values or not all(np.isfinite(v) and low_ok(v) for v in values):
+            zero_ok = name == "noise_scales"
+            if not values or not all(np.isfinite(v) and (v >= 0 if zero_ok else v > 0)
+                                     for v in values):
                 raise GearshotError(f"calibration {name} must be a non-empty list of "
                                     f"{'non-negative' if name == 'noise_scales' else 'positive'}"
                                     f" numbers; got {getattr(self, name)!r}")
@@ -174,7 +175,7 @@ def stretch_about(delta: FloatArray, width: float, centre: int) -> FloatArray:
     frac = pos - np.floor(pos)
     out = delta[:, lo] * (1 - frac) + delta[:, hi] * frac
     out[:, ~inside] = 0.0
-    return out
+    return cast(FloatArray, out)
 
 
 def setting_differences(delta: FloatArray, tf: Any, scale: float, *, gain: float,

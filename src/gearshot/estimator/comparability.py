@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 import scipy.fft
@@ -83,7 +84,7 @@ def harmonic_profile(sa: ArrayLike, mesh_order: int | Sequence[int]) -> FloatArr
     orders = harmonic_orders(arr.shape[-1], mesh_order)
     amp = np.abs(scipy.fft.rfft(arr, axis=-1))[:, orders]
     norm = np.linalg.norm(amp, axis=1, keepdims=True)
-    return np.divide(amp, norm, out=np.zeros_like(amp), where=norm > 0)
+    return cast(FloatArray, np.divide(amp, norm, out=np.zeros_like(amp), where=norm > 0))
 
 
 @dataclass(frozen=True)

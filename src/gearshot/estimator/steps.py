@@ -20,7 +20,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -153,7 +153,7 @@ def _long_healthy_signal(healthy_sa: FloatArray, n_cycles: int, noise_rms: float
     non-synchronous vibration, here white noise.
     """
     one = healthy_sa[rng.integers(0, healthy_sa.shape[0])]
-    return one + noise_rms * rng.standard_normal((n_cycles, one.size))
+    return cast(FloatArray, one + noise_rms * rng.standard_normal((n_cycles, one.size)))
 
 
 # ---------------------------------------------------------------- step 2
@@ -243,9 +243,9 @@ def suppress_harmonics_simulated(sim_sa: ArrayLike, healthy_mask: ArrayLike,
         if twins.shape != sim_sa.shape:
             raise GearshotError(f"twins must have the shape of the simulated SAs "
                                 f"{sim_sa.shape}; got {twins.shape}")
-        return sim_sa - twins
+        return cast(FloatArray, sim_sa - twins)
     first = int(np.flatnonzero(healthy_mask)[0])
-    return sim_sa - sim_sa[first]
+    return cast(FloatArray, sim_sa - sim_sa[first])
 
 
 def residue_power(differences: ArrayLike) -> FloatArray:
@@ -311,8 +311,8 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
             raise GearshotError("centred_features needs healthy_mean or a non-empty "
                                 "healthy_mask")
         healthy_mean = feats[np.asarray(healthy_mask)].mean(axis=0)
-    return (np.asarray(feats - healthy_mean, dtype=np.float64),
-            np.asarray(healthy_mean, dtype=np.float64))
+    mean = np.asarray(healthy_mean, dtype=np.float64)
+    return np.asarray(feats - mean, dtype=np.float64), mean
 
 
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,

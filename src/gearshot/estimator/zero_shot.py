@@ -17,6 +17,7 @@ grade models, not a guess driven by that foreign content.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,7 +42,7 @@ def healthy_signature(sa: ArrayLike, mesh_order: int | Sequence[int], *, n_sideb
     d2 = np.mean(diff ** 2, axis=-1)
     d = np.sqrt(np.maximum(d2 - float(residue_ms), 0.01 * d2))
     h = np.sqrt(np.mean(harm ** 2, axis=-1))
-    return np.log(np.maximum(d, 1e-300) / np.maximum(h, 1e-300))
+    return cast(NDArray[np.float64], np.log(np.maximum(d, 1e-300) / np.maximum(h, 1e-300)))
 
 
 def residue_mean_square(healthy_differences: ArrayLike, mesh_order: int | Sequence[int], *,

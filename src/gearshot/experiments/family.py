@@ -38,6 +38,13 @@ import pandas as pd
 from .._atomic import atomic_path
 from .._errors import GearshotError
 from .._validation import check_int
+from ..paper import (
+    CYCLES_PER_SEGMENT,
+    GEAR_TEETH,
+    PINION_TEETH,
+    SAMPLES_PER_CYCLE,
+    TABLE1_SIZES,
+)
 
 __all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS",
            "SA_PIPELINE_VERSION", "FamilyRig",
@@ -189,12 +196,14 @@ def _rig_segments(rig: FamilyRig, paths, cache_dir: Path, campaign: dict):
         for key, (y, r) in zip(keys, jobs):
             rec = vr.record(speed=rig.speed, load=rig.load, fault_size=y,
                             duration=_duration(campaign, rig.speed), repetition=r)
-            arrays[f"sa__{key}"] = rec.to_sa_segments(gear_teeth=38, pinion_teeth=17,
-                                                      cycles_per_segment=50,
-                                                      samples_per_cycle=2048)
+            arrays[f"sa__{key}"] = rec.to_sa_segments(gear_teeth=GEAR_TEETH,
+                                                      pinion_teeth=PINION_TEETH,
+                                                      cycles_per_segment=CYCLES_PER_SEGMENT,
+                                                      samples_per_cycle=SAMPLES_PER_CYCLE)
             if y == 0:
                 arrays[f"long__{key}"] = rec.angle_domain(
-                    gear_teeth=38, pinion_teeth=17, samples_per_cycle=2048).astype(np.float32)
+                    gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                    samples_per_cycle=SAMPLES_PER_CYCLE).astype(np.float32)
         with atomic_path(file, make_parents=True) as tmp:   # a unique temporary name
             np.savez(tmp, **arrays)
     with np.load(file) as data:
@@ -211,8 +220,8 @@ def _duration(campaign, speed):
     """Seconds per recording: ``duration`` if set, else enough for ``segments`` SAs."""
     if campaign.get("duration"):
         return float(campaign["duration"])
-    gear_revs_per_s = speed * 17 / 38
-    return 1.02 * (campaign["segments"] * 50 + 1) / gear_revs_per_s
+    gear_revs_per_s = speed * PINION_TEETH / GEAR_TEETH
+    return 1.02 * (campaign["segments"] * CYCLES_PER_SEGMENT + 1) / gear_revs_per_s
 
 
 def _tf_digest(tf) -> str:
@@ -255,7 +264,8 @@ def _calibration_oracle_class():
     return CalibrationOracle
 
 
-def true_path_on_grid(rig: FamilyRig, paths, n_points=2048, gear_teeth=38, pinion_teeth=17):
+def true_path_on_grid(rig: FamilyRig, paths, n_points=SAMPLES_PER_CYCLE,
+                      gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH):
     """The rig's hidden transfer path on the SA's DFT grid (order k at k × gear rev rate).
 
     For diagnostics: what the blind TF estimate (step 3) tries to recover.
@@ -352,6 +362,7 @@ def _family_rows(spec: dict) -> list[dict]:
         if plain:
             out += evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=plain, selection_tf=selection,
+                                     fit_kwargs=ds.fit_kwargs(),
                                      random_state=1000 * rig.seed + draw,
                                      keep_estimators=True, **spec["params"])
         for name in (v for v in todo if v in DIAGNOSTIC_VARIANTS):
@@ -363,6 +374,7 @@ def _family_rows(spec: dict) -> list[dict]:
                 factory = oracle
             row, = evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=["full"], selection_tf=selection,
+                                     fit_kwargs=ds.fit_kwargs(),
                                      random_state=1000 * rig.seed + draw,
                                      keep_estimators=True, estimator_class=factory,
                                      **{**spec["params"], **extra})
@@ -386,7 +398,7 @@ def _family_rows(spec: dict) -> list[dict]:
 def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic=4,
                           bank_seed=2023, conditions=PAPER_CONDITIONS, n_draws=2,
                           variants=("full",), duration=None, segments=4, healthy=6,
-                          sizes=(0.32, 0.56, 0.66), repetitions=2, params=None,
+                          sizes=TABLE1_SIZES, repetitions=2, params=None,
                           cache_dir=None, client=None, progress=True):
     """Evaluate the estimator variants on a family of virtual rigs; resumable.
 

@@ -11,6 +11,7 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_int
 from ..io import recording_segments
+from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
 __all__ = ["RigDataset", "rig_dataset"]
 
@@ -32,6 +33,9 @@ class RigDataset:
     test_recording : ndarray of str (m,)
         The recording each test SA comes from.
     example_recording : str
+    gear_teeth, pinion_teeth : int
+        The pair the SAs were segmented for (declared to the estimator's ``fit``, which
+        refuses a database of another pair).
     """
 
     target_healthy: np.ndarray
@@ -42,11 +46,17 @@ class RigDataset:
     test_size: np.ndarray
     test_recording: np.ndarray
     example_recording: str
+    gear_teeth: int = GEAR_TEETH
+    pinion_teeth: int = PINION_TEETH
 
     def fit_args(self, database):
         """Positional arguments for :meth:`OneFaultShotEstimator.fit`."""
         return (database, self.target_healthy, self.faulty_example, self.faulty_size,
                 self.healthy_long)
+
+    def fit_kwargs(self):
+        """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair."""
+        return {"gear_teeth": self.gear_teeth, "pinion_teeth": self.pinion_teeth}
 
 
 def _campaign_rows(campaign, speed, load):
@@ -65,8 +75,9 @@ def _campaign_rows(campaign, speed, load):
     return rows.reset_index(drop=True)
 
 
-def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5, gear_teeth=38,
-                pinion_teeth=17, cycles_per_segment=50, samples_per_cycle=2048,
+def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5,
+                gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                cycles_per_segment=CYCLES_PER_SEGMENT, samples_per_cycle=SAMPLES_PER_CYCLE,
                 random_state=None, segments=None):
     """Build a Sec. 4.2 dataset from a campaign (folder with an index, or its DataFrame).
 
@@ -141,4 +152,6 @@ def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5, gear_teet
         test_size=np.concatenate(test_y),
         test_recording=np.asarray(test_rec),
         example_recording=str(rows.loc[ex_rec, "path"]),
+        gear_teeth=int(gear_teeth),
+        pinion_teeth=int(pinion_teeth),
     )

@@ -19,11 +19,12 @@ __all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summa
 
 def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
                       random_state=0, keep_estimators=False, coverage=0.9,
-                      estimator_class=None, **params):
+                      estimator_class=None, fit_kwargs=None, **params):
     """Fit every variant on one dataset and score it on its test set.
 
     ``estimator_class`` (default :class:`OneFaultShotEstimator`) is what is fitted; the
-    family's diagnostics pass a subclass.
+    family's diagnostics pass a subclass. ``fit_args`` (and ``fit_kwargs``, e.g. the SAs'
+    tooth counts) go to every ``fit``; ``params`` to every estimator.
 
     Returns
     -------
@@ -40,7 +41,7 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
         t0 = time.perf_counter()
         est = (estimator_class or OneFaultShotEstimator)(
             random_state=random_state, **{**params, **variant_params(name)})
-        est.fit(*fit_args, selection_tf=selection_tf)
+        est.fit(*fit_args, selection_tf=selection_tf, **dict(fit_kwargs or {}))
         pred = est.predict(test_sa)
         seconds = time.perf_counter() - t0
         low, high = est.predict_interval(test_sa, coverage=coverage)
@@ -81,7 +82,8 @@ def _simulated_task(spec: dict) -> pd.DataFrame:
     for name in spec["tfs"]:
         ds = simulated_dataset(sa, y, bank[name], grade=spec["grade"],
                                attenuation_db=spec["attenuation_db"],
-                               random_state=[spec["seed"], spec["tfs"].index(name)])
+                               random_state=[spec["seed"], spec["tfs"].index(name)],
+                               attrs=db.attrs)
         for row in evaluate_variants(ds.fit_args(), ds.test_sa, ds.test_size,
                                      variants=spec["variants"], selection_tf=selection,
                                      random_state=spec["seed"], nominal_grade=spec["grade"]):
@@ -203,7 +205,7 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
                          segments=cache)
         for row in evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=variants, selection_tf=selection_tf,
-                                     random_state=seed + r,
+                                     random_state=seed + r, fit_kwargs=ds.fit_kwargs(),
                                      keep_estimators=keep_estimators is True
                                      or (keep_estimators == "first" and r == 0),
                                      **dict(params or {})):

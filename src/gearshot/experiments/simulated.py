@@ -48,7 +48,7 @@ class SimulatedDataset:
 
 def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
                       noise_fraction=0.1, target_fraction=0.25, n_long_cycles=128,
-                      cycles_per_sa=50, random_state=None):
+                      cycles_per_sa=50, random_state=None, attrs=None):
     """Build a Sec. 4.1 dataset from one grade's simulated SAs and a measured TF.
 
     Healthy SAs are split half/half and faulty ones 70/30 between training (simulated
@@ -71,6 +71,9 @@ def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
     target_fraction : float in (0, 1)
     n_long_cycles, cycles_per_sa : int
     random_state : int or Generator
+    attrs : mapping, optional
+        Attributes of the training database: pass the loaded database's (its gear pair,
+        from which the estimator takes its mesh order).
 
     Returns
     -------
@@ -114,7 +117,8 @@ def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
     database = xr.Dataset(
         {"sa": (("signal", "angle"), sa[train_idx])},
         coords={"fault_size": ("signal", y[train_idx]),
-                "grade": ("signal", np.full(train_idx.size, int(grade)))})
+                "grade": ("signal", np.full(train_idx.size, int(grade)))},
+        attrs=dict(attrs or {}))
     return SimulatedDataset(
         database=database,
         target_healthy=to_target(sa[h_target], cycles_per_sa),

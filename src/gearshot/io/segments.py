@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 from .recording import Recording
 
 __all__ = ["recording_segments"]
 
 
-def recording_segments(path, *, gear_teeth=38, pinion_teeth=17, cycles_per_segment=50,
-                       samples_per_cycle=2048,
+def recording_segments(path, *, gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                       cycles_per_segment=CYCLES_PER_SEGMENT,
+                       samples_per_cycle=SAMPLES_PER_CYCLE,
                        long=False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """SA segments (and optionally the angle-domain signal) of one recording file."""
     rec = Recording.read(path)

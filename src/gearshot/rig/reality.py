@@ -13,6 +13,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_int
+from ..paper import GEAR_TEETH, PINION_TEETH
 
 __all__ = ["RigReality", "draw_reality"]
 
@@ -135,8 +136,8 @@ def _non_integer_order(rng: np.random.Generator, low: float, high: float,
     raise GearshotError("could not draw a non-integer order")  # pragma: no cover
 
 
-def draw_reality(rng: np.random.Generator, *, n_tfs: int = 1, gear_teeth: int = 38,
-                 pinion_teeth: int = 17) -> RigReality:
+def draw_reality(rng: np.random.Generator, *, n_tfs: int = 1,
+                 gear_teeth: int = GEAR_TEETH, pinion_teeth: int = PINION_TEETH) -> RigReality:
     """Draw a rig's hidden reality from ``rng`` (ranges as in the issue)."""
     n_tfs = check_int(n_tfs, "n_tfs", minimum=1)
     ratio = pinion_teeth / gear_teeth  # gear revolutions per input revolution

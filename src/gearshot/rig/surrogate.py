@@ -26,6 +26,7 @@ import numpy as np
 import scipy.signal
 
 from .._validation import check_in_range, check_int
+from ..paper import GEAR_TEETH, PINION_TEETH
 from ..sim.profile_errors import DIN_PROFILE_TOLERANCES
 from .reality import RigReality
 
@@ -65,8 +66,8 @@ class SurrogateEngine:
         centre; larger faults lose contact over a wider part of the mesh cycle.
     """
 
-    gear_teeth: int = 38
-    pinion_teeth: int = 17
+    gear_teeth: int = GEAR_TEETH
+    pinion_teeth: int = PINION_TEETH
     nominal_grade: int = 7
     modes_hz: tuple[float, float, float] = (2800.0, 6300.0, 9700.0)
     damping: float = 0.05

@@ -41,6 +41,7 @@ from .._atomic import atomic_path, check_writable, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
+from ..paper import GEAR_TEETH, PINION_TEETH, TABLE1_SIZES
 from ..signal.level import rms
 from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
@@ -99,8 +100,8 @@ class VirtualRig:
     """
 
     def __init__(self, seed: int = 0, *, engine: str | Callable[..., np.ndarray] | None = None,
-                 tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = 38,
-                 pinion_teeth: int = 17, settle: float = 0.25, grade: int | None = None,
+                 tf_bank: Any = None, fs: float = 50_000.0, gear_teeth: int = GEAR_TEETH,
+                 pinion_teeth: int = PINION_TEETH, settle: float = 0.25, grade: int | None = None,
                  reality_overrides: Mapping[str, Any] | None = None,
                  fault_type: str = "ftff"):
         self.seed = seed
@@ -271,7 +272,7 @@ class VirtualRig:
 
     def campaign(self, folder: str | os.PathLike, *, speed: float, load: float,
                  duration: float = 60.0, healthy: int = 6,
-                 sizes: Sequence[float] = (0.32, 0.56, 0.66), repetitions: int = 6,
+                 sizes: Sequence[float] = TABLE1_SIZES, repetitions: int = 6,
                  dtype: str = "float32", progress: bool = True) -> pd.DataFrame:
         """Record one condition as in the paper's Table 1 and write it to ``folder``.
 

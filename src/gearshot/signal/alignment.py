@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+from typing import Literal, cast, overload
+
 import numpy as np
 import scipy.fft
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import ComplexArray, FloatArray, IntArray
 from .._validation import as_signal_array, check_int, describe, finite_result
 
 __all__ = ["fractional_shift", "subtract_healthy"]
 
 
-def _shift_factors(n: int, tau: np.ndarray) -> np.ndarray:
+def _shift_factors(n: int, tau: FloatArray) -> ComplexArray:
     """Spectral factors that advance a band-limited n-periodic signal by ``tau`` samples.
 
     ``x(t + tau)`` ↔ ``X_k exp(2πi k tau / n)``; the Nyquist bin of an even ``n`` is split
@@ -21,11 +25,11 @@ def _shift_factors(n: int, tau: np.ndarray) -> np.ndarray:
     factors = np.exp(2j * np.pi * np.multiply.outer(tau, k) / n)
     if n % 2 == 0:
         factors[..., n // 2] = np.cos(np.pi * tau)
-    return factors
+    return cast(ComplexArray, factors)
 
 
 @finite_result
-def fractional_shift(x, delay) -> np.ndarray:
+def fractional_shift(x: ArrayLike, delay: ArrayLike) -> FloatArray:
     """Circularly delay signals by a (fractional) number of samples.
 
     Band-limited (Fourier) interpolation: ``y(t) = x(t - delay)`` for the periodic,
@@ -41,28 +45,39 @@ def fractional_shift(x, delay) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import fractional_shift
+    >>> print(np.round(fractional_shift([0.0, 1.0, 0.0, 0.0], 1), 3) + 0.0)
+    [0. 0. 1. 0.]
+    >>> theta = np.arange(64) / 64
+    >>> half = fractional_shift(np.cos(2 * np.pi * 3 * theta), 0.5)   # half a sample later
+    >>> bool(np.allclose(half, np.cos(2 * np.pi * 3 * (theta - 0.5 / 64))))
+    True
     """
     x = as_signal_array(x, "x", min_length=2)
     if isinstance(delay, (str, bytes)):
         raise GearshotError(f"delay must be a number of samples; got {describe(delay)}")
     try:
-        delay = np.asarray(delay, dtype=float)
+        tau = np.asarray(delay, dtype=float)
     except (TypeError, ValueError):
         raise GearshotError(f"delay must be a number of samples or an array of them; got "
                             f"{describe(delay)}") from None
-    if not np.all(np.isfinite(delay)) or np.any(np.abs(delay) > 1e12):
+    if not np.all(np.isfinite(tau)) or np.any(np.abs(tau) > 1e12):
         raise GearshotError(f"delay must be finite and at most 1e12 samples in magnitude; "
                             f"got {describe(delay)}")
     try:
-        fits = np.broadcast_shapes(delay.shape, x.shape[:-1]) == x.shape[:-1]
+        fits = np.broadcast_shapes(tau.shape, x.shape[:-1]) == x.shape[:-1]
     except ValueError:
         fits = False
     if not fits:
-        raise GearshotError(f"delay of shape {delay.shape} does not broadcast to the batch "
+        raise GearshotError(f"delay of shape {tau.shape} does not broadcast to the batch "
                             f"shape {x.shape[:-1]} of x (shape {x.shape})")
     n = x.shape[-1]
-    spectrum = scipy.fft.fft(x, axis=-1) * _shift_factors(n, -delay)
-    return scipy.fft.ifft(spectrum, axis=-1).real
+    spectrum = scipy.fft.fft(x, axis=-1) * _shift_factors(n, -tau)
+    return cast(FloatArray, scipy.fft.ifft(spectrum, axis=-1).real)
 
 
 class _LagSearch:
@@ -94,7 +109,7 @@ class _LagSearch:
         self.offset_phase = np.ascontiguousarray(np.vstack([phase.real, phase.imag]))
         self.offsets = offsets
 
-    def best(self, cross: np.ndarray) -> np.ndarray:
+    def best(self, cross: ComplexArray) -> IntArray:
         """Fine-grid index (0 … n·upsample−1) of the first maximum for each row of ``cross``."""
         n, n_fine = self.n, self.n * self.upsample
         half = cross[:, : n // 2 + 1] * self.weights
@@ -111,12 +126,30 @@ class _LagSearch:
         values = values.reshape(len(values), -1)
         fine = fine.reshape(len(fine), -1)
         top = values == values.max(axis=-1, keepdims=True)
-        return np.where(top, fine, n_fine).min(axis=-1)  # first maximum, as argmax
+        return cast(IntArray, np.where(top, fine, n_fine).min(axis=-1))  # first max., as argmax
+
+
+@overload
+def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: int = ...,
+                     return_details: Literal[False] = ...) -> FloatArray: ...
+
+
+@overload
+def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: int = ...,
+                     return_details: Literal[True]) -> tuple[FloatArray, IntArray, FloatArray]:
+    ...
+
+
+@overload
+def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: int = ...,
+                     return_details: bool) -> FloatArray | tuple[FloatArray, IntArray,
+                                                                 FloatArray]: ...
 
 
 @finite_result
-def subtract_healthy(signals, healthy_refs, *, upsample=100,
-                     return_details=False) -> np.ndarray | tuple[np.ndarray, ...]:
+def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: int = 100,
+                     return_details: bool = False
+                     ) -> FloatArray | tuple[FloatArray, IntArray, FloatArray]:
     """Suppress the gear-mesh pattern by subtracting the best delay-aligned healthy SA.
 
     For every signal and every healthy reference, the circular delay that maximizes
@@ -144,6 +177,23 @@ def subtract_healthy(signals, healthy_refs, *, upsample=100,
         Only with ``return_details``.
     delay : ndarray of float, shape signals.shape[:-1]
         Delay (samples, in ``[0, n)``) of the chosen reference; only with ``return_details``.
+
+    Examples
+    --------
+    A signal is the second reference delayed by 2.25 samples plus a small fault
+    component: the second reference is chosen, the delay found to 1/100 sample, and
+    what is left is the fault component alone.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import fractional_shift, subtract_healthy
+    >>> theta = np.arange(64) / 64
+    >>> refs = np.vstack([np.cos(2 * np.pi * 7 * theta),
+    ...                   np.cos(2 * np.pi * 5 * theta) + 0.3 * np.cos(2 * np.pi * 10 * theta)])
+    >>> fault = 0.1 * np.sin(2 * np.pi * 2 * theta)
+    >>> signal = fractional_shift(refs[1], 2.25) + fault
+    >>> residual, index, delay = subtract_healthy(signal, refs, return_details=True)
+    >>> print(int(index), round(float(delay), 2), bool(np.allclose(residual, fault)))
+    1 2.25 True
     """
     signals = as_signal_array(signals, "signals", min_length=2)
     refs = as_signal_array(healthy_refs, "healthy_refs", max_ndim=2, min_length=2)

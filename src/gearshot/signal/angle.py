@@ -27,8 +27,10 @@ shifted against each other (by whole teeth and fractions); SAs of one recording 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import FloatArray
 from .._validation import MAX_POINTS, check_int, finite_result
 from .angular import angle_to_time
 
@@ -59,6 +61,21 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
     -------
     ndarray
         The pulse times, with bridged dropouts filled in.
+
+    Examples
+    --------
+    Two pulses per revolution, one missing at 0.15 s (bridged), and a glitch (refused):
+
+    >>> import numpy as np
+    >>> from gearshot.signal import check_pulse_train
+    >>> print(check_pulse_train(np.array([0.0, 0.05, 0.1, 0.2, 0.25, 0.3]),
+    ...                         pulses_per_rev=2, label="demo"))
+    [0.   0.05 0.1  0.15 0.2  0.25 0.3 ]
+    >>> check_pulse_train(np.array([0.0, 0.1, 0.11, 0.2, 0.3]), pulses_per_rev=1,
+    ...                   label="demo")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gearshot._errors.GearshotError: demo: extra tacho pulse at t=0.11 s ...
     """
     pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     try:
@@ -122,6 +139,17 @@ def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
     ndarray, shape (n_cycles + 1,)
         Start time of gear revolution 0 (the first pulse), 1, ... up to the last revolution
         that ends before the last pulse.
+
+    Examples
+    --------
+    The paper's pair with a once-per-revolution tacho on the 17-tooth pinion turning at
+    10 rev/s: one gear revolution takes 38/17 pinion revolutions, 0.2235 s.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import gear_cycle_times
+    >>> times = gear_cycle_times(np.arange(81) * 0.1, gear_teeth=38, pinion_teeth=17)
+    >>> print(np.round(times[:4], 4) + 0.0)
+    [0.     0.2235 0.4471 0.6706]
     """
     from .angular import _check_pulses
 
@@ -142,11 +170,17 @@ def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
     return angle_to_time(pulses, targets, pulses_per_rev=pulses_per_rev)
 
 
-def uniform_cycle_times(cycle_times: np.ndarray) -> np.ndarray:
+def uniform_cycle_times(cycle_times: ArrayLike) -> FloatArray:
     """Equally spaced cycle times with the same first and last value (constant speed).
 
     Used to show what skipping angular re-sampling costs: the signal is then cut at the
     *mean* cycle period, as a plain time-domain synchronous average would do.
+
+    Examples
+    --------
+    >>> from gearshot.signal.angle import uniform_cycle_times
+    >>> print(uniform_cycle_times([0.0, 1.1, 1.9, 3.0]))
+    [0. 1. 2. 3.]
     """
     c = np.asarray(cycle_times, dtype=np.float64)
     return np.linspace(c[0], c[-1], c.size)

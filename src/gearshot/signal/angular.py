@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import FloatArray
 from .._validation import (
     MAX_POINTS,
     as_signal_array,
@@ -20,7 +24,8 @@ __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 
 
 @finite_result
-def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1) -> np.ndarray:
+def pulse_times(tacho: ArrayLike, fs: float, *, threshold: float | None = None,
+                hysteresis: float = 0.1) -> FloatArray:
     """Times of the rising edges of a tacho signal, interpolated between samples.
 
     An edge is where the signal crosses ``threshold`` upwards after having been below
@@ -43,6 +48,17 @@ def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1) -> np.ndarray:
     -------
     ndarray, shape (n_pulses,)
         Pulse times in seconds from the first sample (strictly increasing).
+
+    Examples
+    --------
+    A 0/5 V tacho rising every 100 samples at 1 kHz, first at sample 50: each edge is
+    placed halfway between the samples around it.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import pulse_times
+    >>> tacho = np.where(np.arange(1000) % 100 < 50, 0.0, 5.0)
+    >>> print(np.round(pulse_times(tacho, 1000.0)[:3], 4))
+    [0.0495 0.1495 0.2495]
     """
     tacho = as_signal_array(tacho, "tacho", max_ndim=1, min_length=2)
     fs = check_positive(fs, "fs")
@@ -74,10 +90,10 @@ def pulse_times(tacho, fs, *, threshold=None, hysteresis=0.1) -> np.ndarray:
         up = up[:0]
     x0, x1 = tacho[up - 1], tacho[up]
     frac = (threshold - x0) / (x1 - x0)
-    return (up - 1 + frac) / fs
+    return cast(FloatArray, (up - 1 + frac) / fs)
 
 
-def _check_pulses(pulse_times, name="pulse_times"):
+def _check_pulses(pulse_times: ArrayLike, name: str = "pulse_times") -> FloatArray:
     pulses = as_signal_array(pulse_times, name, max_ndim=1)
     if pulses.size < 2:
         raise GearshotError(f"{name} must hold at least 2 pulses; got {pulses.size}")
@@ -85,7 +101,8 @@ def _check_pulses(pulse_times, name="pulse_times"):
 
 
 @finite_result
-def angle_to_time(pulse_times, angles, *, pulses_per_rev=1) -> np.ndarray:
+def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
+                  pulses_per_rev: int = 1) -> FloatArray:
     """Time at which the shaft reaches given angles, from its tacho pulses.
 
     The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
@@ -105,15 +122,24 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1) -> np.ndarray:
     -------
     ndarray
         Times, s.
+
+    Examples
+    --------
+    A shaft turning once per 0.1 s:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import angle_to_time
+    >>> print(np.round(angle_to_time(np.arange(11) * 0.1, [0.0, 0.5, 2.25]), 6) + 0.0)
+    [0.    0.05  0.225]
     """
     pulses = _check_pulses(pulse_times)
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     revs = np.arange(pulses.size) / ppr
-    angles = as_signal_array(angles, "angles", min_ndim=0)
+    revs_at = as_signal_array(angles, "angles", min_ndim=0)
     span = revs[-1]
-    outside = (angles < -1e-6) | (angles > span + 1e-6)   # rounding slack: 1e-6 rev
+    outside = (revs_at < -1e-6) | (revs_at > span + 1e-6)   # rounding slack: 1e-6 rev
     if np.any(outside):
-        first = float(angles.ravel()[np.flatnonzero(outside.ravel())[0]])
+        first = float(revs_at.ravel()[np.flatnonzero(outside.ravel())[0]])
         raise GearshotError(
             f"angles must lie within the pulsed span 0 … {span:g} revolutions "
             f"({pulses.size} pulses at pulses_per_rev={ppr}); got {first!r} "
@@ -126,12 +152,13 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1) -> np.ndarray:
             curve = PchipInterpolator(revs, pulses)
     else:
         curve = PchipInterpolator(revs, pulses)
-    return curve(np.clip(angles, 0.0, span))
+    return cast(FloatArray, curve(np.clip(revs_at, 0.0, span)))
 
 
 @finite_result
-def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, upsample=2,
-                     antialias=True, passband=0.9) -> np.ndarray:
+def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples_per_rev: int,
+                     pulses_per_rev: int = 1, upsample: int = 2, antialias: bool = True,
+                     passband: float = 0.9) -> FloatArray:
     """Resample a time signal at equal steps of shaft angle.
 
     The signal is over-sampled ×``upsample`` and then read at the instants the shaft passes
@@ -170,6 +197,23 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
     -------
     ndarray, shape (..., n_revs * samples_per_rev)
         Angle-domain signal starting at the first pulse.
+
+    Examples
+    --------
+    A 30 Hz tone on a shaft turning at 10 rev/s is order 3: nine whole revolutions at
+    16 samples each, one period of order 3 every 16/3 samples.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import angular_resample
+    >>> fs = 1000.0
+    >>> t = np.arange(1000) / fs
+    >>> angle = angular_resample(np.cos(2 * np.pi * 30 * t), fs, np.arange(10) * 0.1,
+    ...                          samples_per_rev=16)
+    >>> angle.shape
+    (144,)
+    >>> order3 = np.cos(2 * np.pi * 3 * np.arange(144) / 16)
+    >>> bool(np.allclose(angle[16:], order3[16:], atol=0.005))   # after the first turn
+    True
     """
     x = as_signal_array(x, "x", min_length=4)
     fs = check_positive(fs, "fs")

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import cast
+
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import FloatArray
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
 __all__ = ["synchronous_average", "nonsynchronous_signal"]
 
 
 @finite_result
-def synchronous_average(x, samples_per_cycle, *, n_cycles=None) -> np.ndarray:
+def synchronous_average(x: ArrayLike, samples_per_cycle: int, *,
+                        n_cycles: int | None = None) -> FloatArray:
     """Synchronous average of an angle-domain signal.
 
     Parameters
@@ -33,6 +37,20 @@ def synchronous_average(x, samples_per_cycle, *, n_cycles=None) -> np.ndarray:
     ------
     GearshotError
         If ``x`` holds fewer samples than one cycle or than the cycles requested.
+
+    Examples
+    --------
+    Five cycles of a 4-point pattern, the first cycle disturbed by +0.4: the average
+    carries a fifth of the disturbance; the trailing partial cycle is ignored.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import synchronous_average
+    >>> x = np.r_[np.tile([0.0, 1.0, 2.0, 3.0], 5), 9.0]
+    >>> x[:4] += 0.4
+    >>> print(synchronous_average(x, 4))
+    [0.08 1.08 2.08 3.08]
+    >>> print(synchronous_average(x, 4, n_cycles=1))
+    [0.4 1.4 2.4 3.4]
     """
     spc = check_int(samples_per_cycle, "samples_per_cycle", minimum=1, maximum=MAX_POINTS)
     x = as_signal_array(x, "x")
@@ -49,11 +67,11 @@ def synchronous_average(x, samples_per_cycle, *, n_cycles=None) -> np.ndarray:
             f"n_cycles={n_cycles} requested but x holds only {available} whole cycles "
             f"of {spc} samples ({x.shape[-1]} samples)")
     blocks = x[..., : n_cycles * spc].reshape(*x.shape[:-1], n_cycles, spc)
-    return blocks.mean(axis=-2)
+    return cast(FloatArray, blocks.mean(axis=-2))
 
 
 @finite_result
-def nonsynchronous_signal(x, samples_per_cycle) -> np.ndarray:
+def nonsynchronous_signal(x: ArrayLike, samples_per_cycle: int) -> FloatArray:
     """The non-synchronous part of an angle-domain signal: each cycle minus the SA.
 
     Everything that does not repeat identically every cycle -- noise, other shafts,
@@ -89,5 +107,5 @@ def nonsynchronous_signal(x, samples_per_cycle) -> np.ndarray:
         raise GearshotError(f"x has {x.shape[-1]} samples, fewer than one cycle of "
                             f"samples_per_cycle={spc}")
     blocks = x[..., : n_cycles * spc].reshape(*x.shape[:-1], n_cycles, spc)
-    return (blocks - blocks.mean(axis=-2, keepdims=True)).reshape(*x.shape[:-1],
-                                                                   n_cycles * spc)
+    return cast(FloatArray, (blocks - blocks.mean(axis=-2, keepdims=True)).reshape(
+        *x.shape[:-1], n_cycles * spc))

@@ -20,18 +20,38 @@ differently, invisible in any SA -- is :func:`gearshot.signal.nonsynchronous_sig
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import cast
+
 import numpy as np
 import scipy.fft
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import BoolArray, FloatArray, IntArray
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
 __all__ = ["harmonic_signal", "difference_signal", "regular_signal", "residual_signal",
            "order_mask", "mesh_band_orders", "check_mesh_order", "check_mesh_orders"]
 
 
-def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int:
-    """Validate a mesh order against the Nyquist order of an ``n_points`` cycle."""
+#: One mesh order or several (a shaft carrying several gears).
+MeshOrders = int | Sequence[int] | ArrayLike
+
+
+def check_mesh_order(mesh_order: object, n_points: int, name: str = "mesh_order") -> int:
+    """Validate a mesh order against the Nyquist order of an ``n_points`` cycle.
+
+    Examples
+    --------
+    >>> from gearshot.signal.orders import check_mesh_order
+    >>> check_mesh_order(38, 2048)
+    38
+    >>> check_mesh_order(1024, 2048)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gearshot._errors.GearshotError: mesh_order=1024 is at or above the Nyquist order 1024 ...
+    """
     mesh_order = check_int(mesh_order, name, minimum=1)
     if mesh_order >= n_points / 2:
         raise GearshotError(
@@ -40,13 +60,22 @@ def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int
     return mesh_order
 
 
-def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tuple[int, ...]:
+def check_mesh_orders(mesh_order: MeshOrders, n_points: int,
+                      name: str = "mesh_order") -> tuple[int, ...]:
     """Validate one mesh order or a sequence of them (a shaft carrying several gears).
 
     Returns
     -------
     tuple of int
         The distinct orders, in the given order.
+
+    Examples
+    --------
+    >>> from gearshot.signal.orders import check_mesh_orders
+    >>> check_mesh_orders([38, 16, 38], 2048)
+    (38, 16)
+    >>> check_mesh_orders(38, 2048)
+    (38,)
     """
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
         orders = (mesh_order.ravel().tolist() if isinstance(mesh_order, np.ndarray)
@@ -62,7 +91,7 @@ def check_mesh_orders(mesh_order, n_points: int, name: str = "mesh_order") -> tu
     return (check_mesh_order(mesh_order, n_points, name),)
 
 
-def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
+def mesh_band_orders(n_points: int, mesh_order: MeshOrders, n_sidebands: int) -> IntArray:
     """One-sided orders (0 … n_points//2) of the mesh harmonics and their sidebands.
 
     ``mesh_order`` may be a sequence (a shaft carrying several gears): the union of the
@@ -72,6 +101,16 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     ``±1 … ±n_sidebands`` sidebands. Orders beyond Nyquist or below zero are folded onto
     their mirror, as zeroing both halves of a two-sided spectrum would do. DC (order 0) is
     not a mesh harmonic and is kept unless a sideband folds onto it.
+
+    Examples
+    --------
+    Mesh order 10 in a 64-point cycle (Nyquist order 32), one sideband each side:
+
+    >>> from gearshot.signal import mesh_band_orders
+    >>> print(mesh_band_orders(64, 10, 1))
+    [ 9 10 11 19 20 21 29 30 31]
+    >>> print(mesh_band_orders(64, [10, 16], 0))    # two meshes on the shaft
+    [10 16 20 30 32]
     """
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
@@ -79,14 +118,14 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
         return _unique_orders(np.concatenate([
             mesh_band_orders(n_points, m, n_sidebands)
             for m in check_mesh_orders(mesh_order, n_points)]), n_points)
-    mesh_order = check_mesh_order(mesh_order, n_points)
-    k = np.arange(1, (n_points // 2) // mesh_order + 1)
+    order = check_mesh_order(mesh_order, n_points)
+    k = np.arange(1, (n_points // 2) // order + 1)
     width = 2 * n_sidebands + 1
     if width >= n_points:
-        return np.arange(n_points // 2 + 1)      # every order is in a band
+        return cast(IntArray, np.arange(n_points // 2 + 1))   # every order is in a band
     else:   # the union of the bands k*m ± n_sidebands (mod n_points), in O(n_points) memory
         diff = np.zeros(n_points + 1, dtype=np.int64)
-        lo = (k * mesh_order - n_sidebands) % n_points
+        lo = (k * order - n_sidebands) % n_points
         hi = lo + width
         wrap = hi > n_points
         np.add.at(diff, lo, 1)
@@ -97,12 +136,12 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     return _unique_orders(np.minimum(idx, n_points - idx), n_points)
 
 
-def _unique_orders(orders: np.ndarray, n_points: int) -> np.ndarray:
+def _unique_orders(orders: IntArray, n_points: int) -> IntArray:
     """Sorted distinct orders in ``0 … n_points//2`` (a count, not a hash: linear time)."""
-    return np.flatnonzero(np.bincount(orders, minlength=n_points // 2 + 1))
+    return cast(IntArray, np.flatnonzero(np.bincount(orders, minlength=n_points // 2 + 1)))
 
 
-def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def order_mask(n_points: int, mesh_order: MeshOrders, *, n_sidebands: int = 2) -> BoolArray:
     """Boolean mask over one-sided orders ``0 … n_points//2``; True on mesh bands.
 
     Parameters
@@ -118,6 +157,16 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     Returns
     -------
     mask : ndarray of bool, shape (n_points // 2 + 1,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import order_mask
+    >>> mask = order_mask(64, 10, n_sidebands=1)
+    >>> mask.shape
+    (33,)
+    >>> print(np.flatnonzero(mask))
+    [ 9 10 11 19 20 21 29 30 31]
     """
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     mesh_order = list(check_mesh_orders(mesh_order, n_points))
@@ -127,11 +176,12 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     return mask
 
 
-def _shaft_orders(shaft_orders, n: int) -> list[int]:
+def _shaft_orders(shaft_orders: int | Sequence[int], n: int) -> list[int]:
+    listed: object = shaft_orders
     if isinstance(shaft_orders, (int, np.integer)) and not isinstance(shaft_orders, bool):
-        shaft_orders = [shaft_orders]
+        listed = [shaft_orders]
     try:
-        orders = list(shaft_orders)
+        orders = list(listed)  # type: ignore[call-overload]
     except TypeError:
         raise GearshotError(f"shaft_orders must be a sequence of integers; got "
                             f"{shaft_orders!r}") from None
@@ -145,7 +195,8 @@ def _shaft_orders(shaft_orders, n: int) -> list[int]:
     return out
 
 
-def _split(sa, mesh_order, n_sidebands, keep_mesh: bool, shaft_orders=None):
+def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int, keep_mesh: bool,
+           shaft_orders: int | Sequence[int] | None = None) -> FloatArray:
     sa = as_signal_array(sa, "sa", min_length=4)
     n = sa.shape[-1]
     mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
@@ -153,11 +204,12 @@ def _split(sa, mesh_order, n_sidebands, keep_mesh: bool, shaft_orders=None):
         mask[[0, *_shaft_orders(shaft_orders, n)]] = True
     spectrum = scipy.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
-    return scipy.fft.irfft(spectrum, n=n, axis=-1)
+    return cast(FloatArray, scipy.fft.irfft(spectrum, n=n, axis=-1))
 
 
 @finite_result
-def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def harmonic_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                    n_sidebands: int = 2) -> FloatArray:
     """The mesh harmonics of a synchronous average and their sidebands.
 
     Keeps orders ``k * mesh_order + s`` (``k >= 1``, ``|s| <= n_sidebands``) in both halves of
@@ -176,12 +228,26 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    A mesh tone at order 10 and a fault component at order 3:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import difference_signal, harmonic_signal, rms
+    >>> theta = np.arange(64) / 64
+    >>> sa = np.cos(2 * np.pi * 10 * theta) + 0.5 * np.cos(2 * np.pi * 3 * theta)
+    >>> print(round(float(rms(harmonic_signal(sa, 10))), 4))    # the unit mesh tone
+    0.7071
+    >>> bool(np.allclose(harmonic_signal(sa, 10) + difference_signal(sa, 10), sa))
+    True
     """
     return _split(sa, mesh_order, n_sidebands, keep_mesh=True)
 
 
 @finite_result
-def difference_signal(sa, mesh_order, *, n_sidebands=2, shaft_orders=None) -> np.ndarray:
+def difference_signal(sa: ArrayLike, mesh_order: MeshOrders, *, n_sidebands: int = 2,
+                      shaft_orders: int | Sequence[int] | None = None) -> FloatArray:
     """A synchronous average with its mesh harmonics and sidebands removed.
 
     Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and
@@ -205,12 +271,28 @@ def difference_signal(sa, mesh_order, *, n_sidebands=2, shaft_orders=None) -> np
     Returns
     -------
     ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    The mesh tone at order 10 goes, the order-3 component stays:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import difference_signal
+    >>> theta = np.arange(64) / 64
+    >>> fault = 0.5 * np.cos(2 * np.pi * 3 * theta)
+    >>> diff = difference_signal(np.cos(2 * np.pi * 10 * theta) + fault, 10)
+    >>> bool(np.allclose(diff, fault))
+    True
+    >>> print(np.round(diff[:3], 3))
+    [0.5   0.478 0.416]
     """
     return _split(sa, mesh_order, n_sidebands, keep_mesh=False, shaft_orders=shaft_orders)
 
 
 @finite_result
-def regular_signal(sa, mesh_order, *, shaft_orders=(1, 2), n_sidebands=0) -> np.ndarray:
+def regular_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                   shaft_orders: int | Sequence[int] | None = (1, 2),
+                   n_sidebands: int = 0) -> FloatArray:
     """The regular part of a synchronous average: shaft orders and mesh harmonics.
 
     Keeps the listed shaft orders and every harmonic of every mesh order (with
@@ -248,11 +330,12 @@ def regular_signal(sa, mesh_order, *, shaft_orders=(1, 2), n_sidebands=0) -> np.
     """
     out = _split(sa, mesh_order, n_sidebands, keep_mesh=True,
                  shaft_orders=() if shaft_orders is None else shaft_orders)
-    return out - out.mean(axis=-1, keepdims=True)
+    return cast(FloatArray, out - out.mean(axis=-1, keepdims=True))
 
 
 @finite_result
-def residual_signal(sa, mesh_order, *, shaft_orders=(1, 2)) -> np.ndarray:
+def residual_signal(sa: ArrayLike, mesh_order: MeshOrders, *,
+                    shaft_orders: int | Sequence[int] = (1, 2)) -> FloatArray:
     """The residual of a synchronous average: shaft orders, DC and mesh harmonics removed.
 
     What is left of the SA once its regular signal (:func:`regular_signal`, no sidebands)
@@ -269,6 +352,18 @@ def residual_signal(sa, mesh_order, *, shaft_orders=(1, 2)) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    The shaft orders 1–2, DC and the mesh go; an order that is neither stays:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import residual_signal
+    >>> k = np.arange(64) / 64
+    >>> other = 0.1 * np.cos(2 * np.pi * 5 * k)
+    >>> sa = 2.0 + np.cos(2 * np.pi * 8 * k) + 0.5 * np.cos(2 * np.pi * k) + other
+    >>> bool(np.allclose(residual_signal(sa, 8), other))
+    True
     """
     return _split(sa, mesh_order, 0, keep_mesh=False,
                   shaft_orders=() if shaft_orders is None else shaft_orders)

@@ -2,18 +2,22 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 import scipy.fft
 from numpy.lib.stride_tricks import sliding_window_view
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import FloatArray
 from .._validation import MAX_POINTS, as_signal_array, check_in_range, check_int, finite_result
 
 __all__ = ["amplitude_spectrum", "acs_background"]
 
 
 @finite_result
-def amplitude_spectrum(x, *, nfft=2**15) -> np.ndarray:
+def amplitude_spectrum(x: ArrayLike, *, nfft: int = 2**15) -> FloatArray:
     """Averaged amplitude spectrum over non-overlapping rectangular segments.
 
     ``sqrt(sum_s |FFT(x_s)|^2 / (n_segments * nfft))`` over the ``n_segments = len(x) // nfft``
@@ -30,6 +34,17 @@ def amplitude_spectrum(x, *, nfft=2**15) -> np.ndarray:
     -------
     ndarray, shape (..., nfft)
         Two-sided amplitude spectrum (index k ↔ k/nfft of the sampling rate).
+
+    Examples
+    --------
+    A unit cosine at bin 4 of 16-point segments: amplitude sqrt(nfft)/2 = 2 at bins 4
+    and 16 - 4, nothing elsewhere.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import amplitude_spectrum
+    >>> x = np.cos(2 * np.pi * 4 * np.arange(64) / 16)
+    >>> print(np.round(amplitude_spectrum(x, nfft=16), 3) + 0.0)
+    [0. 0. 0. 0. 2. 0. 0. 0. 0. 0. 0. 0. 2. 0. 0. 0.]
     """
     nfft = check_int(nfft, "nfft", minimum=2, maximum=MAX_POINTS)
     x = as_signal_array(x, "x")
@@ -39,12 +54,12 @@ def amplitude_spectrum(x, *, nfft=2**15) -> np.ndarray:
             f"x has {x.shape[-1]} samples, fewer than one segment of nfft={nfft}")
     segs = x[..., : n_seg * nfft].reshape(*x.shape[:-1], n_seg, nfft)
     power = np.abs(scipy.fft.fft(segs, axis=-1)) ** 2
-    return np.sqrt(power.sum(axis=-2) / (n_seg * nfft))
+    return cast(FloatArray, np.sqrt(power.sum(axis=-2) / (n_seg * nfft)))
 
 
 @finite_result
-def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
-                   symmetric=True) -> np.ndarray:
+def acs_background(spectrum: ArrayLike, *, segment_size: int = 200, overlap: float = 0.75,
+                   percentile: float = 50, symmetric: bool = True) -> FloatArray:
     """Background of a spectrum by segment percentiles (the reference's ACS).
 
     The spectrum is cut into segments of ``segment_size`` bins advancing by
@@ -71,6 +86,18 @@ def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
     Returns
     -------
     ndarray, shape (..., L)
+
+    Examples
+    --------
+    A flat floor with one tone: the median of each segment ignores the tone.
+
+    >>> import numpy as np
+    >>> from gearshot.signal import acs_background
+    >>> spectrum = np.ones(100)
+    >>> spectrum[30] = 50.0
+    >>> background = acs_background(spectrum, segment_size=20)
+    >>> print(np.round(background[[0, 30, 70]], 3))
+    [1. 1. 1.]
     """
     spectrum = as_signal_array(spectrum, "spectrum", min_length=2)
     length = spectrum.shape[-1]

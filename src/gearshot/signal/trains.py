@@ -18,11 +18,14 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from typing import cast
 
 import numpy as np
 import scipy.fft
+from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
+from .._typing import ComplexArray, FloatArray
 from .._validation import (
     MAX_POINTS,
     as_signal_array,
@@ -37,11 +40,21 @@ __all__ = ["shaft_cycle_times", "as_ratio", "antialias_filter", "bandlimited_res
            "min_shaft_rate"]
 
 
-def as_ratio(value, name: str = "revs_per_cycle") -> Fraction:
+#: What :func:`as_ratio` takes.
+RatioLike = Fraction | int | str | tuple[int, int] | float | np.integer | np.floating
+
+
+def as_ratio(value: RatioLike, name: str = "revs_per_cycle") -> Fraction:
     """An exact positive ratio from a Fraction, an int, a ``"p/q"`` string or a (p, q) pair.
 
     Floats are accepted only when they are exact small fractions (e.g. 2.5); pass tooth
     counts as a fraction to stay exact.
+
+    Examples
+    --------
+    >>> from gearshot.signal.trains import as_ratio
+    >>> print(as_ratio("96/32"), as_ratio((38, 17)), as_ratio(2.5))
+    3 38/17 5/2
     """
     try:
         if isinstance(value, bool):
@@ -65,7 +78,8 @@ def as_ratio(value, name: str = "revs_per_cycle") -> Fraction:
 
 
 @finite_result
-def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1) -> np.ndarray:
+def shaft_cycle_times(pulse_times: ArrayLike, *, revs_per_cycle: RatioLike,
+                      pulses_per_rev: int = 1) -> FloatArray:
     """Times (s) at which a shaft completes whole revolutions, from a tacho on another shaft.
 
     Parameters
@@ -83,6 +97,15 @@ def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1) -> np.nd
     ndarray, shape (n_cycles + 1,)
         Start of target revolution 0 (at the first pulse), 1, ..., up to the last
         revolution that ends by the last pulse.
+
+    Examples
+    --------
+    An idler turning once per three revolutions of a tacho shaft pulsing every 0.1 s:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import shaft_cycle_times
+    >>> print(np.round(shaft_cycle_times(np.arange(10) * 0.1, revs_per_cycle="3"), 6) + 0.0)
+    [0.  0.3 0.6 0.9]
     """
     pulses = as_signal_array(pulse_times, "pulse_times", max_ndim=1)
     ratio = as_ratio(revs_per_cycle)
@@ -102,8 +125,19 @@ def shaft_cycle_times(pulse_times, *, revs_per_cycle, pulses_per_rev=1) -> np.nd
     return angle_to_time(pulses, targets, pulses_per_rev=ppr)
 
 
-def min_shaft_rate(pulse_times, *, pulses_per_rev=1, revs_per_cycle=1):
-    """Lowest speed (revolutions/s of the target shaft) between consecutive tacho pulses."""
+def min_shaft_rate(pulse_times: ArrayLike, *, pulses_per_rev: int = 1,
+                   revs_per_cycle: RatioLike = 1) -> float:
+    """Lowest speed (revolutions/s of the target shaft) between consecutive tacho pulses.
+
+    Examples
+    --------
+    The longest pulse interval is 0.15 s:
+
+    >>> from gearshot.signal.trains import min_shaft_rate
+    >>> pulses = [0.0, 0.1, 0.2, 0.35, 0.45]
+    >>> print(round(min_shaft_rate(pulses), 4), round(min_shaft_rate(pulses, revs_per_cycle=3), 4))
+    6.6667 2.2222
+    """
     pulses = as_signal_array(pulse_times, "pulse_times", max_ndim=1)
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     ratio = as_ratio(revs_per_cycle)
@@ -115,7 +149,8 @@ def min_shaft_rate(pulse_times, *, pulses_per_rev=1, revs_per_cycle=1):
     return float(1.0 / (ppr * gaps.max()) / float(ratio))
 
 
-def _lowpass_spectrum(x, fs, cutoff, passband):
+def _lowpass_spectrum(x: FloatArray, fs: float, cutoff: float,
+                      passband: float) -> tuple[ComplexArray, int, int]:
     """Padded, low-passed one-sided spectrum: (spectrum, n_fft, pad)."""
     n = x.shape[-1]
     f1 = passband * cutoff
@@ -124,7 +159,7 @@ def _lowpass_spectrum(x, fs, cutoff, passband):
     widths = [(0, 0)] * (x.ndim - 1) + [(pad, pad)]
     xp = np.pad(x, widths, mode="reflect", reflect_type="odd")
     n_fft = scipy.fft.next_fast_len(xp.shape[-1], real=True)
-    spec = scipy.fft.rfft(xp, n=n_fft, axis=-1)
+    spec: ComplexArray = scipy.fft.rfft(xp, n=n_fft, axis=-1)
     f = np.arange(spec.shape[-1]) * (fs / n_fft)
     gain = np.ones(f.size)
     ramp = (f > f1) & (f < cutoff)
@@ -134,7 +169,8 @@ def _lowpass_spectrum(x, fs, cutoff, passband):
     return spec, n_fft, pad
 
 
-def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
+def bandlimited_resynthesis(x: ArrayLike, fs: float, *, cutoff: float, passband: float = 0.9,
+                            rate: float) -> tuple[FloatArray, float, float]:
     """Low-pass ``x`` below ``cutoff`` and re-synthesize it at (about) ``rate`` Hz.
 
     The band-limited signal is evaluated on a uniform grid of ``n_out`` points over the
@@ -148,6 +184,23 @@ def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
         Sampling rate of ``y``, Hz.
     t0 : float
         Time of ``y[..., 0]`` relative to ``x[..., 0]``, s (negative: the padding).
+
+    Examples
+    --------
+    Two seconds at 1 kHz of a 10 Hz tone plus a 300 Hz one, low-passed below 100 Hz and
+    re-synthesized at 400 Hz: the 10 Hz tone alone, on the padded time grid.
+
+    >>> import numpy as np
+    >>> from gearshot.signal.trains import bandlimited_resynthesis
+    >>> t = np.arange(2000) / 1000.0
+    >>> x = np.sin(2 * np.pi * 10 * t) + np.sin(2 * np.pi * 300 * t)
+    >>> y, fs_out, t0 = bandlimited_resynthesis(x, 1000.0, cutoff=100.0, rate=400.0)
+    >>> print(fs_out, t0)
+    400.0 -0.6
+    >>> ty = t0 + np.arange(y.size) / fs_out
+    >>> inside = (ty >= 0.1) & (ty < 1.9)
+    >>> bool(np.allclose(y[inside], np.sin(2 * np.pi * 10 * ty[inside]), atol=0.01))
+    True
     """
     x = as_signal_array(x, "x", min_length=4)
     fs = check_positive(fs, "fs")
@@ -167,11 +220,12 @@ def bandlimited_resynthesis(x, fs, *, cutoff, passband=0.9, rate):
         if n_out < n_fft:
             spec[..., -1] = spec[..., -1].real  # the new Nyquist bin of a real signal
     y = scipy.fft.irfft(spec, n=n_out, axis=-1) * (n_out / n_fft)
-    return y, fs * n_out / n_fft, -pad / fs
+    return cast(FloatArray, y), fs * n_out / n_fft, -pad / fs
 
 
 @finite_result
-def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1) -> np.ndarray:
+def antialias_filter(x: ArrayLike, fs: float, *, cutoff: float, passband: float = 0.9,
+                     upsample: int = 1) -> FloatArray:
     """Zero-phase low-pass (and up-sampling) of a time signal, flat to ``passband * cutoff``.
 
     The gain is exactly 1 up to ``passband * cutoff`` Hz, falls as a raised cosine to 0 at
@@ -195,6 +249,22 @@ def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n * upsample)
+
+    Examples
+    --------
+    A 10 Hz tone survives a 100 Hz low-pass untouched, a 300 Hz one goes (away from the
+    record's ends: the last samples see a step of the cut content's end value, which the
+    odd reflection puts there):
+
+    >>> import numpy as np
+    >>> from gearshot.signal import antialias_filter
+    >>> t = np.arange(2000) / 1000.0
+    >>> low = np.sin(2 * np.pi * 10 * t)
+    >>> y = antialias_filter(low + np.sin(2 * np.pi * 300 * t), 1000.0, cutoff=100.0)
+    >>> bool(np.allclose(y[:1800], low[:1800], atol=1e-3))
+    True
+    >>> antialias_filter(low, 1000.0, cutoff=100.0, upsample=2).shape
+    (4000,)
     """
     x = as_signal_array(x, "x", min_length=4)
     fs = check_positive(fs, "fs")
@@ -207,11 +277,11 @@ def antialias_filter(x, fs, *, cutoff, passband=0.9, upsample=1) -> np.ndarray:
                             f"samples")
     n = x.shape[-1]
     if passband * cutoff >= fs / 2 and up == 1:
-        return x.copy()
+        return cast(FloatArray, x.copy())
     spec, n_fft, pad = _lowpass_spectrum(x, fs, cutoff, passband)
     if n_fft % 2 == 0 and up > 1:
         spec[..., -1] *= 0.5  # the Nyquist bin splits in two when zero-padded
     y = scipy.fft.irfft(spec, n=n_fft * up, axis=-1)
     if up > 1:
         y *= up
-    return y[..., pad * up: (pad + n) * up]
+    return cast(FloatArray, y[..., pad * up: (pad + n) * up])

@@ -22,7 +22,7 @@ Example
 (2, 2048)
 """
 
-from .database import build_database, default_database_path, load_database
+from .database import build_database, default_database_path, load_database, pair_attrs
 from .dynamics import DEFAULT_MIN_FS, SimulationResult, simulate, simulate_sa, system_matrices
 from .fault_types import (
                           FAULT_TYPES,
@@ -59,5 +59,6 @@ __all__ = [
     "system_matrices",
     "build_database",
     "load_database",
+    "pair_attrs",
     "default_database_path",
 ]

@@ -95,6 +95,49 @@ def _pair_repr(pair):
     return text.replace(", helix_angle=0.0)", ")") if not pair.is_helical else text
 
 
+#: Dataset attributes that :func:`load_database` sets from the store's gear pair.
+PAIR_ATTRS = ("pinion_teeth", "gear_teeth", "module", "face_width", "pressure_angle",
+              "helix_angle")
+
+
+def _pair_from_manifest(man: dict) -> GearPair | None:
+    """The store's gear pair, read back from the manifest's ``pair`` text (a GearPair
+    repr, recorded by every store since the first format); None if it cannot be read."""
+    import ast
+
+    try:
+        call = ast.parse(str(man["pair"]), mode="eval").body
+        if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
+                and call.func.id == "GearPair" and not call.args):
+            return None
+        fields = {k.arg: _literal(k.value) for k in call.keywords if k.arg}
+        if len(fields) != len(call.keywords):   # a **mapping
+            return None
+        return GearPair(**fields)   # fields absent from older texts take their defaults
+    except (KeyError, SyntaxError, ValueError, TypeError, GearshotError):
+        return None
+
+
+def _literal(node):
+    """A literal of a repr, numpy scalars (``np.float64(0.003)``, numpy >= 2) included."""
+    import ast
+
+    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+            and isinstance(node.func.value, ast.Name) and node.func.value.id in ("np", "numpy")
+            and node.func.attr in ("float64", "float32", "int64", "int32")
+            and len(node.args) == 1 and not node.keywords):
+        return ast.literal_eval(node.args[0])
+    return ast.literal_eval(node)
+
+
+def pair_attrs(pair: GearPair) -> dict:
+    """A gear pair as database attributes (:data:`PAIR_ATTRS`: teeth, m, rad)."""
+    return {"pinion_teeth": int(pair.z_pinion), "gear_teeth": int(pair.z_gear),
+            "module": float(pair.module), "face_width": float(pair.face_width),
+            "pressure_angle": float(pair.pressure_angle),
+            "helix_angle": float(pair.helix_angle)}
+
+
 def _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
               fault_types=("ftff",), paired=False):
     man = {"format": _FORMAT, "pair": _pair_repr(pair), "speeds": [float(s) for s in speeds],
@@ -593,6 +636,14 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
         store built with ``paired=True``); coords ``fault_size``, ``grade``, ``seed``
         and ``fault_type`` along ``signal``; scalar ``speed`` (rev/s) and ``load`` (N m).
         Blocks are concatenated along ``signal`` (grades outer, fault types inner).
+        Attributes: the store's gear pair (:data:`PAIR_ATTRS`: ``pinion_teeth``,
+        ``gear_teeth``, ``module`` and ``face_width`` in m, ``pressure_angle`` and
+        ``helix_angle`` in rad), read from the pair every store's manifest records
+        (fields missing from an older store's text take the :class:`GearPair`
+        defaults; a manifest whose pair cannot be read gives no pair attributes, and
+        the estimator then falls back as :class:`~gearshot.estimator.OneFaultShotEstimator`
+        says). The SAs' cycle is one revolution of the ``gear_teeth`` wheel, so
+        ``gear_teeth`` is their gear-mesh order.
     """
     import xarray as xr
 
@@ -650,4 +701,7 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
     parts = [p.drop_vars(["speed", "load"]) for p in parts]
     ds = parts[0] if len(parts) == 1 else xr.concat(parts, dim="signal", coords="minimal",
                                                     compat="override")
+    pair = _pair_from_manifest(man)
+    if pair is not None:
+        ds.attrs.update(pair_attrs(pair))
     return ds.assign_coords(speed=float(man["speeds"][i]), load=float(man["loads"][j]))

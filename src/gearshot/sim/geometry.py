@@ -19,6 +19,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_positive
+from ..paper import FACE_WIDTH, GEAR_TEETH, MODULE, PINION_TEETH, PRESSURE_ANGLE_DEG
 
 __all__ = ["GearPair"]
 
@@ -71,11 +72,11 @@ class GearPair:
         ``bearing_stiffness``.
     """
 
-    z_pinion: int = 17
-    z_gear: int = 38
-    module: float = 3e-3
-    face_width: float = 15e-3
-    pressure_angle: float = math.radians(20.0)
+    z_pinion: int = PINION_TEETH
+    z_gear: int = GEAR_TEETH
+    module: float = MODULE
+    face_width: float = FACE_WIDTH
+    pressure_angle: float = math.radians(PRESSURE_ANGLE_DEG)
     youngs_modulus: float = 210e9
     poisson: float = 0.3
     density: float = 7850.0
@@ -130,9 +131,10 @@ class GearPair:
     def paper(cls, **overrides) -> GearPair:
         """The pair of Matania et al. (2023): 17/38 teeth, m 3 mm, b 15 mm, 20 deg, steel,
         wheel masses 0.8 / 3.2 kg, 5 % modal damping. Keyword overrides are applied."""
-        base: dict[str, Any] = dict(z_pinion=17, z_gear=38, module=3e-3, face_width=15e-3,
-                    pressure_angle=math.radians(20.0), youngs_modulus=210e9, poisson=0.3,
-                    mass_pinion=0.8, mass_gear=3.2, damping_ratio=0.05)
+        base: dict[str, Any] = dict(z_pinion=PINION_TEETH, z_gear=GEAR_TEETH, module=MODULE,
+                    face_width=FACE_WIDTH, pressure_angle=math.radians(PRESSURE_ANGLE_DEG),
+                    youngs_modulus=210e9, poisson=0.3, mass_pinion=0.8, mass_gear=3.2,
+                    damping_ratio=0.05)
         base.update(overrides)
         return cls(**base)
 

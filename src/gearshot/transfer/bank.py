@@ -32,9 +32,16 @@ class TransferFunctionBank:
 
     Examples
     --------
-    >>> bank = TransferFunctionBank.from_folder("../shared/data/frf")   # doctest: +SKIP
-    >>> selection_tf, rest = bank.hold_out(0)                          # doctest: +SKIP
-    >>> grid = rest.to_signal_grid(2048)   # (n_tf, 2048) complex       # doctest: +SKIP
+    A bank of measured TFs is read with ``TransferFunctionBank.from_folder(folder)``
+    (e.g. ``"../shared/data/frf"``); a seeded synthetic one works alike:
+
+    >>> from gearshot.transfer import TransferFunctionBank
+    >>> bank = TransferFunctionBank.synthetic(4, rng=0)
+    >>> selection_tf, rest = bank.hold_out(0)
+    >>> selection_tf.name == bank.names[0], len(rest)
+    (True, 3)
+    >>> rest.to_signal_grid(2048).shape       # complex, on the SA's DFT grid
+    (3, 2048)
     """
 
     def __init__(self, tfs: Iterable[TransferFunction], *, names: Iterable[str] | None = None):
@@ -170,5 +177,14 @@ def synthetic_bank(n: int, **kwargs) -> TransferFunctionBank:
     The FRFs of :func:`gearshot.transfer.modal.synthetic_tfs` (same arguments: ``band``,
     ``n_lines``, ``rng`` — required —, ``n_modes``, ``damping``, ``attenuation``,
     ``nonminimum_fraction``) as a :class:`TransferFunctionBank`.
+
+    Examples
+    --------
+    >>> from gearshot.transfer import synthetic_bank
+    >>> bank = synthetic_bank(3, rng=0)
+    >>> bank.names
+    ('synthetic_000', 'synthetic_001', 'synthetic_002')
+    >>> bank["synthetic_000"].n_lines
+    1001
     """
     return TransferFunctionBank(synthetic_tfs(n, **kwargs))

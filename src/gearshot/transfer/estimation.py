@@ -42,6 +42,16 @@ def resample_transfer_function(tf_one_sided, n_out) -> np.ndarray:
     Returns
     -------
     ndarray of complex, shape (n_out,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.transfer import resample_transfer_function
+    >>> tf = resample_transfer_function(np.full(5, 2.0 + 0j), 8)    # a constant gain of 2
+    >>> print(np.round(np.abs(tf), 3))
+    [2. 2. 2. 2. 2. 2. 2. 2.]
+    >>> bool(np.allclose(tf[1:], np.conj(tf[1:][::-1])))          # Hermitian: real signals
+    True
     """
     tf = as_signal_array(tf_one_sided, "tf_one_sided", max_ndim=1, min_length=2,
                          allow_complex=True).astype(complex)
@@ -91,6 +101,25 @@ def estimate_transfer_function(healthy_signal, n_out, *, nfft=2**15, segment_siz
     -------
     ndarray of complex, shape (n_out,)
         Minimum-phase transfer-function estimate on the ``n_out``-point DFT grid.
+
+    Examples
+    --------
+    White noise has a flat spectrum: the estimate is flat, near the noise's unit level
+    (the median background sits a little below the mean). Noise through a low-pass is
+    estimated falling with frequency.
+
+    >>> import numpy as np
+    >>> import scipy.signal
+    >>> from gearshot.transfer import estimate_transfer_function
+    >>> noise = np.random.default_rng(0).standard_normal(2**16)
+    >>> tf = estimate_transfer_function(noise, 2048)
+    >>> tf.shape
+    (2048,)
+    >>> bool(np.all((np.abs(tf) > 0.8) & (np.abs(tf) < 1.1)))
+    True
+    >>> low = estimate_transfer_function(scipy.signal.lfilter([1.0], [1.0, -0.9], noise), 2048)
+    >>> bool(np.abs(low[1]) > 10 * np.abs(low[1024]))     # order 1 against Nyquist
+    True
     """
     x = as_signal_array(healthy_signal, "healthy_signal", max_ndim=1)
     spectrum = amplitude_spectrum(x, nfft=nfft)
@@ -118,6 +147,16 @@ def propagate(signals, tf) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n)
+
+    Examples
+    --------
+    A one-sample delay, ``exp(-2πi k / n)``, moves a cycle one sample later (circularly):
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import propagate
+    >>> k = np.fft.fftfreq(8, 1 / 8)
+    >>> print(np.round(propagate(np.arange(8.0), np.exp(-2j * np.pi * k / 8)), 3) + 0.0)
+    [7. 0. 1. 2. 3. 4. 5. 6.]
     """
     signals = as_signal_array(signals, "signals", min_length=2)
     tf = as_signal_array(tf, "tf", max_ndim=1, allow_complex=True)
@@ -144,6 +183,14 @@ def rms_normalize(signals, reference) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n)
+
+    Examples
+    --------
+    The references' RMS values are 1 and 3, their mean 2:
+
+    >>> from gearshot.transfer import rms_normalize
+    >>> print(rms_normalize([[2.0, -2.0, 2.0, -2.0]], [[1.0, -1.0], [3.0, -3.0]]))
+    [[ 1. -1.  1. -1.]]
     """
     signals = as_signal_array(signals, "signals")
     scale = mean_rms(as_signal_array(reference, "reference"))

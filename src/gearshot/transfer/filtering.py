@@ -39,6 +39,19 @@ def fir_from_transfer_function(tf: TransferFunction, fs: float, *, n_taps: int |
     -------
     numpy.ndarray, shape (n_taps,)
         Impulse response samples (per sample: a unit-sample input gives this output).
+
+    Examples
+    --------
+    A flat gain of 0.5 up to 500 Hz at 1 kHz: a single tap of 0.5.
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import TransferFunction, fir_from_transfer_function
+    >>> flat = TransferFunction(np.linspace(0.0, 500.0, 501), np.full(501, 0.5 + 0j))
+    >>> taps = fir_from_transfer_function(flat, 1000.0)
+    >>> taps.shape
+    (1000,)
+    >>> print(np.round(taps[:3], 3) + 0.0)
+    [0.5 0.  0. ]
     """
     if not isinstance(tf, TransferFunction):
         raise GearshotError(f"tf must be a TransferFunction; got {type(tf).__name__}")
@@ -89,6 +102,15 @@ def filter_signal(x, fs: float, tf: TransferFunction, *, n_taps: int | None = No
     -------
     numpy.ndarray, shape (..., n_samples)
         The filtered signal(s) in the TF's output units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.transfer import TransferFunction, filter_signal
+    >>> flat = TransferFunction(np.linspace(0.0, 500.0, 501), np.full(501, 0.5 + 0j))
+    >>> x = np.sin(2 * np.pi * 50 * np.arange(1000) / 1000.0)
+    >>> bool(np.allclose(filter_signal(x, 1000.0, flat), 0.5 * x))
+    True
     """
     x = as_signal_array(x, "x", min_ndim=1)
     acausal_fraction = check_in_range(acausal_fraction, "acausal_fraction", 0.0, 0.5)

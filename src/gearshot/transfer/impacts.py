@@ -101,6 +101,26 @@ def frf_from_impacts(force, response, fs: float, *, estimator: str = "H1",
     GearshotError
         On mismatched shapes, non-finite samples, bad options, or a force spectrum that is
         zero at some line.
+
+    Examples
+    --------
+    Three hammer pulses into a single-mode system (a resonator at 300 Hz, sampled at
+    4096 Hz, fully decayed within the record): H1 peaks at the mode with coherence 1.
+
+    >>> import numpy as np
+    >>> import scipy.signal
+    >>> from gearshot.transfer import frf_from_impacts
+    >>> fs, w0, r = 4096.0, 2 * np.pi * 300 / 4096.0, 0.99
+    >>> force = np.zeros((3, 4096))
+    >>> for i in range(3):
+    ...     force[i, 40 + 7 * i: 46 + 7 * i] = 80.0 * np.sin(np.pi * np.arange(6) / 6)
+    >>> response = scipy.signal.lfilter([0.5, 0.0, -0.5], [1, -2 * r * np.cos(w0), r**2],
+    ...                                 force, axis=-1)
+    >>> tf, coherence = frf_from_impacts(force, response, fs, force_window=None)
+    >>> print(round(float(tf.freqs[np.argmax(np.abs(tf.values))]), 1))
+    300.0
+    >>> print(round(float(np.median(coherence)), 3))
+    1.0
     """
     fs = check_positive(fs, "fs")
     if estimator not in _ESTIMATORS:
@@ -166,6 +186,16 @@ def impact_arrays(records: Sequence[UffRecord], *, response_quantity: str | None
     force, response : numpy.ndarray, shape (n_impacts, n_samples)
     fs : float
         Common sampling rate in Hz.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.transfer import UffRecord, impact_arrays
+    >>> records = [UffRecord(np.r_[1.0, np.zeros(7)], 1000.0, quantity="force"),
+    ...            UffRecord(np.linspace(0.0, 1.0, 8), 1000.0, quantity="acceleration")]
+    >>> force, response, fs = impact_arrays(records)
+    >>> force.shape, response.shape, fs
+    ((1, 8), (1, 8), 1000.0)
     """
     recs = list(records)
     if not recs or not all(isinstance(r, UffRecord) for r in recs):

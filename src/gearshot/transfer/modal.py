@@ -85,6 +85,21 @@ def modal_frf(freqs, modes: Sequence[Mode], *, quantity: str = "accelerance",
     -------
     TransferFunction
         ``metadata`` holds the model (``modes``, ``rigid_body``, ``delay_s``, ``allpass``).
+
+    Examples
+    --------
+    Two modes of the same sign: two resonances with an antiresonance between them.
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import Mode, antiresonances, modal_frf
+    >>> tf = modal_frf(np.linspace(0.0, 1000.0, 1001),
+    ...                [Mode(200.0, 0.02, 1.0), Mode(600.0, 0.02, 1.0)])
+    >>> tf.n_lines
+    1001
+    >>> print(float(tf.freqs[np.argmax(np.abs(tf.values))]))     # the accelerance peaks high
+    601.0
+    >>> print(antiresonances(tf))
+    [447.]
     """
     f = as_signal_array(freqs, "freqs", min_ndim=1, max_ndim=1, min_length=2)
     if quantity not in _QUANTITIES:
@@ -139,6 +154,16 @@ def attenuation_db(tf: TransferFunction) -> float:
 
     This is the level drop that white noise suffers through the TF (10 dB or more for the
     paper's measured TFs together with their attenuation factor α).
+
+    Examples
+    --------
+    A flat gain of 0.5 attenuates by 20·log10(2) dB:
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import TransferFunction, attenuation_db
+    >>> flat = TransferFunction(np.linspace(0.0, 500.0, 501), np.full(501, 0.5 + 0j))
+    >>> print(round(attenuation_db(flat), 3))
+    6.021
     """
     rms = float(np.sqrt(np.mean(tf.magnitude**2)))
     return float(-20 * np.log10(rms)) if rms > 0 else float("inf")
@@ -153,6 +178,18 @@ def antiresonances(tf: TransferFunction, *, min_depth_db: float = 10.0) -> np.nd
     *rises* (by more than π/4 between the lines where |H| is back 3 dB above the minimum).
     The phase rise tells a zero from a mere trough between two resonances whose residues
     change sign (there the phase keeps falling).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.transfer import Mode, antiresonances, modal_frf
+    >>> freqs = np.linspace(0.0, 1000.0, 1001)
+    >>> same_sign = modal_frf(freqs, [Mode(200.0, 0.02, 1.0), Mode(600.0, 0.02, 1.0)])
+    >>> print(antiresonances(same_sign))
+    [447.]
+    >>> opposite = modal_frf(freqs, [Mode(200.0, 0.02, 1.0), Mode(600.0, 0.02, -1.0)])
+    >>> print(antiresonances(opposite))     # a trough between the modes, not a zero
+    []
     """
     min_depth_db = check_positive(min_depth_db, "min_depth_db", allow_zero=True)
     mag = 20 * np.log10(np.maximum(tf.magnitude, np.finfo(float).tiny))
@@ -216,6 +253,15 @@ def synthetic_tfs(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines:
     Returns
     -------
     list of TransferFunction
+
+    Examples
+    --------
+    >>> from gearshot.transfer import attenuation_db, synthetic_tfs
+    >>> tfs = synthetic_tfs(2, rng=0)
+    >>> len(tfs), tfs[0].n_lines
+    (2, 1001)
+    >>> all(10.0 <= attenuation_db(tf) <= 20.0 for tf in tfs)
+    True
     """
     n = check_int(n, "n", minimum=1)
     n_lines = check_int(n_lines, "n_lines", minimum=16)

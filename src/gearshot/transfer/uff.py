@@ -203,6 +203,19 @@ def read_frf(path: str | os.PathLike, *, index: int = 0) -> TransferFunction:
         Naming the file and the problem: missing or empty file, unknown suffix, a truncated or
         corrupt dataset, no dataset 58 of function type 4, NaN/inf values, a frequency axis that
         is not strictly increasing.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> import tempfile
+    >>> import numpy as np
+    >>> from gearshot.transfer import TransferFunction, read_frf, write_frf
+    >>> tf = TransferFunction(np.arange(8.0), np.arange(8.0) + 1j, name="small")
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     write_frf(pathlib.Path(folder) / "small.uff", tf)
+    ...     back = read_frf(pathlib.Path(folder) / "small.uff")
+    >>> back.name, back.n_lines, back == tf
+    ('small', 8, True)
     """
     p = _as_path(path)
     index = check_int(index, "index", minimum=0)
@@ -326,6 +339,24 @@ def write_frf(path: str | os.PathLike, tf: TransferFunction, *,
         float64. ``None`` (default) writes ASCII when that reproduces ``tf`` exactly (as for
         the measured files) and binary 58b otherwise, so :func:`read_frf` always returns the
         same numbers. CSV is written with 17 significant digits (exact round trip).
+
+    Examples
+    --------
+    CSV and UFF58 both give the same numbers back:
+
+    >>> import pathlib
+    >>> import tempfile
+    >>> import numpy as np
+    >>> from gearshot.transfer import TransferFunction, read_frf, write_frf
+    >>> tf = TransferFunction(np.linspace(0.0, 100.0, 11), np.exp(-1j * np.arange(11) / 3))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     for name in ("tf.csv", "tf.uff"):
+    ...         write_frf(pathlib.Path(folder) / name, tf)
+    ...         back = read_frf(pathlib.Path(folder) / name)
+    ...         print(name, np.array_equal(back.freqs, tf.freqs),
+    ...               np.array_equal(back.values, tf.values))
+    tf.csv True True
+    tf.uff True True
     """
     p = _as_path(path)
     if not isinstance(tf, TransferFunction):
@@ -406,6 +437,31 @@ def read_uff_records(path: str | os.PathLike) -> list[UffRecord]:
     GearshotError
         Naming the file and the problem (as :func:`read_frf`; also when no time record exists
         or a record's abscissa is not evenly spaced).
+
+    Examples
+    --------
+    A hammer-test export with one force and one acceleration record (written here with
+    pyuff, as a measurement system would):
+
+    >>> import pathlib
+    >>> import tempfile
+    >>> import numpy as np
+    >>> import pyuff
+    >>> from gearshot.transfer import impact_arrays, read_uff_records
+    >>> def record(quantity_code, data):
+    ...     return {"type": 58, "func_type": 1, "binary": 0, "rsp_node": 1, "rsp_dir": 3,
+    ...             "ref_node": 1, "ref_dir": 3, "abscissa_spacing": 1,
+    ...             "abscissa_spec_data_type": 17, "ordinate_spec_data_type": quantity_code,
+    ...             "orddenom_spec_data_type": 0,
+    ...             "x": np.arange(data.size) / 1000.0, "data": data}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "hammer.uff"
+    ...     uff = pyuff.UFF(str(path))
+    ...     uff.write_sets(record(13, np.r_[1.0, np.zeros(15)]), mode="add")
+    ...     uff.write_sets(record(12, np.linspace(0.0, 1.0, 16)), mode="add")
+    ...     records = read_uff_records(path)
+    >>> [(r.quantity, r.data.size, r.fs) for r in records]
+    [('force', 16, 1000.0), ('acceleration', 16, 1000.0)]
     """
     p = _as_path(path)
     if p.suffix.lower() not in UFF_SUFFIXES:
