@@ -9,13 +9,14 @@ synchronous averages). Options are keyword-only. Bad input raises
 from .alignment import fractional_shift, subtract_healthy
 from .angle import check_pulse_train, gear_cycle_times
 from .angular import angle_to_time, angular_resample, pulse_times
+from .antialias import antialias_filter
 from .averaging import synchronous_average
 from .cepstrum import minimum_phase, real_cepstrum
 from .envelope import envelope
 from .level import mean_rms, rms
 from .orders import difference_signal, harmonic_signal, mesh_band_orders, order_mask
 from .spectra import acs_background, amplitude_spectrum
-from .trains import antialias_filter, shaft_cycle_times
+from .trains import shaft_cycle_times
 
 __all__ = [
     "pulse_times",
