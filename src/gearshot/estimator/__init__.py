@@ -12,6 +12,7 @@
 from .._errors import NotFittedError
 from . import steps, uncertainty
 from ._model import STEP_SEEDS, OneFaultShotEstimator
+from ._params import check_estimator_params
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -53,4 +54,5 @@ __all__ = [
     "signature_weights",
     "save_estimator",
     "load_estimator",
+    "check_estimator_params",
 ]
