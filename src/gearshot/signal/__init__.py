@@ -7,7 +7,7 @@ synchronous averages). Options are keyword-only. Bad input raises
 """
 
 from .alignment import fractional_shift, subtract_healthy
-from .angle import check_pulse_train, gear_cycle_times
+from .angle import check_pulse_train
 from .angular import angle_to_time, angular_resample, pulse_times
 from .antialias import antialias_filter
 from .averaging import synchronous_average
@@ -25,7 +25,6 @@ __all__ = [
     "antialias_filter",
     "shaft_cycle_times",
     "check_pulse_train",
-    "gear_cycle_times",
     "synchronous_average",
     "harmonic_signal",
     "difference_signal",
