@@ -6,6 +6,9 @@ and exceptions other than GearshotError (or RuntimeWarnings) from the public API
 
     PYTHONPATH=src python benchmarks/failure_paths.py
 
+It ends with the cases of issue #22 (``benchmarks/integrity_paths.py``: concurrent builds,
+manifest tampering, zeroed recordings and crafted model files, a full disk, exit 3).
+
 The API table and the fuzz strategies are those of tests/test_reliability.py (imported from
 there, so the benchmark and the tests cannot drift apart); here each fuzzed function gets
 120 examples instead of CI's 60.
@@ -197,6 +200,14 @@ def main() -> None:
     print(f"fuzzed calls: {n_fuzz} over {len(rel.FUZZ)} functions; non-GearshotError "
           f"exceptions or RuntimeWarnings {n_fuzz_bad}")
     print(f"({time.perf_counter() - t0:.0f} s)")
+
+    # issue #22: concurrency, manifest tampering, hostile files, disk full, exit 3
+    print()
+    spec22 = importlib.util.spec_from_file_location("integrity_paths",
+                                                    ROOT / "benchmarks" / "integrity_paths.py")
+    integrity = importlib.util.module_from_spec(spec22)
+    spec22.loader.exec_module(integrity)
+    integrity.main(trials=10)
 
 
 if __name__ == "__main__":

@@ -48,16 +48,20 @@ def small(tmp_path_factory):
 def test_indicators_json_layout_and_figures(small, tmp_path):
     out = tmp_path / "ind.json"
     figs = tmp_path / "figs"
-    res = run("indicators", "--machine", str(SPUR), "--shaft", "idler", str(small["spur2"]),
-              str(small["spur3"]), "--json", str(out), "--out", str(figs))
+    res = run("indicators", "--machine", str(SPUR), "--shaft", "idler", "--sensor",
+              "acc_input", str(small["spur2"]), str(small["spur3"]), "--json", str(out),
+              "--out", str(figs))
     assert res.returncode == 0, res.stderr
     payload = json.loads(out.read_text())
-    assert list(payload) == ["records"] and len(payload["records"]) == 2
+    assert payload["kind"] == "indicators" and len(payload["records"]) == 2
     want = {*available_features(), "rms_raw", "rms_residual"}
     for rec, name in zip(payload["records"], ("spur2", "spur3")):
-        assert list(rec) == ["file", "speed_hz", "n_cycles", "indicators"]
-        assert rec["file"] == f"{name}_30hz_High_1.zip"
-        assert 29.0 < rec["speed_hz"] < 30.0  # read from the tacho, input shaft
+        assert list(rec) == ["file", "sensor", "tacho_speed_hz", "shaft_speed_hz",
+                             "speed_source", "speed_uncertainty_hz", "n_cycles", "indicators"]
+        assert rec["file"] == f"{name}_30hz_High_1.zip" and rec["sensor"] == "acc_input"
+        assert rec["speed_source"] == "tacho" and rec["speed_uncertainty_hz"] is None
+        assert 29.0 < rec["tacho_speed_hz"] < 30.0  # read from the tacho, input shaft
+        assert rec["shaft_speed_hz"] == pytest.approx(rec["tacho_speed_hz"] / 3)  # 32 -> 96
         assert rec["n_cycles"] == 14  # 1.5 s at ~29.9 Hz: 44 whole input revs, 14 idler revs
         assert set(rec["indicators"]) == want
         assert all(isinstance(v, float) for v in rec["indicators"].values())
@@ -67,7 +71,7 @@ def test_indicators_json_layout_and_figures(small, tmp_path):
               "acc_output", str(small["spur2"]), "--baseline", str(small["spur3"]),
               "--json", str(out))
     assert res.returncode == 0, res.stderr
-    assert json.loads(out.read_text())["records"][0]["n_cycles"] == 44
+    assert [r["n_cycles"] for r in json.loads(out.read_text())["records"]] == [44]
 
 
 @pytest.mark.parametrize("args, words", [
@@ -91,7 +95,8 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--grade", "6", "--grade", "7", "--n-healthy", "6", "--n-faulty", "24",
               "--store", str(store), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    assert "pair 96 -> 32 teeth" in res.stdout and "[10.0]" in res.stdout
+    assert "pair 96 -> 32 teeth" in res.stdout and "input (tacho) shaft 30 Hz" in res.stdout
+    assert "rev/s" not in res.stdout     # no internal (idler) speeds
     # a machine's database is paired by default (each signal's healthy twin stored)
     assert json.loads((store / "manifest.json").read_text()).get("paired") is True
     out = tmp_path / "pred.csv"
@@ -109,3 +114,18 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     assert (frame["role"] == "faulty_rest").sum() == 3
     assert (frame["role"] == "test").sum() == 4
     assert (frame["role"] == "healthy_holdout").sum() == 1
+    # issue #19 item 5: every estimate says whether the segment looks like the fitted
+    # machine; spur1 (another build) does not, spur3 held out and spur2's rest do
+    assert frame["comparable"].dtype == bool and frame["comparability"].ge(0).all()
+    assert not frame.loc[frame["role"] == "test", "comparable"].any()
+    assert frame.loc[frame["role"] != "test", "comparable"].all()
+    assert "comparable: 4 segment(s), not comparable: 4" in res.stdout
+    out_json = tmp_path / "pred.json"
+    res = run("predict", "--machine", str(SPUR), "--database", str(store), "--healthy",
+              str(small["spur3"]), "--faulty", str(small["spur2"]), "--faulty-size", "0.5",
+              "--recordings", str(small["spur1"]), "--speed", "30", "--load", "10",
+              "--cycles-per-segment", "10", "--out", str(out_json), env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    records = json.loads(out_json.read_text())
+    assert [r["comparable"] for r in records] == frame["comparable"].tolist()
+    assert all(isinstance(r["comparable"], bool) for r in records)

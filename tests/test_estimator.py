@@ -252,7 +252,7 @@ def test_zero_shot_soft_weights_are_a_distribution_over_grades(data):
 
 
 def test_save_and_load_round_trip(fitted, data, tmp_path):
-    path = tmp_path / "model.joblib"
+    path = tmp_path / "model.skops"
     fitted.save(path)
     again = OneFaultShotEstimator.load(path)
     assert_array_equal(again.predict(data[3]), fitted.predict(data[3]))
@@ -274,7 +274,6 @@ def test_save_and_load_round_trip(fitted, data, tmp_path):
         (lambda a: a.update(db=a["db"].where(a["db"].fault_size > 0, drop=True)),
          ["healthy", "database"]),
         (lambda a: a.update(example=None), ["faulty_example", "zero_shot"]),
-        (lambda a: a.update(sel=None), ["selection_tf"]),
         (lambda a: a.update(long=None), ["healthy_long"]),
     ],
 )
@@ -290,6 +289,22 @@ def test_bad_input_names_the_argument(data, tf_pair, change, words):
     message = str(info.value).lower()
     for word in words:
         assert word in message, message
+
+
+def test_selection_tf_defaults_to_the_cli_synthetic_tf(data):
+    """Issue #20: fit without selection_tf uses default_selection_tf(random_state), the
+    TF the command line passes; the same fit as passing it explicitly."""
+    from gearshot.estimator import default_selection_tf
+
+    db, healthy, long, faulty, y = data
+    kw = dict(random_state=3, grades=[3], nominal_grade=NOMINAL)
+    implicit = OneFaultShotEstimator(**kw).fit(db, healthy, faulty[20], y[20], long)
+    explicit = OneFaultShotEstimator(**kw).fit(db, healthy, faulty[20], y[20], long,
+                                               selection_tf=default_selection_tf(3))
+    assert implicit.selected_features_ == explicit.selected_features_
+    assert_array_equal(implicit.predict(faulty), explicit.predict(faulty))
+    assert not np.allclose(default_selection_tf(3).to_signal_grid(64),
+                           default_selection_tf(4).to_signal_grid(64))
 
 
 def test_bad_parameters_are_reported_at_fit(data):

@@ -409,8 +409,33 @@ FUZZ = {
                                  list(available_features())), min_size=1, max_size=3), _arg),
                              "n_sidebands": _ints, "baseline_variance": _nums})),
     "na4_baseline_variance": (na4_baseline_variance, st.tuples(_arrays, _ints), st.just({})),
+    "regular_signal": (gs.regular_signal, st.tuples(_arrays, _ints),
+                       st.fixed_dictionaries({}, optional={"n_sidebands": _ints,
+                                                           "shaft_orders": _arg})),
+    "residual_signal": (gs.residual_signal, st.tuples(_arrays, _ints),
+                        st.fixed_dictionaries({}, optional={"shaft_orders": _arg})),
+    "nonsynchronous_signal": (gs.nonsynchronous_signal, st.tuples(_arrays, _ints),
+                              st.just({})),
+    "speed_ridge": (gs.speed_ridge, st.tuples(_arrays, _nums),
+                    st.fixed_dictionaries({"orders": _arg, "speed_range": _arg},
+                                          optional={"n_harmonics": _ints, "window": _nums,
+                                                    "max_rate": _nums, "smooth": _nums,
+                                                    "track": _ints})),
+    "demodulate_angle": (gs.demodulate_angle, st.tuples(_arrays, _nums),
+                         st.fixed_dictionaries({"order": _ints, "ridge_times": _arg,
+                                                "ridge_speed": _arg},
+                                               optional={"bandwidth": _nums})),
+    "angle_pulse_times": (gs.angle_pulse_times, st.tuples(_arg, _arg),
+                          st.fixed_dictionaries({}, optional={"pulses_per_rev": _ints})),
+    "estimate_shaft_angle": (gs.estimate_shaft_angle, st.tuples(_arrays, _nums),
+                             st.fixed_dictionaries({"orders": _arg, "speed_range": _arg},
+                                                   optional={"bandwidth": _nums,
+                                                             "min_snr_db": _nums,
+                                                             "max_wander": _nums,
+                                                             "min_lines": _ints,
+                                                             "pulses_per_rev": _ints})),
 }
-#: cases per function; 21 functions × 60 = 1,260 fuzzed calls in CI
+#: cases per function; 28 functions × 60 = 1,680 fuzzed calls in CI
 FUZZ_EXAMPLES = 60
 
 

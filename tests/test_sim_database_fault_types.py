@@ -68,6 +68,12 @@ def test_store_of_an_older_fault_model_is_refused(tmp_path, store):
     shutil.copytree(store, old)
     del man["fault_models"]                 # as written before model versions existed
     (old / "manifest.json").write_text(json.dumps(man))
+    for block in (old / "blocks").glob("*.zarr"):   # ... and the blocks' records then
+        meta = json.loads((block / "zarr.json").read_text())
+        record = meta["attributes"]["gearshot_block"]
+        record["manifest"] = man
+        del record["manifest_sha256"]
+        (block / "zarr.json").write_text(json.dumps(meta))
     with pytest.raises(GearshotError, match=r"'breakage' SAs of an older model.*"
                                             r"version None, current 2"):
         load_database(old, speed=15, load=10, fault_type="breakage")

@@ -21,8 +21,11 @@ import contextlib
 import errno
 import json
 import os
+import re
 import shutil
+import socket
 import tempfile
+import zlib
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -38,6 +41,7 @@ __all__ = [
     "check_writable",
     "remove_tree",
     "os_error_text",
+    "remove_stale_temporaries",
 ]
 
 
@@ -56,7 +60,8 @@ def _is_io_error(exc: BaseException) -> bool:
 
 
 def _fail(path: Path, exc: BaseException, what: str = "write") -> GearshotError:
-    return GearshotError(f"cannot {what} {str(path)!r}: {os_error_text(exc)}")
+    text = " ".join(os_error_text(exc).split())     # libraries' messages may span lines
+    return GearshotError(f"cannot {what} {str(path)!r}: {text}")
 
 
 def check_writable(path: str | os.PathLike, name: str, *, folder: bool = False) -> Path:
@@ -94,6 +99,26 @@ def check_writable(path: str | os.PathLike, name: str, *, folder: bool = False) 
     return path
 
 
+def _umask() -> int:
+    """The process's file-creation mask: from ``/proc/self/status`` where there is one (no
+    race with other threads), else by setting and restoring it."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _user_mode(path: Path, *, folder: bool = False) -> None:
+    """Give a temporary file (0600 from :func:`tempfile.mkstemp`) or folder (0700 from
+    :func:`tempfile.mkdtemp`) the mode a plain ``open``/``mkdir`` would have: 0666 or 0777
+    less the user's umask, so that the renamed result is as readable as any other file."""
+    os.chmod(path, (0o777 if folder else 0o666) & ~_umask())
+
+
 def _fsync_file(path: Path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
@@ -109,6 +134,48 @@ def _fsync_dir(path: Path) -> None:
             os.fsync(fd)
         finally:
             os.close(fd)
+
+
+_HOST = format(zlib.crc32(socket.gethostname().encode()), "08x")[:6]
+_STALE = re.compile(r"^\..+\.g(\d+)@([0-9a-f]{6})-[^/]*\.tmp")
+
+
+def _temp_prefix(path: Path) -> str:
+    """``.<name>.g<pid>@<host>-``: the temporaries of this process, recognisable later."""
+    return f".{path.name}.g{os.getpid()}@{_HOST}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:          # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Remove temporaries in ``folder`` left by killed processes of this host.
+
+    A temporary of :func:`atomic_path` / :func:`atomic_dir` carries its process id and a
+    host tag in its name; it is removed when that process no longer exists (a process of
+    another host, or one still alive, keeps its temporaries). Returns what was removed.
+    """
+    removed = []
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(os.fspath(folder)):
+            m = _STALE.match(entry.name)
+            if m is None or m.group(2) != _HOST or _alive(int(m.group(1))):
+                continue
+            target = Path(entry.path)
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(target, ignore_errors=True)
+            else:
+                with contextlib.suppress(OSError):
+                    target.unlink()
+            removed.append(target)
+    return removed
 
 
 def _make_folder(folder: Path, target: Path) -> None:
@@ -141,14 +208,16 @@ def atomic_path(path: str | os.PathLike, *, make_parents: bool = False) -> Itera
         raise GearshotError(f"cannot write {str(path)!r}: folder {str(folder)!r} {what}")
     if path.exists() and not path.is_file():
         raise GearshotError(f"cannot write {str(path)!r}: it exists and is not a regular file")
+    remove_stale_temporaries(folder)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
+        fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=".tmp" + path.suffix,
                                    dir=folder)
     except OSError as exc:
         raise _fail(path, exc) from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:
+        _user_mode(tmp_path)
         yield tmp_path
         _fsync_file(tmp_path)
         os.replace(tmp_path, path)
@@ -185,16 +254,19 @@ def atomic_dir(path: str | os.PathLike, *, exist_ok: bool = False) -> Iterator[P
     ``exist_ok=True``: if ``path`` appeared meanwhile (another worker finished the same
     folder), the temporary one is discarded and the existing one kept. On any exception the
     temporary folder is removed; OS errors become a :class:`~gearshot.GearshotError`.
-    Leftovers of killed processes are named ``.<name>.<random>.tmp``.
+    Leftovers of killed processes are named ``.<name>.g<pid>@<host>-<random>.tmp`` and
+    removed by the next write into the same folder (:func:`remove_stale_temporaries`).
     """
     path = Path(path)
     folder = path.parent
     _make_folder(folder, path)
+    remove_stale_temporaries(folder)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder))
+        tmp = Path(tempfile.mkdtemp(prefix=_temp_prefix(path), suffix=".tmp", dir=folder))
     except OSError as exc:
         raise _fail(path, exc) from None
     try:
+        _user_mode(tmp, folder=True)
         yield tmp
         for root, _dirs, files in os.walk(tmp):
             for f in files:
@@ -223,8 +295,10 @@ def staging_dir(folder: str | os.PathLike) -> Iterator[Path]:
     """
     folder = Path(folder)
     _make_folder(folder, folder)
+    remove_stale_temporaries(folder)
     try:
-        staging = Path(tempfile.mkdtemp(prefix=".staging-", suffix=".tmp", dir=folder))
+        staging = Path(tempfile.mkdtemp(prefix=f".staging.g{os.getpid()}@{_HOST}-",
+                                        suffix=".tmp", dir=folder))
     except OSError as exc:
         raise _fail(folder, exc) from None
     try:
@@ -240,7 +314,7 @@ def remove_tree(path: str | os.PathLike) -> None:
     path = Path(path)
     if not path.exists():
         return
-    trash = path.with_name(f".{path.name}.removed-{os.getpid()}.tmp")
+    trash = path.with_name(f"{_temp_prefix(path)}removed.tmp")
     try:
         os.rename(path, trash)
     except OSError as exc:

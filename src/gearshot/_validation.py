@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 import numbers
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -22,6 +23,11 @@ __all__ = [
     "finite_result",
     "MAX_ABS",
     "MAX_POINTS",
+    "SPEED_RANGE",
+    "MAX_LOAD",
+    "MAX_FS",
+    "check_speed",
+    "check_load",
 ]
 
 #: Largest magnitude accepted in a signal: its square, sums of squares over millions of
@@ -29,6 +35,12 @@ __all__ = [
 MAX_ABS = 1e100
 #: Largest length/size argument (points per cycle, FFT length, ...): 16 Mi points.
 MAX_POINTS = 1 << 24
+
+#: Physical bounds, checked wherever a speed, load or sampling rate enters: shaft speeds in
+#: rev/s (0.5 rps = 30 rpm up to 60 000 rpm), load torques in N m, sampling rates in Hz.
+SPEED_RANGE = (0.5, 1000.0)
+MAX_LOAD = 1e5
+MAX_FS = 1e8
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -109,8 +121,14 @@ def as_signal_array(
         raise GearshotError(
             f"{name} must have at least {min_length} samples along its last axis; "
             f"got {arr.shape[-1]}")
-    check_finite(arr, name)
-    peak = float(np.max(np.abs(arr)))
+    if np.iscomplexobj(arr):
+        check_finite(arr, name)
+        peak = float(np.max(np.abs(arr)))
+    else:  # two reductions without temporaries: NaN and inf show in the min or the max
+        lo, hi = float(arr.min()), float(arr.max())
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            check_finite(arr, name)
+        peak = max(-lo, hi)
     if max_abs is not None and peak > max_abs:
         raise GearshotError(f"{name} holds a value of magnitude {peak:.3g}; values up to "
                             f"{max_abs:g} are accepted (rescale the units)")
@@ -198,3 +216,20 @@ def check_increasing(x: np.ndarray, name: str, *, unit: str = "") -> np.ndarray:
             f"{name} must be strictly increasing; {name}[{i + 1}]={float(x[i + 1])!r}{unit} "
             f"does not follow {name}[{i}]={float(x[i])!r}{unit}")
     return x
+
+
+def check_speed(value: Any, name: str = "speed") -> float:
+    """A shaft speed in rev/s within :data:`SPEED_RANGE`."""
+    value = check_positive(value, name)
+    lo, hi = SPEED_RANGE
+    if not lo <= value <= hi:
+        raise GearshotError(f"{name} must lie in [{lo:g}, {hi:g}] rev/s; got {value:g}")
+    return value
+
+
+def check_load(value: Any, name: str = "load") -> float:
+    """A load torque in N m in (0, :data:`MAX_LOAD`]."""
+    value = check_positive(value, name)
+    if value > MAX_LOAD:
+        raise GearshotError(f"{name} must lie in (0, {MAX_LOAD:g}] N m; got {value:g}")
+    return value

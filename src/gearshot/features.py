@@ -89,12 +89,16 @@ class _Parts:
 
     @cached_property
     def envelope(self):
-        # analytic signal straight from the one-sided spectrum (as scipy.signal.hilbert)
+        # |analytic signal| (as scipy.signal.hilbert): its real part is the difference
+        # signal, its imaginary part the Hilbert transform, the real inverse FFT of
+        # -i X_k over 0 < k < n/2 (DC and Nyquist give no imaginary part)
         n, half = self.n, self.diff_spectrum
-        analytic = np.zeros(half.shape[:-1] + (n,), dtype=complex)
-        analytic[..., : half.shape[-1]] = half
-        analytic[..., 1:(n + 1) // 2] *= 2.0
-        env = np.abs(scipy.fft.ifft(analytic, axis=-1, overwrite_x=True, workers=_WORKERS))
+        quad = -1j * half
+        quad[..., 0] = 0.0
+        if n % 2 == 0:
+            quad[..., n // 2] = 0.0
+        hilb = scipy.fft.irfft(quad, n=n, axis=-1, workers=_WORKERS)
+        env = np.hypot(self.diff, hilb)
         env -= env.mean(axis=-1, keepdims=True)
         return env
 

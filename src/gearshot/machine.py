@@ -25,6 +25,13 @@ shafts is an exact fraction). It is read from a TOML file (:meth:`Machine.from_t
     pulses_per_rev = 10
     # threshold = 2.5              # optional trigger level, file units
 
+    # No [tacho] table: the speed is estimated from the vibration (gearshot.signal.tracking)
+    # [speed]                      # optional; used only when a recording has no tacho
+    # shaft = "input"              # the shaft tracked (default: the first shaft)
+    # range_hz = [26, 52]          # its speeds searched, rev/s (keep within an octave)
+    # track = 32                   # optional: the order whose phase gives the angle
+    # sensor = "acc_input"         # optional: the sensor tracked (default: the first)
+
     [[sensor]]                     # in order; the first is the default sensor
     name = "acc_input"
     channel = "acc_input"
@@ -63,10 +70,10 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import GearshotError
-from ._validation import describe
+from ._validation import MAX_FS, describe
 
-__all__ = ["Machine", "GearStage", "Tacho", "Sensor", "FileLayout", "MonitoredGear",
-           "parse_sensitivity"]
+__all__ = ["Machine", "GearStage", "Tacho", "VibrationSpeed", "Sensor", "FileLayout",
+           "MonitoredGear", "parse_sensitivity"]
 
 _DELIMITERS = {"whitespace": None, "space": None, ",": ",", "comma": ",", ";": ";",
                "semicolon": ";", "tab": "\t", "\t": "\t"}
@@ -109,8 +116,12 @@ def _rate(value: Any, key: str) -> float:
                                 f"{value!r}") from None
         if frac <= 0:
             raise GearshotError(f"{key} must be > 0 Hz; got {value!r}")
-        return float(frac)
-    return _float(value, key)
+        rate = float(frac) if frac <= MAX_FS else math.inf
+    else:
+        rate = _float(value, key)
+    if rate > MAX_FS:
+        raise GearshotError(f"{key} must be <= {MAX_FS:g} Hz; got {value!r}")
+    return rate
 
 
 def parse_sensitivity(text: Any, *, key: str = "sensitivity") -> tuple[float, str]:
@@ -233,6 +244,49 @@ class Tacho:
 
 
 @dataclass(frozen=True)
+class VibrationSpeed:
+    """No tacho: the speed of ``shaft`` is estimated from the vibration (``[speed]`` table).
+
+    Parameters
+    ----------
+    shaft : str
+        The shaft whose speed and angle are tracked (every other shaft follows through the
+        gear train).
+    speed_range : (float, float) or None
+        Speeds of ``shaft`` searched, rev/s (``range_hz``). ``None``: the recording's
+        nominal ``speed`` ±10 %, else an error.
+    track : int or None
+        Order of ``shaft`` whose phase gives the angle; default: the strongest harmonic of
+        the first gear on ``shaft``.
+    sensor : str or None
+        Sensor whose signal is tracked; default: the first.
+    """
+
+    shaft: str
+    speed_range: tuple[float, float] | None = None
+    track: int | None = None
+    sensor: str | None = None
+
+    def __post_init__(self) -> None:
+        _name(self.shaft, "speed.shaft")
+        if self.speed_range is not None:
+            rng = self.speed_range
+            if not isinstance(rng, (list, tuple)) or len(rng) != 2:
+                raise GearshotError(f"speed.range_hz must be [low, high] (rev/s of the shaft); "
+                                    f"got {describe(rng)}")
+            lo = _float(rng[0], "speed.range_hz[0]")
+            hi = _float(rng[1], "speed.range_hz[1]")
+            if not lo < hi:
+                raise GearshotError(f"speed.range_hz must be [low, high] with low < high; got "
+                                    f"{list(rng)}")
+            object.__setattr__(self, "speed_range", (lo, hi))
+        if self.track is not None:
+            _int(self.track, "speed.track")
+        if self.sensor is not None:
+            _name(self.sensor, "speed.sensor")
+
+
+@dataclass(frozen=True)
 class Sensor:
     """A vibration sensor: its name, file channel, sensitivity and physical unit.
 
@@ -309,7 +363,8 @@ class Machine:
     stages : tuple of GearStage
         Gear meshes; together they must connect every shaft (speed ratios are exact
         fractions of tooth counts).
-    tacho : Tacho
+    tacho : Tacho or None
+        ``None``: no tacho; the speed comes from the vibration (``vibration_speed``).
     sensors : tuple of Sensor
         Vibration sensors; the first is the default.
     layout : FileLayout or None
@@ -326,12 +381,15 @@ class Machine:
         Sidebands removed around every mesh harmonic in the paper's difference signal.
     antialias : bool
         Low-pass the time signal below the angular Nyquist before angular resampling.
+    vibration_speed : VibrationSpeed or None
+        How to estimate the speed from the vibration when a recording has no tacho
+        (``[speed]``); default with no tacho: track the first shaft.
     """
 
     name: str
     shafts: tuple[str, ...]
     stages: tuple[GearStage, ...]
-    tacho: Tacho
+    tacho: Tacho | None
     sensors: tuple[Sensor, ...]
     layout: FileLayout | None = None
     monitored: MonitoredGear | None = None
@@ -340,6 +398,7 @@ class Machine:
     shaft_orders: tuple[int, ...] = (1, 2)
     n_sidebands: int = 2
     antialias: bool = True
+    vibration_speed: VibrationSpeed | None = None
     _ratios: dict[str, Fraction] = field(default_factory=dict, init=False, repr=False,
                                          compare=False)
 
@@ -365,23 +424,35 @@ class Machine:
                 if getattr(st, key) not in known:
                     raise GearshotError(f"stage[{i}].{key}={getattr(st, key)!r} is not one of "
                                         f"the shafts {list(self.shafts)}")
-        if not isinstance(self.tacho, Tacho):
-            raise GearshotError(f"tacho must be a Tacho; got {describe(self.tacho)}")
-        if self.tacho.shaft not in known:
+        if self.tacho is not None and not isinstance(self.tacho, Tacho):
+            raise GearshotError(f"tacho must be a Tacho or None; got {describe(self.tacho)}")
+        if self.tacho is not None and self.tacho.shaft not in known:
             raise GearshotError(f"tacho.shaft={self.tacho.shaft!r} is not one of the shafts "
                                 f"{list(self.shafts)}")
+        if self.vibration_speed is None and self.tacho is None:
+            set_(self, "vibration_speed", VibrationSpeed(self.shafts[0]))
+        if self.vibration_speed is not None:
+            if not isinstance(self.vibration_speed, VibrationSpeed):
+                raise GearshotError(f"vibration_speed must be a VibrationSpeed; got "
+                                    f"{describe(self.vibration_speed)}")
+            if self.vibration_speed.shaft not in known:
+                raise GearshotError(f"speed.shaft={self.vibration_speed.shaft!r} is not one of "
+                                    f"the shafts {list(self.shafts)}")
         if not self.sensors:
             raise GearshotError("the machine needs at least one [[sensor]]")
         names = [s.name for s in self.sensors]
         if len(set(names)) != len(names):
             raise GearshotError(f"sensor names must be unique; got {names}")
+        vs = self.vibration_speed
+        if isinstance(vs, VibrationSpeed) and vs.sensor is not None and vs.sensor not in names:
+            raise GearshotError(f"speed.sensor={vs.sensor!r} is not a sensor; sensors: {names}")
         if self.layout is not None:
             cols = set(self.layout.columns)
             for sensor in self.sensors:
                 if sensor.channel not in cols:
                     raise GearshotError(f"sensor {sensor.name!r}: channel={sensor.channel!r} is "
                                         f"not one of file.columns {list(self.layout.columns)}")
-            if self.tacho.channel not in cols:
+            if self.tacho is not None and self.tacho.channel not in cols:
                 raise GearshotError(f"tacho.channel={self.tacho.channel!r} is not one of "
                                     f"file.columns {list(self.layout.columns)}")
         if self.monitored is not None:
@@ -405,9 +476,18 @@ class Machine:
         set_(self, "_ratios", self._solve_ratios())
 
     # ------------------------------------------------------------------ train
+    @property
+    def reference_shaft(self) -> str:
+        """The shaft whose speed is measured: the tacho's, else the one tracked in the
+        vibration (``[speed]`` shaft). Speed ratios are relative to it."""
+        if self.tacho is not None:
+            return self.tacho.shaft
+        assert self.vibration_speed is not None
+        return self.vibration_speed.shaft
+
     def _solve_ratios(self) -> dict[str, Fraction]:
-        """Speed of every shaft relative to the tacho shaft, as exact fractions."""
-        ref = self.tacho.shaft
+        """Speed of every shaft relative to the reference (tacho) shaft, exact fractions."""
+        ref = self.reference_shaft
         speed = {ref: Fraction(1)}
         todo = [ref]
         while todo:
@@ -443,9 +523,9 @@ class Machine:
 
     def speed_ratio(self, shaft: str, relative_to: str | None = None) -> Fraction:
         """Revolutions of ``shaft`` per revolution of ``relative_to`` (default: the tacho
-        shaft), as an exact fraction of tooth counts."""
+        shaft, or the tracked shaft without a tacho), as an exact fraction of tooth counts."""
         self.check_shaft(shaft)
-        ref = self.tacho.shaft if relative_to is None else self.check_shaft(relative_to,
+        ref = self.reference_shaft if relative_to is None else self.check_shaft(relative_to,
                                                                             "relative_to")
         return self._ratios[shaft] / self._ratios[ref]
 
@@ -584,8 +664,19 @@ class Machine:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Machine:
         """Build a machine from the parsed TOML mapping."""
+        if not isinstance(data, Mapping):
+            raise GearshotError(f"a machine description must be a mapping; got "
+                                f"{describe(data)}")
+        try:
+            return cls._from_dict(data)
+        except (TypeError, AttributeError) as exc:   # a list or table where a value belongs
+            raise GearshotError(f"a value of the wrong type ({type(exc).__name__}: {exc}); "
+                                f"see the machine file format in gearshot.machine") from None
+
+    @classmethod
+    def _from_dict(cls, data: Mapping[str, Any]) -> Machine:
         _check_keys(data, {"name", "shafts", "stage", "tacho", "sensor", "file", "monitored",
-                           "analysis"}, "the top level")
+                           "analysis", "speed"}, "the top level")
         name = data.get("name", "")
         if not isinstance(name, str):
             raise GearshotError(f"name must be a string; got {describe(name)}")
@@ -619,15 +710,29 @@ class Machine:
             except GearshotError as exc:
                 raise GearshotError(f"stage[{i}]: {exc}") from None
 
-        tt = _table(data, "tacho", required=True) or {}
-        _check_keys(tt, {"channel", "shaft", "pulses_per_rev", "threshold"}, "[tacho]")
-        for key in ("channel", "shaft", "pulses_per_rev"):
-            if key not in tt:
-                raise GearshotError(f"[tacho] needs {key!r} (pulses_per_rev is never guessed)")
-        tacho = Tacho(_name(tt["channel"], "tacho.channel"), _name(tt["shaft"], "tacho.shaft"),
-                      _int(tt["pulses_per_rev"], "tacho.pulses_per_rev"),
-                      None if tt.get("threshold") is None
-                      else _float(tt["threshold"], "tacho.threshold", positive=False))
+        tt = _table(data, "tacho", required=False)
+        tacho = None
+        if tt is not None:
+            _check_keys(tt, {"channel", "shaft", "pulses_per_rev", "threshold"}, "[tacho]")
+            for key in ("channel", "shaft", "pulses_per_rev"):
+                if key not in tt:
+                    raise GearshotError(f"[tacho] needs {key!r} (pulses_per_rev is never "
+                                        f"guessed)")
+            tacho = Tacho(_name(tt["channel"], "tacho.channel"),
+                          _name(tt["shaft"], "tacho.shaft"),
+                          _int(tt["pulses_per_rev"], "tacho.pulses_per_rev"),
+                          None if tt.get("threshold") is None
+                          else _float(tt["threshold"], "tacho.threshold", positive=False))
+        vibration_speed = None
+        st_ = _table(data, "speed", required=False)
+        if st_ is not None:
+            _check_keys(st_, {"shaft", "range_hz", "track", "sensor"}, "[speed]")
+            shafts_ = data.get("shafts") if isinstance(data.get("shafts"), list) else []
+            vibration_speed = VibrationSpeed(
+                _name(st_.get("shaft", shafts_[0] if shafts_ else None), "speed.shaft"),
+                st_.get("range_hz"),
+                None if st_.get("track") is None else _int(st_["track"], "speed.track"),
+                None if st_.get("sensor") is None else _name(st_["sensor"], "speed.sensor"))
 
         sensors = []
         for i, s in enumerate(_tables(data, "sensor")):
@@ -663,7 +768,7 @@ class Machine:
             if "fs" not in ft:
                 raise GearshotError("[file] needs 'fs' (sampling rate, Hz)")
             delim = ft.get("delimiter", "whitespace")
-            if delim not in _DELIMITERS:
+            if not isinstance(delim, str) or delim not in _DELIMITERS:
                 raise GearshotError(f"file.delimiter must be one of {sorted(_DELIMITERS)}; got "
                                     f"{delim!r}")
             header = ft.get("header", False)
@@ -707,4 +812,4 @@ class Machine:
             cycles_per_segment=cps,
             shaft_orders=tuple(_int(o, "analysis.shaft_orders[]") for o in orders),
             n_sidebands=_int(at.get("n_sidebands", 2), "analysis.n_sidebands", minimum=0),
-            antialias=at.get("antialias", True))
+            antialias=at.get("antialias", True), vibration_speed=vibration_speed)

@@ -14,6 +14,7 @@ import typer
 from .. import __version__
 from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
+from .._validation import check_load, check_speed
 
 app = typer.Typer(
     name="gearshot",
@@ -25,6 +26,12 @@ app = typer.Typer(
 experiment_app = typer.Typer(help="Run the paper's experiments (Sec. 4.1 and 4.2).",
                              no_args_is_help=True)
 app.add_typer(experiment_app, name="experiment")
+
+HELP_N_HEALTHY = "Simulated healthy signals per grade and condition."
+HELP_N_FAULTY = ("Simulated faulty signals per grade and condition (sizes drawn uniformly "
+                 "in (0, 1]).")
+HELP_SCHEDULER = "Address of a running Dask scheduler (default: a LocalCluster of --workers)."
+HELP_WORKERS = "LocalCluster workers when no --scheduler is given."
 
 PAPER_SPEEDS = [float(s) for s in range(10, 36)]
 PAPER_LOADS = [5.0, 10.0, 15.0, 20.0]
@@ -84,8 +91,7 @@ MAX_COUNT = 10_000      # recordings per campaign size / simulated signals are b
 def _check_duration(duration: float, speed: float, *, option: str = "--duration",
                     gear_teeth: int = 38, pinion_teeth: int = 17) -> None:
     """A recording must hold one SA segment (50 gear revolutions) at this speed."""
-    if not (0 < speed <= 1000):
-        raise GearshotError(f"--speed must lie in (0, 1000] rps; got {speed!r}")
+    check_speed(speed, "--speed")
     if not (0 < duration <= MAX_DURATION):
         raise GearshotError(f"{option} must lie in (0, {MAX_DURATION:g}] s; got {duration!r}")
     revs = duration * speed * pinion_teeth / gear_teeth
@@ -95,6 +101,37 @@ def _check_duration(duration: float, speed: float, *, option: str = "--duration"
             f"{option} {duration:g} s holds {revs:.3g} gear revolution(s) at --speed "
             f"{speed:g} rps; one SA segment needs {SEGMENT_REVOLUTIONS} "
             f"(--duration >= {need:.3g} s)")
+
+
+def _check_condition(speeds, loads) -> None:
+    """Physical bounds on the --speed / --load values (rev/s, N m)."""
+    for v in speeds:
+        check_speed(v, "--speed")
+    for v in loads:
+        check_load(v, "--load")
+
+
+def _check_frf_folder(folder: Path | None, *, minimum: int = 1) -> None:
+    """The FRF folder exists and holds at least ``minimum`` readable FRFs (checked now,
+    before any database is built)."""
+    if folder is None:
+        return
+    if not folder.is_dir():
+        raise GearshotError(f"--frf-folder {str(folder)!r} is not a folder")
+    from ..transfer import TransferFunctionBank
+
+    try:
+        bank = TransferFunctionBank.from_folder(folder)
+    except GearshotError as exc:
+        raise GearshotError(f"--frf-folder: {exc}") from None
+    if len(bank) < minimum:
+        raise GearshotError(f"--frf-folder {str(folder)!r} holds {len(bank)} FRF(s); "
+                            f"this needs at least {minimum}")
+
+
+def _check_rig_grade(rig_grade: int | None) -> None:
+    if rig_grade is not None and not 1 <= rig_grade <= 12:
+        raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
 
 
 def _check_count(value: int, option: str, *, minimum: int = 0,
@@ -177,9 +214,10 @@ def simulate(
     speed: list[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps."),
     load: list[float] = typer.Option([10.0], "--load", help="Load(s), Nm."),
     grade: list[int] = typer.Option(list(range(1, 13)), "--grade", help="DIN grade(s)."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
-    seed: int = typer.Option(0, "--seed"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
+    seed: int = typer.Option(0, "--seed", help="Seed of the profile errors, fault sizes and "
+                             "noise (each block from its own child seed)."),
     paper: bool = typer.Option(False, "--paper", help="All paper speeds (10–35 rps) and "
                                "loads (5–20 Nm)."),
     scheduler: str | None = typer.Option(None, "--scheduler", help="Address of a "
@@ -204,6 +242,7 @@ def simulate(
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
     _check_count(workers, "--workers", minimum=1, maximum=256)
+    _check_condition(speed, load)
     if machine is not None:
         _early(store, "--store", folder=True)
         _simulate_machine(machine, store, speed, load, grade, n_healthy, n_faulty, seed,
@@ -249,21 +288,24 @@ def _simulate_machine(machine_file, store, speeds, loads, grades, n_healthy, n_f
         if client is not None:
             client.close()
     mate_shaft, _ = mach.mate()
+    ref_kind = "tacho" if mach.tacho is not None else "reference"
     typer.echo(f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
-               f"gear); {mate_shaft} speeds {[round(s, 4) for s in sim_speeds]} rev/s for "
-               f"{mach.tacho.shaft} speeds {list(speeds)}")
+               f"gear, its mate on the {mate_shaft} shaft); conditions: {mach.reference_shaft} "
+               f"({ref_kind}) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "
+               f"{', '.join(f'{x:g}' for x in loads)} N m")
     typer.echo(f"database ready: {store}")
 
 
 @app.command()
 def rig(
     folder: Path = typer.Argument(..., help="Campaign folder (created)."),
-    speed: float = typer.Option(15.0, "--speed"),
-    load: float = typer.Option(10.0, "--load"),
+    speed: float = typer.Option(15.0, "--speed", help="Input (pinion) speed of the rig, "
+                                "rps."),
+    load: float = typer.Option(10.0, "--load", help="Load torque of the rig, N m."),
     duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
-    healthy: int = typer.Option(6, "--healthy"),
+    healthy: int = typer.Option(6, "--healthy", help="Number of healthy recordings."),
     size: list[float] = typer.Option([0.32, 0.56, 0.66], "--size", help="Fault size(s)."),
-    repetitions: int = typer.Option(6, "--repetitions"),
+    repetitions: int = typer.Option(6, "--repetitions", help="Recordings per fault size."),
     seed: int = typer.Option(0, "--seed", help="Seed of the rig's hidden reality."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "for the transfer path (default synthetic)."),
@@ -271,9 +313,10 @@ def rig(
                                             "surface grade (default: hidden, drawn)."),
 ) -> None:
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder)
     _check_duration(duration, speed)
+    _check_condition([speed], [load])
+    _check_rig_grade(rig_grade)
     _check_count(healthy, "--healthy")
     _check_count(repetitions, "--repetitions")
     _early(folder, "FOLDER", folder=True)
@@ -290,8 +333,7 @@ def _make_rig(seed, frf_folder, rig_grade):
     if frf_folder is not None:
         kwargs["tf_bank"] = str(frf_folder)
     if rig_grade is not None:
-        if not 1 <= rig_grade <= 12:
-            raise GearshotError(f"--rig-grade must be 1 … 12; got {rig_grade}")
+        _check_rig_grade(rig_grade)
         kwargs["grade"] = rig_grade
     return VirtualRig(seed=seed, **kwargs)
 
@@ -300,27 +342,33 @@ def _make_rig(seed, frf_folder, rig_grade):
 def experiment_simulated(
     store: Path | None = typer.Option(None, "--store", help="Database store (built if "
                                          "missing)."),
-    speed: list[float] = typer.Option([15.0], "--speed"),
-    load: list[float] = typer.Option([10.0], "--load"),
+    speed: list[float] = typer.Option([15.0], "--speed", help="Input speed(s), rps "
+                                      "(repeat the option)."),
+    load: list[float] = typer.Option([10.0], "--load", help="Load(s), N m (repeat the "
+                                     "option)."),
     grade: int = typer.Option(7, "--grade", help="Grade of the simulated signals."),
-    attenuation_db: list[float] = typer.Option([10.0], "--attenuation-db"),
+    attenuation_db: list[float] = typer.Option([10.0], "--attenuation-db", help="Path "
+                                               "attenuation(s) of the measured TFs, dB."),
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "(default: a synthetic bank of 24)."),
     selection_tf: str | None = typer.Option(None, "--selection-tf", help="Name of the "
                                                "held-out TF (default the bank's last)."),
-    seed: int = typer.Option(0, "--seed"),
+    seed: int = typer.Option(0, "--seed", help="Seed of the database and the splits."),
     full: bool = typer.Option(False, "--full", help="The paper's sweep: 26 speeds × 4 loads "
                               "× 23 TFs."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
     json_out: Path | None = typer.Option(None, "--json", help="Write results as JSON."),
     out: Path | None = typer.Option(None, "--out", help="Folder for figures and report."),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
-    workers: int = typer.Option(2, "--workers"),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
+    workers: int = typer.Option(2, "--workers", help=HELP_WORKERS),
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder, minimum=2)      # one held out for selection, one to test
+    if not full:
+        _check_condition(speed, load)
+    if not 1 <= grade <= 12:
+        raise GearshotError(f"--grade must be 1 … 12; got {grade}")
     _early(json_out, "--json")
     _early(out, "--out", folder=True)
     _early(store, "--store", folder=True)
@@ -363,23 +411,26 @@ def experiment_simulated(
 def experiment_rig(
     campaign: Path | None = typer.Option(None, "--campaign", help="Campaign folder "
                                             "(recorded if missing)."),
-    store: Path | None = typer.Option(None, "--store"),
-    speed: float = typer.Option(15.0, "--speed"),
-    load: float = typer.Option(10.0, "--load"),
-    seed: int = typer.Option(0, "--seed"),
-    frf_folder: Path | None = typer.Option(None, "--frf-folder"),
-    rig_grade: int | None = typer.Option(None, "--rig-grade"),
+    store: Path | None = typer.Option(None, "--store", help="Database store (built if "
+                                         "missing; default under gearshot's data home)."),
+    speed: float = typer.Option(15.0, "--speed", help="Input speed, rps."),
+    load: float = typer.Option(10.0, "--load", help="Load, N m."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the database, rig and splits."),
+    frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs for "
+                                              "the rig's path (default synthetic)."),
+    rig_grade: int | None = typer.Option(None, "--rig-grade", help="Force the rig's true "
+                                            "surface grade (default: hidden, drawn)."),
     attenuation_db: float | None = typer.Option(None, "--attenuation-db",
                                                    help="Rig path attenuation (default "
                                                    "hidden, 10–30 dB)."),
-    duration: float = typer.Option(60.0, "--duration"),
+    duration: float = typer.Option(60.0, "--duration", help="Seconds per recording."),
     repeats: int = typer.Option(5, "--repeats", help="Random example draws."),
-    n_healthy: int = typer.Option(100, "--n-healthy"),
-    n_faulty: int = typer.Option(700, "--n-faulty"),
-    json_out: Path | None = typer.Option(None, "--json"),
-    out: Path | None = typer.Option(None, "--out"),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
-    workers: int = typer.Option(2, "--workers"),
+    n_healthy: int = typer.Option(100, "--n-healthy", help=HELP_N_HEALTHY),
+    n_faulty: int = typer.Option(700, "--n-faulty", help=HELP_N_FAULTY),
+    json_out: Path | None = typer.Option(None, "--json", help="Write results as JSON."),
+    out: Path | None = typer.Option(None, "--out", help="Folder for figures and report."),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
+    workers: int = typer.Option(2, "--workers", help=HELP_WORKERS),
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE: an estimator parameter "
                                     "for every variant (VALUE as JSON when it parses)."),
     paired: bool = typer.Option(True, "--paired/--no-paired", help="Build and use the "
@@ -388,9 +439,11 @@ def experiment_rig(
                                 "own twin (steps 1 and 6). --no-paired: the old layout."),
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
-    if frf_folder is not None and not frf_folder.is_dir():
-        raise GearshotError(f"--frf-folder {str(frf_folder)!r} is not a folder")
+    _check_frf_folder(frf_folder)
     _check_duration(duration, speed)
+    _check_condition([speed], [load])
+    _check_rig_grade(rig_grade)
+    _check_count(seed, "--seed", maximum=2**32 - 1)
     _check_count(repeats, "--repeats", minimum=1, maximum=1000)
     _check_count(n_healthy, "--n-healthy", maximum=100_000)
     _check_count(n_faulty, "--n-faulty", maximum=100_000)
@@ -489,7 +542,7 @@ def experiment_rig_family(
     json_out: Path | None = typer.Option(None, "--json", help="Write the summary tables "
                                             "as JSON."),
     rigs_table: bool = typer.Option(False, "--rigs-table", help="Print the per-rig table."),
-    scheduler: str | None = typer.Option(None, "--scheduler"),
+    scheduler: str | None = typer.Option(None, "--scheduler", help=HELP_SCHEDULER),
     workers: int = typer.Option(1, "--workers", help="LocalCluster workers (rigs in "
                                 "parallel) when no --scheduler is given."),
 ) -> None:
@@ -543,25 +596,66 @@ def experiment_rig_family(
     _write_json(json_out, payload)
 
 
+def _comparable_summary(frame) -> str:
+    """One line counting the comparable segments of a predict table (issue #19)."""
+    if "comparable" not in frame or not len(frame):
+        return "comparable: no segment estimated"
+    n_yes = int(frame["comparable"].sum())
+    n_no = len(frame) - n_yes
+    line = f"comparable: {n_yes} segment(s), not comparable: {n_no}"
+    if n_no:
+        line += (" (they do not look like the fitted machine — another build, speed, load "
+                 "or sensor? — do not act on their estimates)")
+    return line
+
+
+FAULTY_SIZE_HELP = (
+    "Declared size of the faulty recording's fault, in (0, 1], in the units of the "
+    "database's fault type (--fault-type of gearshot simulate): ftff (default): width of "
+    "the cut along the active profile / the active profile's width (1: the whole profile); "
+    "partial_face: the cut band's width / the face width; breakage: lost tooth height / "
+    "the height above the lowest contact point, the break spanning that share of the face "
+    "(1: a missing tooth); destruction: the pitted band's width / the active profile's. "
+    "An ordinal label (chipped, broken) has no size: give your best measure of it (the "
+    "estimates are on the same scale).")
+
+
 @app.command()
 def predict(
-    database: Path = typer.Option(..., "--database", help="Simulated database store."),
-    healthy: list[Path] = typer.Option(..., "--healthy", help="Healthy recording file(s)."),
-    faulty: Path = typer.Option(..., "--faulty", help="The one faulty recording."),
-    faulty_size: float = typer.Option(..., "--faulty-size", help="Its fault size in (0, 1]."),
-    recordings: list[Path] = typer.Option([], "--recordings", help="Folder (or file) of "
-                                          "recordings to estimate; with --machine, any "
-                                          "number of files."),
-    speed: float = typer.Option(..., "--speed", help="Condition of the database slice, rps."),
-    load: float = typer.Option(..., "--load", help="Nm."),
-    out: Path = typer.Option(Path("predictions.csv"), "--out", help="CSV or JSON output."),
+    database: Path = typer.Option(..., "--database", help="Simulated database store "
+                                  "(gearshot simulate; with --machine, gearshot simulate "
+                                  "--machine)."),
+    healthy: list[str] = typer.Option(..., "--healthy", help="Healthy recordings of the "
+                                      "machine: any number of files, folders or glob "
+                                      "patterns after one --healthy."),
+    faulty: Path = typer.Option(..., "--faulty", help="The one faulty recording; its first "
+                                "segment is the example."),
+    faulty_size: float = typer.Option(..., "--faulty-size", help=FAULTY_SIZE_HELP),
+    recordings: list[str] = typer.Option([], "--recordings", help="Recordings to estimate: "
+                                         "any number of files, folders (their recording "
+                                         "files) or glob patterns after one --recordings."),
+    speed: float | None = typer.Option(None, "--speed", help="Database condition. With "
+                                          "--machine: the tacho shaft's speed in Hz "
+                                          "(default: the database speed nearest to the "
+                                          "healthy recordings' tacho); without: the "
+                                          "database's speed in rps (required)."),
+    load: float | None = typer.Option(None, "--load", help="Database load, N m (default: "
+                                         "the database's only load; an unquantified load: "
+                                         "build the database at one load and leave this "
+                                         "out)."),
+    out: Path = typer.Option(Path("predictions.csv"), "--out", help="Output table, CSV "
+                             "or (by suffix .json) JSON; one row per SA segment with its "
+                             "role, estimate and interval."),
     coverage: float = typer.Option(0.9, "--coverage", help="Prediction-interval coverage."),
-    gear_teeth: int = typer.Option(38, "--gear-teeth"),
-    pinion_teeth: int = typer.Option(17, "--pinion-teeth"),
-    seed: int = typer.Option(0, "--seed"),
+    gear_teeth: int = typer.Option(38, "--gear-teeth", help="Without --machine: teeth of "
+                                   "the monitored (faulty) gear."),
+    pinion_teeth: int = typer.Option(17, "--pinion-teeth", help="Without --machine: teeth "
+                                     "of its pinion (whose speed is --speed)."),
+    seed: int = typer.Option(0, "--seed", help="Random state of the fit (splits, step 1's "
+                             "held-out TF)."),
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): SAs of the monitored gear's shaft through "
-                                           "its gear train; --speed is the tacho shaft's."),
+                                           "its gear train; speeds in tacho-shaft Hz."),
     cycles_per_segment: int | None = typer.Option(None, "--cycles-per-segment",
                                                      help="With --machine: revolutions per "
                                                      "SA segment (default: the machine's)."),
@@ -570,98 +664,172 @@ def predict(
     holdout: float = typer.Option(0.25, "--holdout", help="With --machine: fraction of each "
                                   "healthy recording's segments kept out of the fit and "
                                   "estimated."),
+    speed_tolerance: float = typer.Option(0.05, "--speed-tolerance", help="With --machine: "
+                                          "largest relative distance between a recording's "
+                                          "tacho speed and the database condition (beyond "
+                                          "it the recording is refused)."),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    if out.suffix.lower() not in (".csv", ".json"):
+        raise GearshotError(f"--out {str(out)!r} must end in .csv or .json (the formats "
+                            f"predict writes); got suffix {out.suffix!r}")
+    _check_count(seed, "--seed", maximum=2**32 - 1)
+    from .files import expand_recordings
+
     _early(out, "--out")
+    healthy_files = expand_recordings(healthy, "--healthy")
+    if not 0 < speed_tolerance < 1:
+        raise GearshotError(f"--speed-tolerance must lie in (0, 1); got {speed_tolerance!r}")
     if machine is not None:
         from ..machine import Machine
         from .predict_machine import predict_from_machine
 
-        frame = predict_from_machine(Machine.from_toml(machine), database, healthy, faulty,
-                                     faulty_size, recordings, speed=speed, load=load,
+        frame = predict_from_machine(Machine.from_toml(machine), database, healthy_files,
+                                     faulty, faulty_size,
+                                     expand_recordings(recordings, "--recordings"),
+                                     speed=speed, load=load,
                                      cycles_per_segment=cycles_per_segment, sensor=sensor,
-                                     holdout=holdout, coverage=coverage, seed=seed)
+                                     holdout=holdout, coverage=coverage, seed=seed,
+                                     speed_tolerance=speed_tolerance)
+        where = (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, load "
+                 f"{frame.attrs['load']:g} N m")
     else:
         from .predict import predict_from_files
 
-        if len(recordings) != 1:
-            raise GearshotError(f"--recordings takes one folder or file without --machine; "
-                                f"got {len(recordings)}")
-        frame = predict_from_files(database, healthy, faulty, faulty_size, recordings[0],
+        if speed is None:
+            raise GearshotError("--speed is required without --machine (the database's "
+                                "speed, rps)")
+        if not recordings:
+            raise GearshotError("--recordings: give at least one file or folder to estimate")
+        frame = predict_from_files(database, healthy_files, faulty, faulty_size, recordings,
                                    speed=speed, load=load, coverage=coverage,
                                    gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
                                    seed=seed)
+        where = (f"database condition: {frame.attrs['speed']:g} rps, load "
+                 f"{frame.attrs['load']:g} N m")
     with atomic_path(out, make_parents=True) as tmp:
         if out.suffix.lower() == ".json":
             tmp.write_text(frame.to_json(orient="records", indent=2))
         else:
             frame.to_csv(tmp, index=False)
-    by = ["recording", "role"] if "role" in frame else "recording"
-    typer.echo(frame.groupby(by)["predicted"].mean().to_string())
+    from .predict import summary_table
+
+    typer.echo(where)
+    typer.echo(summary_table(frame).to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    typer.echo(_comparable_summary(frame))
     typer.echo(f"predictions written to {out}")
 
 
 @app.command()
 def indicators(
-    recordings: list[Path] = typer.Argument(..., help="Recording files (the original zips "
-                                            "are fine)."),
+    recordings: list[str] = typer.Argument(..., help="Recording files, folders or glob "
+                                           "patterns (the original zips are fine)."),
     machine: Path = typer.Option(..., "--machine", help="Machine description (TOML)."),
     shaft: str = typer.Option(..., "--shaft", help="Shaft whose revolution is the SA cycle."),
-    sensor: str | None = typer.Option(None, "--sensor", help="Sensor name (default: the "
-                                         "machine file's first)."),
-    json_out: Path = typer.Option(..., "--json", help="Write the indicators as JSON."),
+    sensor: list[str] = typer.Option([], "--sensor", help="Sensor name(s), repeat the "
+                                     "option for several (default: every sensor of the "
+                                     "machine file)."),
+    json_out: Path | None = typer.Option(None, "--json", help="Write the indicators as JSON "
+                                            "(machine, shaft, speeds, sensor, units)."),
     out: Path | None = typer.Option(None, "--out", help="Folder for one figure per "
-                                       "indicator."),
-    baseline: list[Path] = typer.Option([], "--baseline", help="Healthy recording(s): NA4 "
-                                        "against their residual variance."),
+                                       "indicator (and the ranking with --labels)."),
+    baseline: list[str] = typer.Option([], "--baseline", help="Healthy recording(s): NA4 "
+                                       "against their residual variance (files up to the "
+                                       "next option)."),
+    labels: Path | None = typer.Option(None, "--labels", help="CSV with columns file, label "
+                                          "(and optionally cell): rank the indicators by how "
+                                          "well they separate healthy (label 0, healthy or "
+                                          "good) from the other labels, AUC per cell and "
+                                          "overall."),
 ) -> None:
-    """Condition indicators of one shaft per recording, through a machine description."""
+    """Condition indicators of one shaft per recording and sensor (--labels: a ranking)."""
     from ..machine import Machine
-    from .indicators import indicator_figures, indicator_table, record_indicators
+    from .files import expand_recordings
+    from .indicators import format_indicators, indicator_figures, record_indicators
 
     mach = Machine.from_toml(machine)
     _early(json_out, "--json")
     _early(out, "--out", folder=True)
-    payload = record_indicators(recordings, mach, shaft=shaft, sensor=sensor,
-                                baseline_paths=baseline)
-    _write_json(json_out, payload)
-    table = indicator_table(payload)
-    typer.echo(table.drop(columns=["case", "condition"]).to_string(
-        index=False, float_format=lambda v: f"{v:.4g}"))
+    files = expand_recordings(recordings, "RECORDINGS")
+    base = expand_recordings(baseline, "--baseline")
+    label_table = None
+    if labels is not None:
+        from .ranking import read_labels
+
+        label_table = read_labels(labels, [f.name for f in files])
+    payload = record_indicators(files, mach, shaft=shaft, sensors=sensor or None,
+                                baseline_paths=base, machine_file=machine)
+    typer.echo(format_indicators(payload))
+    if label_table is not None:
+        from .ranking import format_ranking, indicator_ranking, ranking_figure
+
+        ranking = indicator_ranking(payload, label_table)
+        payload["ranking"] = json.loads(ranking.to_json(orient="records"))
+        typer.echo(format_ranking(ranking))
+        if out is not None:
+            from .._atomic import atomic_path as _ap
+
+            with _ap(out / "ranking.csv", make_parents=True) as tmp:
+                ranking.to_csv(tmp, index=False)
+            ranking_figure(ranking, out / "ranking.png",
+                           title=f"{mach.name}, shaft {shaft}")
+    if json_out is not None:
+        _write_json(json_out, payload)
+        typer.echo(f"indicators written to {json_out}")
     if out is not None:
         indicator_figures(payload, out, title=f"{mach.name}, shaft {shaft}")
-    typer.echo(f"indicators written to {json_out}")
+        typer.echo(f"figures written to {out}")
 
 
 @app.command()
 def report(
-    results: Path = typer.Argument(..., help="A results JSON written by --json."),
-    out: Path = typer.Option(Path("gearshot-report"), "--out"),
+    results: Path = typer.Argument(..., help="A JSON written by gearshot: demo's "
+                                   "results.json, experiment/rig-family/indicators --json, "
+                                   "predict --out X.json."),
+    out: Path = typer.Option(Path("gearshot-report"), "--out", help="Folder for the "
+                             "figures and report.md."),
 ) -> None:
-    """Figures and a Markdown report from a results JSON."""
+    """Figures and a Markdown report from any JSON gearshot writes."""
     if not results.is_file():
         raise GearshotError(f"results file {str(results)!r} does not exist")
     _early(out, "--out", folder=True)
-    from .figures import report_from_json
+    from .report import report_from_any_json
 
-    path = report_from_json(results, out)
+    path = report_from_any_json(results, out)
     typer.echo(f"report: {path}")
+
+
+def _one_line(exc: object) -> str:
+    """A message on one line (libraries' messages may span several)."""
+    return " ".join(str(exc).split())
+
+
+def _usage_line(exc) -> str:
+    """A click usage error as one line, naming the command and where its help is."""
+    text = " ".join(str(exc.format_message()).split())
+    ctx = getattr(exc, "ctx", None)
+    command = getattr(ctx, "command_path", None) or "gearshot"
+    return f"{text} (see `{command} --help`)"
 
 
 def main() -> None:
     """Console entry point: user errors become one line and a non-zero exit."""
+    from .files import spread_file_options
+
     try:
-        app(standalone_mode=False)
+        app(args=spread_file_options(sys.argv[1:]), prog_name="gearshot",
+            standalone_mode=False)
     except GearshotError as exc:
-        typer.secho(f"gearshot: error: {exc}", err=True, fg="red")
+        typer.secho(f"gearshot: error: {_one_line(exc)}", err=True, fg="red")
         sys.exit(2)
     except OSError as exc:  # disk full, file too large, permission, missing file
         where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
-        typer.secho(f"gearshot: error:{where} {os_error_text(exc)}", err=True, fg="red")
+        typer.secho(f"gearshot: error:{where} {_one_line(os_error_text(exc))}", err=True,
+                    fg="red")
         sys.exit(1)
     except MemoryError:
-        typer.secho("gearshot: error: out of memory; try smaller sizes (counts, --duration)",
-                    err=True, fg="red")
+        typer.secho("gearshot: error: out of memory; try fewer or shorter signals (smaller "
+                    "counts or sizes)", err=True, fg="red")
         sys.exit(1)
     except KeyboardInterrupt:
         typer.secho("gearshot: interrupted", err=True)
@@ -670,9 +838,13 @@ def main() -> None:
         sys.exit(exc.exit_code)
     except typer.Abort:
         sys.exit(1)
-    except Exception as exc:  # usage errors of typer's click: show them, exit 2
+    except Exception as exc:  # usage errors of typer's click: one line, exit 2
         if hasattr(exc, "show") and hasattr(exc, "exit_code"):
-            exc.show()
+            if type(exc).__name__ == "NoArgsIsHelpError" or not hasattr(exc,
+                                                                         "format_message"):
+                exc.show()       # `gearshot` or `gearshot experiment` alone: the help
+                sys.exit(exc.exit_code)
+            typer.secho(f"gearshot: error: {_usage_line(exc)}", err=True, fg="red")
             sys.exit(exc.exit_code)
         if os.environ.get("GEARSHOT_DEBUG"):
             raise

@@ -130,8 +130,9 @@ def _mae_stats(results):
     """Mean, std, min and max of the MAE (in %) over draws, per variant (in run order)."""
     order = list(dict.fromkeys(results["variant"]))
     grouped = results.groupby("variant")["mae"]
-    stats = 100 * grouped.agg(["mean", "std", "min", "max"])
-    return stats.fillna(0.0).loc[order]
+    stats = (100 * grouped.agg(["mean", "std", "min", "max"])).fillna(0.0).loc[order]
+    stats.attrs["draws"] = int(results["repeat"].nunique()) if "repeat" in results else 1
+    return stats
 
 
 def _figures(out, est, stats, full_pred, campaign, rig):
@@ -144,17 +145,19 @@ def _figures(out, est, stats, full_pred, campaign, rig):
     from .. import plotting
     from ..io import read_campaign, recording_segments
     from ..signal import acs_background, amplitude_spectrum
-    from .figures import estimator_figures
+    from .figures import ablation_figure, estimator_figures
 
     figs = {}
+    draws = int(stats.attrs.get("draws", 0)) or None
     fig, ax = plt.subplots(figsize=(4.5, 4.5))
-    plotting.plot_predicted_vs_true(full_pred["true"], full_pred["predicted"], ax=ax)
-    figs["Predicted vs true size (full algorithm), Fig. 14a"] = \
+    plotting.plot_predicted_vs_true(
+        full_pred["true"], full_pred["predicted"], ax=ax,
+        title="draw 1" + (f" of {draws}" if draws else "") + ": MAE {mae} %")
+    figs["Predicted vs true size (full algorithm, the first draw), Fig. 14a"] = \
         plotting.save_figure(fig, out / "fig14a_predicted_vs_true")[0]
-    fig, ax = plt.subplots(figsize=(6.5, 3.5))
-    plotting.plot_ablation({v: m / 100 for v, m in stats["mean"].items()}, ax=ax)
-    figs["Mean MAE of the ablations over the example draws, Fig. 14b"] = \
-        plotting.save_figure(fig, out / "fig14b_ablation")[0]
+    figs["Mean MAE of the ablations over the example draws (bars: ± 1 std), Fig. 14b"] = \
+        ablation_figure({v: m / 100 for v, m in stats["mean"].items()}, out,
+                        spread={v: s / 100 for v, s in stats["std"].items()}, draws=draws)
     figs.update(estimator_figures(est, out))
     index = read_campaign(campaign)
     healthy_path = index[index["fault_size"] == 0]["path"].iloc[0]
@@ -162,7 +165,8 @@ def _figures(out, est, stats, full_pred, campaign, rig):
     _, long = recording_segments(healthy_path, long=True)
     spec = amplitude_spectrum(long)
     fig, ax = plt.subplots(figsize=(8, 3.5))
-    plotting.plot_spectrum_background(spec, acs_background(spec), ax=ax)
+    plotting.plot_spectrum_background(spec, acs_background(spec), ax=ax,
+                                      samples_per_cycle=est.n_points_)
     figs["Spectrum of a long healthy signal and its ACS background"] = \
         plotting.save_figure(fig, out / "spectrum_acs")[0]
     true_tf = _hidden_path_on_sa_grid(rig, SPEED, est.n_points_)
@@ -172,7 +176,8 @@ def _figures(out, est, stats, full_pred, campaign, rig):
         plotting.save_figure(fig, out / "tf_estimate")[0]
     sa = recording_segments(faulty_path)[0]
     fig, ax = plt.subplots(figsize=(8, 3.5))
-    plotting.plot_sa_and_difference(sa, est.mesh_order, ax=ax)
+    plotting.plot_sa_and_difference(sa, est.mesh_order, ax=ax,
+                                    fault_size=float(index["fault_size"].max()))
     figs["A faulty SA and its difference signal"] = \
         plotting.save_figure(fig, out / "sa_difference")[0]
     return figs

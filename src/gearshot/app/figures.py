@@ -10,7 +10,8 @@ import pandas as pd
 
 from .._errors import GearshotError
 
-__all__ = ["simulated_figures", "rig_figures", "estimator_figures", "report_from_json"]
+__all__ = ["simulated_figures", "rig_figures", "estimator_figures", "report_from_json",
+           "ablation_figure"]
 
 
 def _plt():
@@ -20,6 +21,18 @@ def _plt():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def ablation_figure(mae: dict, out, *, spread: dict | None = None,
+                    draws: int | None = None, name: str = "fig14b_ablation") -> Path:
+    """Fig. 14b as ``out/name.png`` (and .pdf): mean MAE per variant, ± 1 std over the
+    draws when ``spread`` is given."""
+    from .. import plotting
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    plotting.plot_ablation(mae, ax=ax, spread=spread or None, draws=draws)
+    return plotting.save_figure(fig, Path(out) / name)[0]
 
 
 def simulated_figures(results: pd.DataFrame, out) -> dict:
@@ -58,13 +71,16 @@ def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out, *,
     out = Path(out)
     figs = {}
     full = predictions[predictions["variant"] == "full"]
+    n_draws = int(results["repeat"].nunique()) if "repeat" in results else 1
     fig, ax = plt.subplots(figsize=(4.5, 4.5))
-    plotting.plot_predicted_vs_true(full["true"], full["predicted"], ax=ax)
+    plotting.plot_predicted_vs_true(full["true"], full["predicted"], ax=ax,
+                                    title=f"all {n_draws} draws pooled: MAE {{mae}} %")
     figs["Predicted vs true (Fig. 14a)"] = plotting.save_figure(fig, out / "fig14a")[0]
-    fig, ax = plt.subplots(figsize=(6.5, 3.5))
-    mae = results.groupby("variant", sort=False)["mae"].mean()
-    plotting.plot_ablation(mae.to_dict(), ax=ax)
-    figs["Ablations (Fig. 14b)"] = plotting.save_figure(fig, out / "fig14b")[0]
+    grouped = results.groupby("variant", sort=False)["mae"]
+    mae = grouped.mean()
+    spread = grouped.std().fillna(0.0).to_dict() if n_draws > 1 else None
+    figs["Ablations (Fig. 14b)"] = ablation_figure(mae.to_dict(), out, spread=spread,
+                                                   draws=n_draws, name="fig14b")
     if estimator is not None:
         figs.update(estimator_figures(estimator, out))
     from .report import write_report
@@ -116,22 +132,35 @@ def report_from_json(path, out) -> Path:
         raise GearshotError(f"results file {str(path)!r} does not exist")
     try:
         payload = json.loads(path.read_text())
-        rows = pd.DataFrame(payload["rows"])
-    except (ValueError, KeyError) as exc:
+    except (ValueError, UnicodeDecodeError) as exc:
         raise GearshotError(f"{str(path)!r} is not a gearshot results JSON ({exc})") from None
+    rows = payload.get("rows") if isinstance(payload, dict) else None
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        raise GearshotError(f"{str(path)!r} is not a gearshot results JSON: it needs an "
+                            f"object with 'rows', a non-empty list of objects (as written "
+                            f"by --json)")
+    need = {"variant", "mae"} | ({"speed", "load", "tf", "attenuation_db"}
+                                 if payload.get("experiment") == "simulated" else set())
+    missing = sorted(need - set().union(*rows))
+    if missing:
+        raise GearshotError(f"{str(path)!r}: its rows lack the key(s) {missing} (not a "
+                            f"results JSON written by --json)")
+    rows = pd.DataFrame(rows)
+    if not np.issubdtype(rows["mae"].dtype, np.number):
+        raise GearshotError(f"{str(path)!r}: its rows' 'mae' values are not numbers")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if payload.get("experiment") == "simulated":
         simulated_figures(rows, out)
     else:
-        from .. import plotting
         from .report import write_report
 
-        plt = _plt()
-        fig, ax = plt.subplots(figsize=(6.5, 3.5))
-        mae = rows.groupby("variant", sort=False)["mae"].mean()
-        plotting.plot_ablation(mae.to_dict(), ax=ax)
-        figs = {"Ablations (Fig. 14b)": plotting.save_figure(fig, out / "fig14b")[0]}
+        grouped = rows.groupby("variant", sort=False)["mae"]
+        mae = grouped.mean()
+        n_draws = int(rows["repeat"].nunique()) if "repeat" in rows else 1
+        spread = grouped.std().fillna(0.0).to_dict() if n_draws > 1 else None
+        figs = {"Ablations (Fig. 14b)": ablation_figure(mae.to_dict(), out, spread=spread,
+                                                        draws=n_draws, name="fig14b")}
         write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,
                            "ablations": (mae * 100).to_dict()}, figs)
     return out / "report.md"

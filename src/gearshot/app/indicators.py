@@ -9,9 +9,11 @@ from typing import Any
 
 import numpy as np
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 
 __all__ = ["shaft_indicators", "record_indicators", "indicator_table", "indicator_figures",
+           "format_indicators", "indicator_units",
            "baseline_variance", "INDICATOR_EXTRAS"]
 
 #: Indicators added to every registered feature: RMS of the raw (mean-removed) time signal
@@ -97,33 +99,87 @@ def shaft_indicators(rec, machine, *, shaft: str, sensors: Sequence[str] | None 
     return out
 
 
+#: Units of every indicator: the RMS values are in the sensor's physical unit (``{unit}``),
+#: the rest are ratios or moments without a unit.
+_UNIT_OF = {"rms_diff": "{unit}", "rms_env_diff": "{unit}", "rms_raw": "{unit}",
+            "rms_residual": "{unit}"}
+
+
+def indicator_units(machine, sensor: str) -> dict[str, str]:
+    """{indicator: unit} for one sensor (``"g"`` for the RMS values of a 10 mV/g
+    accelerometer, ``"1"`` for the dimensionless ones)."""
+    from ..features import available_features
+
+    unit = machine.sensor(sensor).unit
+    return {f: _UNIT_OF.get(f, "1").format(unit=unit)
+            for f in (*available_features(), *INDICATOR_EXTRAS)}
+
+
 def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
-                      sensor: str | None = None, baseline_paths: Sequence[str | Path] = ()
+                      sensors: Sequence[str] | str | None = None,
+                      baseline_paths: Sequence[str | Path] = (),
+                      machine_file: str | Path | None = None, sensor: str | None = None
                       ) -> dict[str, Any]:
     """The ``gearshot indicators`` payload for recording files.
+
+    Parameters
+    ----------
+    paths : sequence of path
+        Recording files.
+    machine : gearshot.Machine
+    shaft : str
+        The shaft whose revolution is the SA cycle.
+    sensors : sequence of str, optional
+        Default: every sensor of the machine (``sensor``, one name, is kept for callers
+        of old).
+    baseline_paths : sequence of path
+        Healthy recordings: NA4's baseline variance, per sensor.
+    machine_file : path, optional
+        Recorded in the payload.
 
     Returns
     -------
     dict
-        ``{"records": [{"file", "speed_hz", "n_cycles", "indicators"}, ...]}``; ``speed_hz``
-        is the mean speed of the tacho shaft read from the tacho.
+        ``{"kind": "indicators", "machine", "machine_file", "shaft", "tacho_shaft",
+        "shaft_speed_ratio", "units", "records": [...]}``; one record per file and
+        sensor: ``{"file", "sensor", "tacho_speed_hz", "shaft_speed_hz", "speed_source",
+        "speed_uncertainty_hz", "n_cycles", "indicators"}``. ``tacho_speed_hz`` is the mean
+        speed of the machine's reference (tacho) shaft, read from the tacho
+        (``speed_source="tacho"``) or, for a machine without ``[tacho]``, estimated from the
+        vibration (``"vibration"``, with the standard uncertainty of the instantaneous
+        speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
+        the gear train).
     """
     from ..io import Recording
 
     machine.check_shaft(shaft, "--shaft")
-    name = machine.sensor(sensor).name
-    baseline = None
+    if isinstance(sensors, str):
+        sensors = [sensors]
+    names = [machine.sensor(s).name for s in
+             (sensors or ([sensor] if sensor else [s.name for s in machine.sensors]))]
+    ratio = float(machine.speed_ratio(shaft))
+    baselines: dict[str, float | None] = {n: None for n in names}
     if baseline_paths:
         recs = [Recording.read(p, machine=machine) for p in baseline_paths]
-        baseline = baseline_variance(recs, machine, shaft=shaft, sensor=name)
+        baselines = {n: baseline_variance(recs, machine, shaft=shaft, sensor=n) for n in names}
     records = []
     for path in paths:
         rec = Recording.read(path, machine=machine)
-        res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
-                               baseline=baseline)[name]
-        records.append({"file": Path(path).name, "speed_hz": float(rec.shaft_speed()),
-                        "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
-    return {"records": records}
+        tacho = float(rec.shaft_speed())
+        for name in names:
+            res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
+                                   baseline=baselines[name])[name]
+            records.append({"file": Path(path).name, "sensor": name,
+                            "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
+                            "speed_source": rec.speed_source,
+                            "speed_uncertainty_hz": rec.speed_uncertainty,
+                            "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
+    units = {n: indicator_units(machine, n) for n in names}
+    return {"kind": "indicators", "machine": machine.name,
+            "machine_file": None if machine_file is None else str(machine_file),
+            "shaft": shaft, "tacho_shaft": machine.reference_shaft, "shaft_speed_ratio": ratio,
+            "units": {"speeds": "Hz (revolutions per second)", "indicators": units},
+            "records": records}
 
 
 def _case_of(file_name: str) -> tuple[str, str]:
@@ -133,6 +189,22 @@ def _case_of(file_name: str) -> tuple[str, str]:
     return case, rest
 
 
+def format_indicators(payload: dict[str, Any]) -> str:
+    """The payload as the aligned text table ``gearshot indicators`` prints (one row per
+    record and sensor; plain Python, so that a one-record call does not import pandas)."""
+    head = ["file", "sensor", "tacho_hz", "shaft_hz", "n_cycles"]
+    rows = []
+    for r in payload["records"]:
+        rows.append([r["file"], r.get("sensor", ""), f"{r['tacho_speed_hz']:.4g}",
+                     f"{r['shaft_speed_hz']:.4g}", str(r["n_cycles"])]
+                    + [f"{v:.4g}" for v in r["indicators"].values()])
+    if payload["records"]:
+        head += list(payload["records"][0]["indicators"])
+    widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
+    lines = [" ".join(str(c).rjust(w) for c, w in zip(line, widths)) for line in [head, *rows]]
+    return "\n".join(lines)
+
+
 def indicator_table(payload: dict[str, Any]):
     """The payload as a pandas DataFrame: one row per record, one column per indicator."""
     import pandas as pd
@@ -140,45 +212,63 @@ def indicator_table(payload: dict[str, Any]):
     rows = []
     for r in payload["records"]:
         case, cond = _case_of(r["file"])
+        extra = {k: r[k] for k in ("speed_source", "speed_uncertainty_hz") if k in r}
         rows.append({"file": r["file"], "case": case, "condition": cond,
-                     "speed_hz": r["speed_hz"], "n_cycles": r["n_cycles"], **r["indicators"]})
+                     "sensor": r.get("sensor", ""),
+                     "tacho_speed_hz": r.get("tacho_speed_hz", r.get("speed_hz")),
+                     "shaft_speed_hz": r.get("shaft_speed_hz", r.get("speed_hz")),
+                     **extra, "n_cycles": r["n_cycles"], **r["indicators"]})
     return pd.DataFrame(rows)
+
+
+_META = ("file", "case", "condition", "sensor", "tacho_speed_hz", "shaft_speed_hz",
+         "speed_source", "speed_uncertainty_hz",
+         "n_cycles")
 
 
 def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
                       title: str = "") -> list[Path]:
-    """One figure per indicator: value against the measured speed, one colour per case
-    (the file-name prefix before the first ``_``), one marker per remaining condition."""
+    """One figure per indicator (``<name>.png``): value against the tacho-shaft speed, one
+    panel per sensor, one colour per case (the file-name prefix before the first ``_``),
+    one marker per remaining condition; the unit on the axis. Written atomically."""
     from matplotlib.figure import Figure
 
+
     table = indicator_table(payload)
+    units = payload.get("units", {}).get("indicators", {})
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    cols = [c for c in table.columns if c not in ("file", "case", "condition", "speed_hz",
-                                                  "n_cycles")]
+    cols = [c for c in table.columns if c not in _META]
     cases = sorted(table["case"].unique())
+    sensors = list(dict.fromkeys(table["sensor"]))
     conds = sorted({re.sub(r"^\d+hz_?", "", c, flags=re.I) for c in table["condition"]})
     markers = "osD^v<>pP*X"
     paths = []
     for col in cols:
-        fig = Figure(figsize=(5.5, 3.6))
-        ax = fig.add_subplot()
-        for ci, case in enumerate(cases):
-            sub = table[table["case"] == case]
-            for _, row in sub.iterrows():
-                cond = re.sub(r"^\d+hz_?", "", row["condition"], flags=re.I)
-                ax.plot(row["speed_hz"], row[col], markers[conds.index(cond) % len(markers)],
-                        color=f"C{ci % 10}", ms=6)
-            ax.plot([], [], "o", color=f"C{ci % 10}", label=case)
-        for k, cond in enumerate(conds):
-            if cond:
-                ax.plot([], [], markers[k % len(markers)], color="0.4", label=cond)
-        ax.set_xlabel("tacho-shaft speed read from the tacho (Hz)")
-        ax.set_ylabel(col)
-        ax.set_title(f"{title} {col}".strip(), fontsize=9)
-        ax.legend(fontsize=7, ncol=2)
-        fig.tight_layout()
+        source = (table["speed_source"].iloc[0] if "speed_source" in table.columns
+                  and table["speed_source"].nunique() == 1 else "tacho")
+        fig = Figure(figsize=(4.2 * len(sensors) + 1.3, 3.8), layout="constrained")
+        axes = fig.subplots(1, len(sensors), squeeze=False)[0]
+        for ax, sensor in zip(axes, sensors):
+            sub_s = table[table["sensor"] == sensor]
+            for ci, case in enumerate(cases):
+                for _, row in sub_s[sub_s["case"] == case].iterrows():
+                    cond = re.sub(r"^\d+hz_?", "", row["condition"], flags=re.I)
+                    ax.plot(row["tacho_speed_hz"], row[col],
+                            markers[conds.index(cond) % len(markers)],
+                            color=f"C{ci % 10}", ms=6)
+            unit = units.get(sensor, {}).get(col, "")
+            ax.set_xlabel("tacho-shaft speed (Hz), read from the tacho" if source == "tacho"
+                          else "reference-shaft speed (Hz), estimated from the vibration")
+            ax.set_ylabel(f"{col} [{unit}]" if unit and unit != "1" else f"{col} (ratio)")
+            ax.set_title(f"sensor {sensor}" if sensor else "", fontsize=9)
+        handles = [axes[0].plot([], [], "o", color=f"C{ci % 10}", label=case)[0]
+                   for ci, case in enumerate(cases)]
+        handles += [axes[0].plot([], [], markers[k % len(markers)], color="0.4",
+                                 label=cond)[0] for k, cond in enumerate(conds) if cond]
+        fig.legend(handles=handles, loc="outside right upper", fontsize=7)
+        fig.suptitle(f"{title}: {col}".strip(": "), fontsize=10)
         path = folder / f"{col}.png"
-        fig.savefig(path, dpi=110)
+        with atomic_path(path, make_parents=True) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
         paths.append(path)
     return paths

@@ -4,15 +4,17 @@
 ``steps``                      the paper's steps 1–8, in order, one function each
 ``uncertainty``                grade weights and prediction intervals (not paper steps)
 ``zero_shot``                  grade choice from healthy data alone
+``comparability``              does a segment look like the fitted machine (issue #19)
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
 ``save_estimator`` / ``load``  persistence with version metadata
 =============================  ======================================================
 """
 
 from .._errors import NotFittedError
-from . import steps, uncertainty
-from ._model import STEP_SEEDS, OneFaultShotEstimator
+from . import comparability, steps, uncertainty
+from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from ._params import check_estimator_params
+from .comparability import Comparability, ComparabilityReference, harmonic_profile
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -33,8 +35,13 @@ __all__ = [
     "OneFaultShotEstimator",
     "NotFittedError",
     "STEP_SEEDS",
+    "default_selection_tf",
     "steps",
     "uncertainty",
+    "comparability",
+    "Comparability",
+    "ComparabilityReference",
+    "harmonic_profile",
     "select_features",
     "tune_grade",
     "estimate_tf",

@@ -50,11 +50,12 @@ from .calibration import (
     setting_differences,
     setting_log_likelihoods,
 )
+from .comparability import Comparability, fit_comparability
 from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
 
-__all__ = ["OneFaultShotEstimator", "STEP_SEEDS"]
+__all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -191,6 +192,21 @@ def _step_seeds(random_state: Any) -> dict[str, int]:
         root = np.random.SeedSequence(int(random_state))
     children = root.spawn(len(STEP_SEEDS))
     return {name: int(child.generate_state(1)[0]) for name, child in zip(STEP_SEEDS, children)}
+
+
+def default_selection_tf(random_state: Any = 0) -> Any:
+    """Step 1's held-out TF when none is given: one TF of
+    :meth:`gearshot.transfer.TransferFunctionBank.synthetic`, drawn with
+    ``numpy.random.default_rng([random_state, 99])`` for an int ``random_state`` (the TF
+    ``gearshot predict`` and ``gearshot experiment rig`` use with ``--seed``), else from
+    the ``select_features`` step seed of ``random_state``."""
+    from ..transfer import TransferFunctionBank
+
+    if isinstance(random_state, numbers.Integral) and not isinstance(random_state, bool):
+        rng = np.random.default_rng([int(random_state), 99])
+    else:
+        rng = np.random.default_rng(_step_seeds(random_state)["select_features"])
+    return TransferFunctionBank.synthetic(1, rng=rng)[0]
 
 
 def _on_grid(tf: Any, n_points: int, name: str) -> ComplexArray:
@@ -422,6 +438,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         weight; else None) and ``options`` (the joint grid's options or None).
     setting_models_ : list of KnnModel
         One model per entry of ``calibration_["settings"]``.
+    comparability_reference_ : ComparabilityReference
+        The fitted machine's harmonic profiles (healthy mean, the example's direction,
+        healthy spread) that :meth:`comparability` measures segments against
+        (:mod:`gearshot.estimator.comparability`).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -511,9 +531,12 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             Its size.
         healthy_long : array_like (n_samples,)
             Long healthy angle-domain target signal (≥ 2**15 samples) for the TF estimate.
-        selection_tf : array_like of complex or TransferFunction
+        selection_tf : array_like of complex or TransferFunction, optional
             The held-out TF for feature selection (on the SA grid, one-sided, or an object
-            with ``to_signal_grid(n)``); needed when ``select_features``.
+            with ``to_signal_grid(n)``). Default: :func:`default_selection_tf` of
+            ``random_state`` (one TF of the synthetic bank, as the command line uses): on a
+            real machine no second measured path is at hand, and step 1 only needs a
+            plausible path other than the estimated one.
 
         Returns
         -------
@@ -567,6 +590,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                            settings=settings, grid=choice.grid,
                            options=None if options is None or choice.settings is None
                            else options.as_dict())
+        comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
+                                          faulty_example=inputs.faulty_example,
+                                          faulty_size=inputs.faulty_size)
 
         learned = dict(
             n_points_=inputs.n_points, transfer_function_=target.transfer_function,
@@ -581,7 +607,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
             grade_models_=models, model_=best, tuning_curve_=choice.tuning_curve,
             calibration_=calibration, setting_models_=setting_models,
             n_neighbors_=best.n_neighbors, faulty_size_=inputs.faulty_size,
-            step_seeds_=seeds, simulated_reference_=reference)
+            step_seeds_=seeds, simulated_reference_=reference,
+            comparability_reference_=comparability)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
@@ -619,8 +646,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
         sel_tf = None
         if self.select_features:
             if selection_tf is None:
-                raise GearshotError("selection_tf is required with select_features=True "
-                                    "(the held-out TF of step 1)")
+                selection_tf = default_selection_tf(self.random_state)
             sel_tf = _on_grid(selection_tf, n_points, "selection_tf")
         return _FitInputs(healthy, example, size, long, sel_tf, n_points)
 
@@ -965,6 +991,38 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
                     zip(self.calibration_["settings"], self.setting_models_)),
                    np.zeros(len(X)))
 
+    def comparability(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
+        """Whether target SAs look like the fitted machine (know when not to answer).
+
+        Compares each SA's regular part — the unit-norm amplitudes of its mesh-harmonic
+        orders (:func:`~gearshot.estimator.comparability.harmonic_profile`) — with the
+        fitted machine's states: the healthy SAs' mean profile, moved toward the faulty
+        example's profile as a fault grows to size 1. The score is the distance from
+        those states in units of the healthy SAs' own spread; a segment of another build,
+        another speed or load than the database's, or another sensor lies far from them
+        and is not comparable: its estimate should not be acted on.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        threshold : float > 0, optional
+            Largest score of a comparable segment; default
+            :data:`~gearshot.estimator.comparability.DEFAULT_THRESHOLD` (3.0, chosen on
+            the PHM 2009 spur subset's 30 Hz cells, benchmarks/RESULTS.md).
+
+        Returns
+        -------
+        Comparability
+            ``score`` (n_signals,), ``comparable`` (bool, ``score <= threshold``) and
+            ``threshold``.
+        """
+        self._check_fitted("comparability")
+        reference = getattr(self, "comparability_reference_", None)
+        if reference is None:  # an estimator saved before comparability existed
+            raise GearshotError("this estimator was fitted by an older gearshot without "
+                                "a comparability reference; fit it again")
+        return reference.evaluate(sa, threshold)
+
     def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
                          ) -> tuple[FloatArray, FloatArray]:
         """Prediction intervals: split-conformal residuals widened by the model discrepancy.
@@ -1012,14 +1070,18 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):
 
     # ------------------------------------------------------------------ persistence
     def save(self, path: str | Any) -> None:
-        """Save the fitted estimator (joblib) with version metadata, atomically."""
+        """Save the fitted estimator (skops format: loading it runs no code) with version
+        metadata, atomically."""
         from .persistence import save_estimator
 
         save_estimator(self, path)
 
     @classmethod
-    def load(cls, path: str | Any) -> OneFaultShotEstimator:
-        """Load an estimator saved by :meth:`save`."""
+    def load(cls, path: str | Any, *, trusted: bool = False) -> OneFaultShotEstimator:
+        """Load an estimator saved by :meth:`save`; a file that would construct other types
+        than an estimator's, or an old joblib pickle, needs ``trusted=True`` (which runs
+        the file's code: only for files you made; see
+        :func:`gearshot.estimator.persistence.load_estimator`)."""
         from .persistence import load_estimator
 
-        return load_estimator(path)
+        return load_estimator(path, trusted=trusted)

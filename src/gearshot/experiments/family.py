@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._atomic import atomic_path
 from .._errors import GearshotError
 from .._validation import check_int
 
@@ -176,7 +177,8 @@ def _rig_segments(rig: FamilyRig, paths, cache_dir: Path, campaign: dict):
     """
     from ..rig import VirtualRig
 
-    tag = _hash(dict(rig=asdict(rig), campaign=campaign, paths=[p.name for p in paths]))
+    tag = _hash(dict(rig=asdict(rig), campaign=campaign,
+                     paths=[[p.name, _tf_digest(p)] for p in paths]))
     file = cache_dir / f"rig-{rig.seed}-{tag}.npz"
     jobs = ([(0.0, r) for r in range(campaign["healthy"])]
             + [(float(y), r) for y in campaign["sizes"] for r in range(campaign["repetitions"])])
@@ -193,10 +195,8 @@ def _rig_segments(rig: FamilyRig, paths, cache_dir: Path, campaign: dict):
             if y == 0:
                 arrays[f"long__{key}"] = rec.angle_domain(
                     gear_teeth=38, pinion_teeth=17, samples_per_cycle=2048).astype(np.float32)
-        cache_dir.mkdir(parents=True, exist_ok=True)
-        tmp = file.with_suffix(".tmp.npz")
-        np.savez(tmp, **arrays)
-        tmp.replace(file)
+        with atomic_path(file, make_parents=True) as tmp:   # a unique temporary name
+            np.savez(tmp, **arrays)
     with np.load(file) as data:
         segments = {k: (data[f"sa__{k}"].astype(float),
                         data[f"long__{k}"].astype(float) if f"long__{k}" in data else None)
@@ -213,6 +213,15 @@ def _duration(campaign, speed):
         return float(campaign["duration"])
     gear_revs_per_s = speed * 17 / 38
     return 1.02 * (campaign["segments"] * 50 + 1) / gear_revs_per_s
+
+
+def _tf_digest(tf) -> str:
+    """Content hash of a transfer function (its frequencies and values), not its name."""
+    h = hashlib.sha256()
+    for arr in (tf.freqs, tf.values):
+        a = np.ascontiguousarray(arr)
+        h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
+    return h.hexdigest()[:16]
 
 
 def _hash(obj) -> str:
@@ -467,26 +476,26 @@ def _effective_params(params: dict) -> dict:
 
 
 def _run(specs, results: Path, client, progress, total):
-    from rich.progress import Progress
+    from .._progress import progress as progress_of
 
     def append(rows):
         with open(results, "a") as fh:
             for row in rows:
                 fh.write(json.dumps(row, default=_json_default) + "\n")
 
-    with Progress(transient=False, disable=not progress) as bar:
-        job = bar.add_task("rig family", total=total, completed=total - len(specs))
+    with progress_of("rig family", total, completed=total - len(specs),
+                     enabled=progress) as bar:
         if client is None:
             for spec in specs:
                 append(_family_task(spec))
-                bar.advance(job)
+                bar.advance()
         else:
             from dask.distributed import as_completed
 
             futures = [client.submit(_family_task, spec, pure=False) for spec in specs]
             for fut in as_completed(futures):
                 append(fut.result())
-                bar.advance(job)
+                bar.advance()
 
 
 def _json_default(value):

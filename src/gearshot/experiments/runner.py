@@ -102,7 +102,7 @@ def _bank(spec):
 
 def _run_specs(specs, task, results_dir: Path, client, description: str) -> pd.DataFrame:
     """Run tasks whose result file is missing; return all results. Resumable."""
-    from rich.progress import Progress
+    from .._progress import progress
 
     results_dir.mkdir(parents=True, exist_ok=True)
     todo = []
@@ -110,19 +110,18 @@ def _run_specs(specs, task, results_dir: Path, client, description: str) -> pd.D
         path = results_dir / f"{_task_key(spec)}.parquet"
         if not path.exists():
             todo.append((spec, path))
-    with Progress(transient=False) as bar:
-        job = bar.add_task(description, total=len(specs), completed=len(specs) - len(todo))
+    with progress(description, len(specs), completed=len(specs) - len(todo)) as bar:
         if client is None:
             for spec, path in todo:
                 _write_parquet_atomic(task(spec), path)
-                bar.advance(job)
+                bar.advance()
         else:
             from dask.distributed import as_completed
 
             futures = {client.submit(task, spec, pure=False): path for spec, path in todo}
             for fut in as_completed(futures):
                 _write_parquet_atomic(fut.result(), futures[fut])
-                bar.advance(job)
+                bar.advance()
     frames = [pd.read_parquet(results_dir / f"{_task_key(s)}.parquet") for s in specs]
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 

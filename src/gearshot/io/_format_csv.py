@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from .._errors import GearshotError
 from ._fileio import TIME_NAMES, RawFile, atomic_path, read_sidecar, time_column_fs
@@ -26,6 +25,8 @@ _TAG = "# gearshot.recording "
 
 def read_csv(path: Path) -> RawFile:
     """Read a CSV file into channels, fs and metadata."""
+    import pandas as pd  # imported on use
+
     path = Path(path)
     header: dict[str, Any] = dict(read_sidecar(path))
     n_comment = 0

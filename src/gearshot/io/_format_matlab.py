@@ -17,14 +17,16 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import h5py
 import numpy as np
-import scipy.io
 
 from .._errors import GearshotError
 from ._fileio import FS_NAMES, RawFile, atomic_path
+from ._format_hdf5 import check_extent
+
+if TYPE_CHECKING:
+    import h5py
 
 __all__ = ["read_mat", "write_mat"]
 
@@ -33,6 +35,7 @@ _FLOAT_META = ("speed", "load", "fault_size")
 
 
 def _is_v73(path: Path) -> bool:
+    import h5py  # imported on use (as scipy.io): other formats never pay for them
     with open(path, "rb") as fh:
         head = fh.read(128)
     return head.startswith(b"MATLAB 7.3") or (h5py.is_hdf5(path) and not
@@ -98,12 +101,15 @@ def _read_v73_dataset(ds: h5py.Dataset) -> Any:
 
 def read_mat(path: Path) -> RawFile:
     """Read a v5 or v7.3 MAT-file into channels, fs and metadata."""
+    import h5py
+    import scipy.io
     path = Path(path)
     if _is_v73(path):
         variables: dict[str, Any] = {}
         with h5py.File(path, "r") as f:
             for name, obj in f.items():
                 if isinstance(obj, h5py.Dataset) and not name.startswith("#"):
+                    check_extent(path, obj)
                     variables[name] = _read_v73_dataset(obj)
         return _collect(path, variables)
     variables = scipy.io.loadmat(path, squeeze_me=True, chars_as_strings=True)
@@ -132,6 +138,7 @@ def _write_v73(variables: dict[str, Any], path: Path) -> None:
 
 def write_mat(rec: Any, path: Path, *, version: str = "5") -> None:
     """Write ``rec`` as a MAT-file (``version`` "5" or "7.3"), atomically."""
+    import scipy.io
     variables = _mat_variables(rec)
     with atomic_path(path) as tmp:
         if version == "5":

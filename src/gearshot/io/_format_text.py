@@ -18,7 +18,6 @@ from pathlib import Path
 from types import EllipsisType
 
 import numpy as np
-import pandas as pd
 
 from .._errors import GearshotError
 from ._fileio import TIME_NAMES, RawFile, read_sidecar, time_column_fs
@@ -79,6 +78,41 @@ def _split(row: str, delimiter: str | None) -> list[str]:
     return [c.strip() for c in (row.split() if delimiter is None else row.split(delimiter))]
 
 
+def _plain_numbers(text: str, skip_rows: int) -> np.ndarray | None:
+    """A header-less, whitespace-delimited table of numbers through numpy's C reader (no
+    pandas import on the common path: the PHM09 zips, most lab exports); None when numpy
+    cannot read it, and pandas then reads it and names the problem."""
+    try:
+        data = np.loadtxt(io.StringIO(text), comments="#", skiprows=skip_rows, ndmin=2,
+                          dtype=np.float64)
+    except ValueError:
+        return None
+    return data if data.size else None
+
+
+def _read_with_pandas(path, text, delimiter, header, skip_rows):
+    """(number of columns, names, float64 columns) read by pandas."""
+    import pandas as pd
+
+    sep = r"\s+" if delimiter is None else delimiter
+    try:
+        frame = pd.read_csv(io.StringIO(text), sep=sep, header=0 if header else None,
+                            skiprows=skip_rows, comment="#", engine="c",
+                            skipinitialspace=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise GearshotError(f"{str(path)!r} is not a readable delimited text file: "
+                            f"{exc}") from None
+    names = [str(c).strip() for c in frame.columns] if header else \
+        [str(i) for i in range(frame.shape[1])]
+    cols = []
+    for i in range(frame.shape[1]):
+        col = frame.iloc[:, i]
+        if col.dtype.kind not in "fiu":
+            col = pd.to_numeric(col, errors="coerce")
+        cols.append(col.to_numpy(dtype=np.float64))
+    return frame.shape[1], names, cols
+
+
 def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header: bool | None = None,
               columns: Sequence[str] | None = None, skip_rows: int = 0) -> RawFile:
     """Read a delimited text recording into named channels.
@@ -124,31 +158,25 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
         raise GearshotError(f"{str(path)!r}: header=True but the first row {rows[0][:60]!r} is "
                             f"numeric (no header row?)")
     n_cols = len(_split(rows[1] if len(rows) > 1 else rows[0], delimiter))
-    sep = r"\s+" if delimiter is None else delimiter
-    try:
-        frame = pd.read_csv(io.StringIO(text), sep=sep, header=0 if header else None,
-                            skiprows=skip_rows, comment="#", engine="c",
-                            skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-        raise GearshotError(f"{str(path)!r} is not a readable delimited text file: "
-                            f"{exc}") from None
-    if frame.shape[1] != n_cols and not header:
-        raise GearshotError(f"{str(path)!r}: rows have {n_cols} values but {frame.shape[1]} "
+    table = None
+    if not header and delimiter is None:
+        table = _plain_numbers(text, skip_rows)
+    if table is not None:
+        n_read, cols = table.shape[1], [table[:, i] for i in range(table.shape[1])]
+        names = [str(i) for i in range(n_read)]
+    else:
+        n_read, names, cols = _read_with_pandas(path, text, delimiter, header, skip_rows)
+    if n_read != n_cols and not header:
+        raise GearshotError(f"{str(path)!r}: rows have {n_cols} values but {n_read} "
                             f"columns were read (ragged file?)")
-    names = [str(c).strip() for c in frame.columns] if header else \
-        [str(i) for i in range(frame.shape[1])]
     if columns is not None:
         columns = [str(c) for c in columns]
-        if len(columns) != frame.shape[1]:
-            raise GearshotError(f"{str(path)!r} has {frame.shape[1]} column(s) but columns="
+        if len(columns) != n_read:
+            raise GearshotError(f"{str(path)!r} has {n_read} column(s) but columns="
                                 f"{columns!r} names {len(columns)}")
         names = columns
     chans: dict[str, np.ndarray] = {}
-    for i, name in enumerate(names):
-        col = frame.iloc[:, i]
-        if col.dtype.kind not in "fiu":
-            col = pd.to_numeric(col, errors="coerce")
-        arr = col.to_numpy(dtype=np.float64)
+    for name, arr in zip(names, cols):
         if np.isnan(arr).any():
             bad = int(np.flatnonzero(np.isnan(arr))[0])
             raise GearshotError(f"{str(path)!r}: column {name!r} has a missing or non-numeric "

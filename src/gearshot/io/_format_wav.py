@@ -4,18 +4,19 @@ Samples are float32, int16 or int32. Integer samples are first normalized to [-1
 (divided by 2**(bits-1)); the physical value is that times the channel's ``scale`` from the
 sidecar (1 if there is none). The sidecar ``<name>.wav.json`` (or ``<name>.json``) may hold
 ``channels`` (one name per channel), ``scale`` (one factor per channel), ``fs`` (must agree
-with the WAV header), ``n_samples`` and ``metadata`` (the Recording's metadata fields).
+with the WAV header), ``n_samples``, ``sha256`` (of the WAV file: a damaged or zeroed file is
+refused) and ``metadata`` (the Recording's metadata fields).
 The caller's ``channels=`` argument names channels the same way.
 """
 
 from __future__ import annotations
 
+import hashlib
 import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.io.wavfile
 
 from .._errors import GearshotError
 from ._fileio import RawFile, atomic_path, read_sidecar, sidecar_path, write_json_atomic
@@ -27,6 +28,7 @@ WAV_DTYPES = ("float32", "int16", "int32")
 
 def read_wav(path: Path) -> RawFile:
     """Read a WAV file (and its sidecar) into channels, fs and metadata."""
+    import scipy.io.wavfile  # imported on use
     path = Path(path)
     side = read_sidecar(path)
     with warnings.catch_warnings():
@@ -59,6 +61,10 @@ def read_wav(path: Path) -> RawFile:
     if n_expected is not None and int(n_expected) != values.shape[0]:
         raise GearshotError(f"{str(path)!r} holds {values.shape[0]} samples but its sidecar "
                             f"says {n_expected} (truncated file?)")
+    digest = side.get("sha256")
+    if digest is not None and _sha256(path) != digest:
+        raise GearshotError(f"{str(path)!r} does not match the SHA-256 its sidecar records "
+                            f"(damaged or changed after writing)")
     side_fs = side.get("fs")
     if side_fs is not None and abs(float(side_fs) - rate) > 1e-9 * rate:
         raise GearshotError(f"{str(path)!r}: the WAV header says fs={rate} Hz but its sidecar "
@@ -74,6 +80,7 @@ def write_wav(rec: Any, path: Path, *, dtype: Any = "float32") -> None:
     ``dtype`` is the sample type: "float32", "int16" or "int32" (integer channels are scaled
     to their peak; the factor goes to the sidecar).
     """
+    import scipy.io.wavfile
     path = Path(path)
     dtype = str(np.dtype(dtype))
     if dtype not in WAV_DTYPES:
@@ -102,4 +109,13 @@ def write_wav(rec: Any, path: Path, *, dtype: Any = "float32") -> None:
     }
     with atomic_path(path) as tmp:
         scipy.io.wavfile.write(tmp, int(round(rec.fs)), samples)
+        side["sha256"] = _sha256(tmp)
         write_json_atomic(side, sidecar_path(path))
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while chunk := fh.read(1 << 22):
+            h.update(chunk)
+    return h.hexdigest()

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .._errors import GearshotError
 
@@ -17,6 +19,8 @@ INDEX_COLUMNS = ["path", "speed", "load", "fault_size", "repetition"]
 
 def read_campaign(folder: str | os.PathLike) -> pd.DataFrame:
     """The index of a campaign folder, with absolute paths."""
+    import pandas as pd  # imported on use: reading one recording never needs it
+
     folder = Path(folder)
     index_path = folder / INDEX_NAME
     if not index_path.is_file():

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_int, check_positive, describe
+from .._validation import MAX_FS, as_signal_array, check_int, check_positive, describe
 from ..signal.angle import TACHO_SHAFTS, check_pulse_train, uniform_cycle_times
 from ._fileio import METADATA_KEYS, RawFile, reconcile_fs, select_channels
 from ._format_csv import read_csv, write_csv
@@ -124,6 +124,8 @@ class Recording:
                                     f"({acc.shape[-1]}); got {tac.size}")
             set_(self, "tacho", tac)
         set_(self, "fs", check_positive(self.fs, "fs"))
+        if self.fs > MAX_FS:
+            raise GearshotError(f"fs must be <= {MAX_FS:g} Hz; got {self.fs:g}")
         set_(self, "speed", _opt_float(self.speed, "speed"))
         if self.speed is not None and self.speed <= 0:
             raise GearshotError(f"speed must be > 0 rev/s; got {self.speed}")
@@ -245,7 +247,7 @@ class Recording:
             reader = {"hdf5": read_hdf5, "mat": read_mat, "wav": read_wav, "csv": read_csv,
                       "text": read_text, "tdms": read_tdms}[fmt]
         try:
-            raw: RawFile = reader(path)
+            raw: RawFile = _bounded_read(reader, path)
         except GearshotError:
             raise
         except Exception as exc:  # corrupt / truncated / not this format
@@ -264,8 +266,9 @@ class Recording:
         if machine is not None:
             units = [s.unit for s in machine.sensors]
             meta.update(units=units[0] if len(set(units)) == 1 else ",".join(units),
-                        tacho_pulses_per_rev=machine.tacho.pulses_per_rev,
-                        tacho_shaft=machine.tacho.shaft)
+                        tacho_pulses_per_rev=(None if machine.tacho is None
+                                              else machine.tacho.pulses_per_rev),
+                        tacho_shaft=machine.reference_shaft)
             meta.setdefault("source", machine.name)
         extras = dict(meta.pop("extras", None) or {})
         for key, value in (metadata or {}).items():
@@ -473,11 +476,113 @@ class Recording:
                 f"shaft={st.driven!r}")
         return true, self._tacho_over_input()
 
+    @property
+    def speed_source(self) -> str:
+        """Where the speed and angle come from: ``"tacho"``, or ``"vibration"`` (no tacho:
+        estimated from a mesh harmonic, :meth:`vibration_angle`)."""
+        return "tacho" if self.tacho is not None else "vibration"
+
+    @property
+    def speed_uncertainty(self) -> float | None:
+        """Standard uncertainty (rev/s) of the instantaneous speed of the tracked shaft
+        estimated from the vibration (phase noise only); ``None`` with a tacho."""
+        if self.tacho is not None:
+            return None
+        return float(self.vibration_angle().speed_std)
+
+    def vibration_angle(self, *, orders: Any = None, speed_range: Any = None,
+                        bandwidth: float | None = None):
+        """Angle and speed of the tacho shaft estimated from the vibration (no tacho needed).
+
+        With a machine: the shaft is the machine's ``[speed]`` shaft (the reference shaft,
+        ``tacho_shaft``), its mesh orders come from the gear train
+        (:meth:`gearshot.Machine.mesh_orders`), the sensor, searched range and tracked
+        order from ``[speed]``. Without one, ``orders`` must be given (e.g. the pinion's
+        teeth for the input shaft).
+
+        Parameters
+        ----------
+        orders : int or sequence of int, optional
+            Mesh orders of the tracked shaft, its own gear first.
+        speed_range : (float, float), optional
+            Speeds of the tracked shaft searched, rev/s. Default: the machine's
+            ``range_hz``, else the nominal ``speed`` ±10 % (converted to that shaft).
+        bandwidth : float, optional
+            Band kept around the tracked harmonic, shaft orders (see
+            :func:`gearshot.signal.demodulate_angle`). Default: half the rate of the
+            slowest shaft of the machine (every shaft's runout modulates the meshes), at
+            most 0.25.
+
+        Returns
+        -------
+        gearshot.signal.tracking.ShaftAngle
+            Cached per argument set.
+
+        Raises
+        ------
+        GearshotError
+            No orders or speed range to go by, or no mesh harmonic stands out (the message
+            states the SNR found).
+        """
+        from ..signal.tracking import estimate_shaft_angle
+
+        m = self.machine
+        vs = None if m is None else m.vibration_speed
+        shaft = self.tacho_shaft
+        track = None if vs is None or vs.shaft != shaft else vs.track
+        cache = self.__dict__.setdefault("_angle_cache", {})
+        if orders is None and m is None and cache and speed_range is None:
+            return next(reversed(cache.values()))  # the last estimate (its orders known)
+        if orders is None:
+            if m is None:
+                raise GearshotError(f"{self._label()} has no tacho; estimating the speed from "
+                                    f"the vibration needs the mesh orders of the "
+                                    f"{shaft!r} shaft (orders=, or gear_teeth/pinion_teeth, "
+                                    f"or a machine)")
+            orders = m.mesh_orders(shaft)
+        # keep the band below half the slowest shaft's rate: every shaft modulates the meshes
+        # (its runout), and a mesh harmonic of this shaft may also be one of another stage
+        if bandwidth is None:
+            slowest = 1.0 if m is None else min(float(m.speed_ratio(s, shaft))
+                                                for s in m.shafts)
+            bandwidth = min(0.25, 0.5 * slowest)
+        if speed_range is None and vs is not None and vs.shaft == shaft:
+            speed_range = vs.speed_range
+        if speed_range is None:
+            ratio = self._tacho_over_input()
+            if self.speed is None or ratio is None:
+                raise GearshotError(
+                    f"{self._label()} has no tacho and no nominal speed: give the speeds of "
+                    f"shaft {shaft!r} to search (machine file [speed] range_hz = [low, high], "
+                    f"or speed_range=) or the nominal speed (metadata speed=)")
+            nominal = self.speed * float(ratio)
+            speed_range = (nominal * (1 - SPEED_TOLERANCE), nominal * (1 + SPEED_TOLERANCE))
+        acc = self.acceleration
+        if acc.ndim == 2:
+            name = vs.sensor if vs is not None and vs.sensor is not None else 0
+            acc = acc[self._channel_index(name)]
+        key = (tuple(np.atleast_1d(orders).tolist()), tuple(float(v) for v in speed_range),
+               track, bandwidth)
+        if key not in cache:
+            try:
+                cache[key] = estimate_shaft_angle(acc, self.fs, orders=orders,
+                                                  speed_range=speed_range, track=track,
+                                                  bandwidth=bandwidth, label=self._label())
+            except GearshotError as exc:
+                raise GearshotError(f"{exc} [shaft {shaft!r}]") from None
+        return cache[key]
+
     def shaft_speed(self, shaft: str | None = None) -> float:
-        """Mean speed (rev/s) over the record: of the tacho shaft, or of ``shaft`` (machine)."""
-        pulses = self.pulse_times()
-        ppr = self.resolved_pulses_per_rev()
-        tacho_rate = (pulses.size - 1) / ppr / float(pulses[-1] - pulses[0])
+        """Mean speed (rev/s) over the record: of the tacho shaft, or of ``shaft`` (machine).
+
+        Without a tacho: from the vibration (:meth:`vibration_angle`; the tracked shaft
+        stands for the tacho shaft)."""
+        if self.tacho is None:
+            tacho_rate = self.vibration_angle().mean_speed
+        else:
+            pulses = self.pulse_times()
+            ppr = self.resolved_pulses_per_rev()
+            tacho_rate = (pulses.size - 1) / ppr / float(pulses[-1] - pulses[0])
         if shaft is None:
             return tacho_rate
         if self.machine is None:
@@ -489,6 +594,17 @@ class Recording:
         from ..signal.trains import shaft_cycle_times
 
         revs_per_cycle, tacho_over_input = self._target(gear_teeth, pinion_teeth, shaft)
+        if self.tacho is None:  # no tacho: virtual pulses from the vibration
+            orders, band = None, None
+            if self.machine is None and pinion_teeth is not None and gear_teeth is not None:
+                if self.tacho_shaft == "input":
+                    orders = (int(pinion_teeth),)
+                    band = min(0.25, 0.5 * int(pinion_teeth) / int(gear_teeth))
+                else:
+                    orders = (int(gear_teeth),)
+            est = self.vibration_angle(orders=orders, bandwidth=band)
+            return shaft_cycle_times(est.pulse_times, revs_per_cycle=revs_per_cycle,
+                                     pulses_per_rev=est.pulses_per_rev)
         pulses = self.pulse_times()
         ppr = self.resolved_pulses_per_rev()
         if tacho_over_input is not None:
@@ -612,8 +728,42 @@ class Recording:
         return np.asarray(synchronous_average(blocks, samples_per_cycle, n_cycles=per))
 
 
+#: Seconds a file read may take: this plus one per MB of file (a damaged file fails within
+#: it; a healthy one reads at far more than 1 MB/s).
+READ_BUDGET_S = 20.0
+
+
+def _bounded_read(reader: Any, path: Path) -> RawFile:
+    """Run ``reader(path)`` in a worker thread; the caller waits in short, interruptible
+    steps (Ctrl-C is honoured at once) and gives up with a :class:`GearshotError` after
+    :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file)."""
+    import threading
+    import time
+
+    budget = READ_BUDGET_S + path.stat().st_size / 1e6
+    box: dict[str, Any] = {}
+
+    def work() -> None:
+        try:
+            box["raw"] = reader(path)
+        except BaseException as exc:  # handed to the caller
+            box["exc"] = exc
+
+    worker = threading.Thread(target=work, name=f"gearshot-read-{path.name}", daemon=True)
+    worker.start()
+    deadline = time.monotonic() + budget
+    while worker.is_alive() and time.monotonic() < deadline:
+        worker.join(0.1)
+    if worker.is_alive():
+        raise GearshotError(f"reading {str(path)!r} did not finish within {budget:.0f} s: "
+                            f"a damaged file (or a stalled disk)")
+    if "exc" in box:
+        raise box["exc"]
+    return box["raw"]
+
+
 def _machine_channels(raw: RawFile, machine: Any
-                      ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+                      ) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
     """Sensor channels (scaled to physical units) and the tacho of a file, by the machine."""
     from ._fileio import _resolve
 
@@ -622,8 +772,10 @@ def _machine_channels(raw: RawFile, machine: Any
         name = _resolve(raw, f"sensor {s.name!r} channel", s.channel, {})
         row = np.asarray(raw.channels[name], dtype=np.float64).ravel() / s.sensitivity
         rows.append(row - row.mean() if s.ac_coupled else row)
-    tname = _resolve(raw, "tacho.channel", machine.tacho.channel, {})
-    tac = np.asarray(raw.channels[tname], dtype=np.float64).ravel()
+    tac = None
+    if machine.tacho is not None:  # no [tacho]: the speed comes from the vibration
+        tname = _resolve(raw, "tacho.channel", machine.tacho.channel, {})
+        tac = np.asarray(raw.channels[tname], dtype=np.float64).ravel()
     acc = rows[0] if len(rows) == 1 else np.stack(rows)
     return acc, tac, tuple(s.name for s in machine.sensors)
 

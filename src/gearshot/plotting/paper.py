@@ -60,8 +60,10 @@ def save_figure(fig, path) -> list[Path]:
     return out
 
 
-def plot_sa_and_difference(sa, mesh_order, *, ax=None, n_sidebands=2):
-    """An SA and its difference signal over one cycle."""
+def plot_sa_and_difference(sa, mesh_order, *, ax=None, n_sidebands=2, unit="g",
+                           fault_size=None):
+    """An SA and its difference signal over one cycle (``unit``: of the signal;
+    ``fault_size``: shown in the title when given)."""
     from ..signal import difference_signal
 
     ax = _ax(ax, figsize=(8, 3.5))
@@ -71,20 +73,33 @@ def plot_sa_and_difference(sa, mesh_order, *, ax=None, n_sidebands=2):
     lines += ax.plot(angle, difference_signal(sa, mesh_order, n_sidebands=n_sidebands),
                      lw=0.8, label="difference signal")
     ax.set_xlabel("gear angle [deg]")
-    ax.set_ylabel("acceleration")
+    ax.set_ylabel(f"acceleration [{unit}]")
+    if fault_size is not None:
+        ax.set_title(f"fault size y = {fault_size:.2f}", fontsize=9)
     ax.legend(loc="upper right", fontsize=8)
     return lines
 
 
-def plot_spectrum_background(spectrum, background, *, ax=None, fs=None):
-    """A one-sided amplitude spectrum with its ACS background."""
+def plot_spectrum_background(spectrum, background, *, ax=None, fs=None,
+                             samples_per_cycle=None, unit="g"):
+    """A one-sided amplitude spectrum with its ACS background.
+
+    The x axis is in Hz with ``fs`` (a time signal's rate), in orders (cycles per gear
+    revolution) with ``samples_per_cycle`` (an angle-domain signal), else in FFT bins.
+    """
     ax = _ax(ax, figsize=(8, 3.5))
     n = spectrum.size // 2 + 1
-    x = np.arange(n) if fs is None else np.arange(n) * fs / spectrum.size
+    if fs is not None:
+        x, label = np.arange(n) * fs / spectrum.size, "frequency [Hz]"
+    elif samples_per_cycle is not None:
+        x = np.arange(n) * samples_per_cycle / spectrum.size
+        label = "order [cycles per gear revolution]"
+    else:
+        x, label = np.arange(n), "FFT bin"
     lines = ax.semilogy(x, spectrum[:n], lw=0.5, label="amplitude spectrum")
     lines += ax.semilogy(x, background[:n], lw=1.5, label="ACS background")
-    ax.set_xlabel("frequency [Hz]" if fs else "bin (cycle-domain order × nfft/cycle)")
-    ax.set_ylabel("amplitude")
+    ax.set_xlabel(label)
+    ax.set_ylabel(f"amplitude [{unit}]")
     ax.legend(fontsize=8)
     return lines
 
@@ -99,9 +114,14 @@ def plot_tf_estimate(tf_true, tf_est, *, ax=None):
         h = np.abs(np.asarray(h)[:n])
         return 20 * np.log10(h / np.sqrt(np.mean(h ** 2)))
 
-    lines = ax.plot(orders, db(tf_true), lw=0.7, label="true TF")
-    lines += ax.plot(orders, db(tf_est), lw=1.5, label="estimate (ACS + minimum phase)")
-    ax.set_xlabel("order (SA grid)")
+    d_true, d_est = db(tf_true), db(tf_est)
+    lines = ax.plot(orders, d_true, lw=0.7, label="true TF")
+    lines += ax.plot(orders, d_est, lw=1.5, label="estimate (ACS + minimum phase)")
+    ok = np.isfinite(d_true) & np.isfinite(d_est)
+    dist = float(np.sqrt(np.mean((d_true[ok] - d_est[ok]) ** 2))) if ok.any() else np.nan
+    ax.set_title(f"estimate vs path: RMS difference {dist:.1f} dB over orders 0-{n - 1}",
+                 fontsize=9)
+    ax.set_xlabel("order [cycles per gear revolution] (SA grid)")
     ax.set_ylabel("|H| [dB re RMS]")
     ax.legend(fontsize=8)
     return lines
@@ -163,8 +183,12 @@ def plot_feature_invariance(train, test, names, errors, *, axes=None):
     return artists
 
 
-def plot_predicted_vs_true(true, predicted, *, ax=None, low=None, high=None):
-    """Fig. 14a: predicted vs true size per test SA (with intervals when given)."""
+def plot_predicted_vs_true(true, predicted, *, ax=None, low=None, high=None, title=None):
+    """Fig. 14a: predicted vs true size per test SA (with intervals when given).
+
+    ``title``: default ``"MAE x %"`` of these points; ``"{mae}"`` in a given title is
+    replaced by that number (``"draw 1 of 5: MAE {mae} %"``).
+    """
     ax = _ax(ax, figsize=(4.5, 4.5))
     true, predicted = np.asarray(true), np.asarray(predicted)
     rng = np.random.default_rng(0)
@@ -179,19 +203,30 @@ def plot_predicted_vs_true(true, predicted, *, ax=None, low=None, high=None):
     ax.set_ylim(-0.05, 1.05)
     ax.set_xlabel("true size y")
     ax.set_ylabel("predicted size y")
-    ax.set_title(f"MAE {100 * np.mean(np.abs(true - predicted)):.1f} %")
+    mae = f"{100 * np.mean(np.abs(true - predicted)):.1f}"
+    ax.set_title(f"MAE {mae} %" if title is None else title.replace("{mae}", mae),
+                 fontsize=9)
     return artists
 
 
-def plot_ablation(mae_by_variant, *, ax=None):
-    """Fig. 14b: MAE (%) of each variant."""
-    ax = _ax(ax, figsize=(6, 3.5))
+def plot_ablation(mae_by_variant, *, ax=None, spread=None, draws=None):
+    """Fig. 14b: MAE (%) of each variant; ``spread`` (same keys, std over draws as a
+    fraction) draws ± 1 std error bars, ``draws`` names their number on the axis."""
+    ax = _ax(ax, figsize=(6.5, 3.8))
     names = list(mae_by_variant)
-    values = [100 * mae_by_variant[n] for n in names]
-    bars = ax.bar([VARIANT_LABELS.get(n, n) for n in names], values)
-    ax.bar_label(bars, fmt="%.1f")
-    ax.set_ylabel("MAE [%]")
-    ax.tick_params(axis="x", labelrotation=20)
+    values = np.array([100 * mae_by_variant[n] for n in names], float)
+    err = None if not spread else np.array([100 * spread.get(n, 0.0) for n in names])
+    bars = ax.bar(range(len(names)), values, yerr=err, capsize=4,
+                  error_kw={"lw": 1.0, "ecolor": "0.25"})
+    labels = [f"{v:.1f}" if err is None else f"{v:.1f} ± {e:.1f}"
+              for v, e in zip(values, err if err is not None else values)]
+    ax.bar_label(bars, labels=labels, padding=3, fontsize=8)
+    top = np.nanmax(values + (err if err is not None else 0)) if values.size else 1.0
+    ax.set_ylim(0, 1.18 * top if np.isfinite(top) and top > 0 else 1.0)  # room for labels
+    ax.set_xticks(range(len(names)), [VARIANT_LABELS.get(n, n) for n in names],
+                  rotation=20, ha="right")
+    over = f" over {draws} draws" if draws else ""
+    ax.set_ylabel("MAE [%]" + (f" (mean ± std{over})" if err is not None else ""))
     return bars
 
 

@@ -134,7 +134,9 @@ class IrregularPartialFace(PartialFaceFault):
         super().__post_init__()
 
     @property
-    def transverse(self) -> IrregularFaceFault:
+    def transverse(self) -> FullToothFaceFault:
+        if not self.roughness:     # the nominal cut (and its batch tables, bit for bit)
+            return super().transverse
         return IrregularFaceFault(tooth=self.tooth, size=self.profile_size,
                                   center=self.center, depth=self.depth,
                                   roughness=self.roughness)

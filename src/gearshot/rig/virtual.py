@@ -39,12 +39,12 @@ import pandas as pd
 
 from .._atomic import atomic_path, check_writable, staging_dir
 from .._errors import GearshotError
-from .._validation import check_in_range, check_int, check_positive
+from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
 from ..signal.level import rms
 from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
-from .motion import load_torque, motor_angle
+from .motion import load_torque, motor_angle, ramp_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
 from .reality import RigReality, draw_reality
 from .sim_engine import SimulatorEngine
@@ -181,7 +181,8 @@ class VirtualRig:
 
     # ------------------------------------------------------------------ one recording
     def record(self, *, speed: float, load: float, fault_size: float = 0.0,
-               duration: float = 60.0, repetition: int = 0) -> Recording:
+               duration: float = 60.0, repetition: int = 0,
+               end_speed: float | None = None) -> Recording:
         """Run the rig once and record it.
 
         Parameters
@@ -196,6 +197,11 @@ class VirtualRig:
             Recorded length, s.
         repetition : int
             Repetition number (a different run of the same condition).
+        end_speed : float, optional
+            A run-up (or run-down): the input speed ramps linearly from ``speed`` at the
+            start of the recorded span to ``end_speed`` at its end
+            (:func:`gearshot.rig.motion.ramp_angle`; the per-revolution ripple stays, the
+            slow drift is replaced by the ramp). ``speed`` in the metadata is the mean.
 
         Returns
         -------
@@ -203,8 +209,8 @@ class VirtualRig:
             Acceleration in g, the input-shaft tacho, metadata (no hidden parameters).
         """
         reality, fir, _ = self._build()
-        speed = check_positive(speed, "speed")
-        load = check_positive(load, "load")
+        speed = check_speed(speed)
+        load = check_load(load)
         fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
         duration = check_positive(duration, "duration")
         repetition = check_int(repetition, "repetition", minimum=0)
@@ -217,8 +223,14 @@ class VirtualRig:
         # relative position of the wheels at the start: a whole number of pinion turns
         # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
         start = float(rng.integers(0, self.gear_teeth))
-        motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
-                            ripple=reality.speed_ripple, rng=rng, start=start)
+        if end_speed is None:
+            motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
+                                ripple=reality.speed_ripple, rng=rng, start=start)
+        else:
+            end_speed = check_positive(end_speed, "end_speed")
+            motor = ramp_angle(t, speed=speed, end_speed=end_speed, t_start=self.settle,
+                               t_end=float(t[-1]), ripple=reality.speed_ripple, rng=rng,
+                               start=start)
         torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
                              ripple=reality.load_ripple, rng=rng)
         engine = self._engine()
@@ -240,12 +252,16 @@ class VirtualRig:
         acc = apply_path(vib, fir)[n_settle:]
         acc = add_noise(acc, snr_db=reality.snr_db, rng=rng)
         tach = tacho_signal(motor[n_settle:], jitter=reality.tacho_jitter, rng=rng)
+        extras = {}
+        if end_speed is not None:
+            extras = {"start_speed": speed, "end_speed": end_speed}
+            speed = 0.5 * (speed + end_speed)
         return Recording(
             acc, tach, fs, speed=speed, load=load, fault_size=fault_size, units="g",
             source=f"gearshot.rig.VirtualRig(seed={int(self.seed)})",
             extras={"repetition": repetition, "rig_seed": int(self.seed),
                     "engine": type(getattr(engine, "func", engine)).__name__,
-                    "fault_type": self.fault_type})
+                    "fault_type": self.fault_type, **extras})
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod
@@ -275,8 +291,8 @@ class VirtualRig:
             one row per recording of this condition.
         """
         folder = Path(folder)
-        speed = check_positive(speed, "speed")
-        load = check_positive(load, "load")
+        speed = check_speed(speed)
+        load = check_load(load)
         healthy = check_int(healthy, "healthy", minimum=0)
         repetitions = check_int(repetitions, "repetitions", minimum=0)
         sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
@@ -289,10 +305,9 @@ class VirtualRig:
         check_writable(folder, "folder", folder=True)
         with staging_dir(folder) as staging:
             rows = []
-            from rich.progress import track
+            from .._progress import track
 
-            for y, r in track(jobs, description=f"rig {speed:g} rev/s {load:g} N m",
-                              disable=not progress):
+            for y, r in track(jobs, f"rig {speed:g} rev/s {load:g} N m", enabled=progress):
                 rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
                                   repetition=r)
                 name = self.file_name(speed, load, y, r)

@@ -10,12 +10,21 @@ from .alignment import fractional_shift, subtract_healthy
 from .angle import check_pulse_train
 from .angular import angle_to_time, angular_resample, pulse_times
 from .antialias import antialias_filter
-from .averaging import synchronous_average
+from .averaging import nonsynchronous_signal, synchronous_average
 from .cepstrum import minimum_phase, real_cepstrum
 from .envelope import envelope
 from .level import mean_rms, rms
-from .orders import difference_signal, harmonic_signal, mesh_band_orders, order_mask
+from .orders import (
+    difference_signal,
+    harmonic_signal,
+    mesh_band_orders,
+    order_mask,
+    regular_signal,
+    residual_signal,
+)
+from .ridge import speed_ridge
 from .spectra import acs_background, amplitude_spectrum
+from .tracking import angle_pulse_times, demodulate_angle, estimate_shaft_angle
 from .trains import shaft_cycle_times
 
 __all__ = [
@@ -28,6 +37,9 @@ __all__ = [
     "synchronous_average",
     "harmonic_signal",
     "difference_signal",
+    "regular_signal",
+    "residual_signal",
+    "nonsynchronous_signal",
     "order_mask",
     "mesh_band_orders",
     "rms",
@@ -39,4 +51,8 @@ __all__ = [
     "minimum_phase",
     "fractional_shift",
     "subtract_healthy",
+    "speed_ridge",
+    "demodulate_angle",
+    "angle_pulse_times",
+    "estimate_shaft_angle",
 ]

@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.ndimage
-import scipy.signal
-from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .._errors import GearshotError
 from .._validation import (
@@ -122,6 +119,8 @@ def angle_to_time(pulse_times, angles, *, pulses_per_rev=1) -> np.ndarray:
             f"angles must lie within the pulsed span 0 … {span:g} revolutions "
             f"({pulses.size} pulses at pulses_per_rev={ppr}); got {first!r} "
             f"({int(outside.sum())} value(s) outside)")
+    from scipy.interpolate import CubicSpline, PchipInterpolator
+
     if pulses.size >= 4:
         curve = CubicSpline(revs, pulses)
         if np.any(curve(revs[:-1] + 0.5 / ppr, 1) <= 0) or np.any(curve(revs, 1) <= 0):
@@ -206,8 +205,12 @@ def angular_resample(x, fs, pulse_times, *, samples_per_rev, pulses_per_rev=1, u
                                                       rate=rate)
         position = (times - t0) * fs_fine
     else:
+        import scipy.signal  # imported here: a 0.5-1 s import the default path never needs
+
         x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1) if upsample > 1 else x
         position = times * fs * upsample  # fractional sample index in x_fine
+    import scipy.ndimage
+
     flat = x_fine.reshape(-1, x_fine.shape[-1])
     out = np.empty((flat.shape[0], position.size))
     for i, row in enumerate(flat):

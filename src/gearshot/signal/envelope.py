@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 
 from .._validation import as_signal_array, finite_result
 
@@ -24,5 +23,7 @@ def envelope(x) -> np.ndarray:
     ndarray, shape (..., n)
         Magnitude of the analytic signal (mean not removed).
     """
+    import scipy.signal  # a slow import (0.5-1 s): only when an envelope is asked for
+
     x = as_signal_array(x, "x", min_length=2)
     return np.abs(scipy.signal.hilbert(x, axis=-1))

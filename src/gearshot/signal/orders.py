@@ -1,4 +1,22 @@
-"""Order-domain separation of a synchronous average into mesh and residual parts."""
+"""Order-domain separation of a synchronous average into mesh and residual parts.
+
+The three classical parts of a synchronous average (SA), with the reference toolchain's
+names (MATLAB Predictive Maintenance Toolbox) for orientation:
+
+* :func:`regular_signal` -- the shaft orders and every mesh harmonic (with optional
+  sidebands), everything else zeroed: ``tsaregular`` with the shaft orders and the mesh
+  orders in its order list (here the shaft orders are listed one by one, since all
+  harmonics of order 1 would be every order).
+* :func:`difference_signal` -- the SA with the mesh harmonics and ``n_sidebands``
+  sidebands removed; with ``shaft_orders=`` also those shaft orders and DC, which is
+  ``tsadifference`` (regular signal and first-order sidebands removed: ``n_sidebands=1,
+  shaft_orders=(1, 2)``). Without ``shaft_orders`` it is the paper's difference signal.
+* :func:`residual_signal` -- the SA minus its regular signal (shaft orders, DC and mesh
+  harmonics removed, sidebands kept): ``tsaresidual``; NA4 is its normalized kurtosis.
+
+The *non-synchronous* part of the angle-domain signal -- what every revolution does
+differently, invisible in any SA -- is :func:`gearshot.signal.nonsynchronous_signal`.
+"""
 
 from __future__ import annotations
 
@@ -8,8 +26,8 @@ import scipy.fft
 from .._errors import GearshotError
 from .._validation import MAX_POINTS, as_signal_array, check_int, finite_result
 
-__all__ = ["harmonic_signal", "difference_signal", "order_mask", "mesh_band_orders",
-           "check_mesh_order", "check_mesh_orders"]
+__all__ = ["harmonic_signal", "difference_signal", "regular_signal", "residual_signal",
+           "order_mask", "mesh_band_orders", "check_mesh_order", "check_mesh_orders"]
 
 
 def check_mesh_order(mesh_order, n_points: int, name: str = "mesh_order") -> int:
@@ -58,15 +76,30 @@ def mesh_band_orders(n_points: int, mesh_order, n_sidebands: int) -> np.ndarray:
     n_points = check_int(n_points, "n_points", minimum=2, maximum=MAX_POINTS)
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n_points)
     if isinstance(mesh_order, (list, tuple, np.ndarray)):
-        return np.unique(np.concatenate([
+        return _unique_orders(np.concatenate([
             mesh_band_orders(n_points, m, n_sidebands)
-            for m in check_mesh_orders(mesh_order, n_points)]))
+            for m in check_mesh_orders(mesh_order, n_points)]), n_points)
     mesh_order = check_mesh_order(mesh_order, n_points)
     k = np.arange(1, (n_points // 2) // mesh_order + 1)
-    s = np.arange(-n_sidebands, n_sidebands + 1)
-    idx = (k[:, None] * mesh_order + s[None, :]).ravel() % n_points
-    folded = np.minimum(idx, n_points - idx)
-    return np.unique(folded)
+    width = 2 * n_sidebands + 1
+    if width >= n_points:
+        return np.arange(n_points // 2 + 1)      # every order is in a band
+    else:   # the union of the bands k*m ± n_sidebands (mod n_points), in O(n_points) memory
+        diff = np.zeros(n_points + 1, dtype=np.int64)
+        lo = (k * mesh_order - n_sidebands) % n_points
+        hi = lo + width
+        wrap = hi > n_points
+        np.add.at(diff, lo, 1)
+        np.add.at(diff, np.minimum(hi, n_points), -1)
+        np.add.at(diff, np.zeros(int(wrap.sum()), dtype=np.int64), 1)
+        np.add.at(diff, hi[wrap] - n_points, -1)
+        idx = np.flatnonzero(np.cumsum(diff[:-1]) > 0)
+    return _unique_orders(np.minimum(idx, n_points - idx), n_points)
+
+
+def _unique_orders(orders: np.ndarray, n_points: int) -> np.ndarray:
+    """Sorted distinct orders in ``0 … n_points//2`` (a count, not a hash: linear time)."""
+    return np.flatnonzero(np.bincount(orders, minlength=n_points // 2 + 1))
 
 
 def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
@@ -94,10 +127,30 @@ def order_mask(n_points, mesh_order, *, n_sidebands=2) -> np.ndarray:
     return mask
 
 
-def _split(sa, mesh_order, n_sidebands, keep_mesh: bool):
+def _shaft_orders(shaft_orders, n: int) -> list[int]:
+    if isinstance(shaft_orders, (int, np.integer)) and not isinstance(shaft_orders, bool):
+        shaft_orders = [shaft_orders]
+    try:
+        orders = list(shaft_orders)
+    except TypeError:
+        raise GearshotError(f"shaft_orders must be a sequence of integers; got "
+                            f"{shaft_orders!r}") from None
+    out = []
+    for i, o in enumerate(orders):
+        o = check_int(o, f"shaft_orders[{i}]", minimum=0)
+        if o > n // 2:
+            raise GearshotError(f"shaft_orders[{i}]={o} is above the Nyquist order {n // 2} "
+                                f"of a {n}-point cycle")
+        out.append(o)
+    return out
+
+
+def _split(sa, mesh_order, n_sidebands, keep_mesh: bool, shaft_orders=None):
     sa = as_signal_array(sa, "sa", min_length=4)
     n = sa.shape[-1]
     mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
+    if shaft_orders is not None:
+        mask[[0, *_shaft_orders(shaft_orders, n)]] = True
     spectrum = scipy.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
     return scipy.fft.irfft(spectrum, n=n, axis=-1)
@@ -128,7 +181,7 @@ def harmonic_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
 
 
 @finite_result
-def difference_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
+def difference_signal(sa, mesh_order, *, n_sidebands=2, shaft_orders=None) -> np.ndarray:
     """A synchronous average with its mesh harmonics and sidebands removed.
 
     Zeroes orders ``k * mesh_order + s`` for ``k = 1 … floor(n/2 / mesh_order)`` and
@@ -144,9 +197,78 @@ def difference_signal(sa, mesh_order, *, n_sidebands=2) -> np.ndarray:
         ``[96, 48]`` for an idler shaft: every mesh's harmonics and sidebands go).
     n_sidebands : int, default 2
         Sidebands removed on each side of every harmonic.
+    shaft_orders : sequence of int, optional
+        Shaft orders removed too, with DC (the regular signal's shaft part): with
+        ``n_sidebands=1, shaft_orders=(1, 2)`` this is Zakrajsek's difference signal (FM4),
+        the reference toolchain's ``tsadifference``. Default: none (the paper's).
 
     Returns
     -------
     ndarray, shape (..., n_points), real
     """
-    return _split(sa, mesh_order, n_sidebands, keep_mesh=False)
+    return _split(sa, mesh_order, n_sidebands, keep_mesh=False, shaft_orders=shaft_orders)
+
+
+@finite_result
+def regular_signal(sa, mesh_order, *, shaft_orders=(1, 2), n_sidebands=0) -> np.ndarray:
+    """The regular part of a synchronous average: shaft orders and mesh harmonics.
+
+    Keeps the listed shaft orders and every harmonic of every mesh order (with
+    ``n_sidebands`` sidebands each), zeroes everything else, DC included. The reference
+    toolchain's ``tsaregular`` with the shaft and mesh orders in its order list.
+    ``regular_signal(sa, m) + residual_signal(sa, m) == sa - mean(sa)``.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+        Synchronous average(s), one cycle each.
+    mesh_order : int or sequence of int
+        Mesh order(s) of the cycle (every mesh synchronous with the shaft,
+        :meth:`gearshot.Machine.mesh_orders`).
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders kept (each one alone, not its harmonics).
+    n_sidebands : int, default 0
+        Sidebands kept on each side of every mesh harmonic.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.signal import regular_signal, residual_signal
+    >>> k = np.arange(64) / 64
+    >>> other = 0.1 * np.cos(2 * np.pi * 5 * k)  # order 5: neither shaft nor mesh
+    >>> sa = np.cos(2 * np.pi * 8 * k) + 0.5 * np.cos(2 * np.pi * k) + other
+    >>> bool(np.allclose(regular_signal(sa, 8), sa - other))
+    True
+    >>> bool(np.allclose(residual_signal(sa, 8), other))
+    True
+    """
+    out = _split(sa, mesh_order, n_sidebands, keep_mesh=True,
+                 shaft_orders=() if shaft_orders is None else shaft_orders)
+    return out - out.mean(axis=-1, keepdims=True)
+
+
+@finite_result
+def residual_signal(sa, mesh_order, *, shaft_orders=(1, 2)) -> np.ndarray:
+    """The residual of a synchronous average: shaft orders, DC and mesh harmonics removed.
+
+    What is left of the SA once its regular signal (:func:`regular_signal`, no sidebands)
+    is taken out: the mesh sidebands and every other synchronous order. The reference
+    toolchain's ``tsaresidual``; the signal whose normalized kurtosis is NA4.
+
+    Parameters
+    ----------
+    sa : array_like, shape (..., n_points)
+    mesh_order : int or sequence of int
+    shaft_orders : sequence of int, default (1, 2)
+        Shaft orders removed.
+
+    Returns
+    -------
+    ndarray, shape (..., n_points), real
+    """
+    return _split(sa, mesh_order, 0, keep_mesh=False,
+                  shaft_orders=() if shaft_orders is None else shaft_orders)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import scipy.fft
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy.interpolate import PchipInterpolator
 
 from .._errors import GearshotError
 from .._validation import MAX_POINTS, as_signal_array, check_in_range, check_int, finite_result
@@ -90,6 +89,8 @@ def acs_background(spectrum, *, segment_size=200, overlap=0.75, percentile=50,
     if values.shape[-1] == 1:
         background = np.broadcast_to(values, spectrum.shape).copy()
     else:
+        from scipy.interpolate import PchipInterpolator
+
         background = PchipInterpolator(centres, values, axis=-1, extrapolate=False)(grid)
         before, after = grid < centres[0], grid > centres[-1]
         background[..., before] = values[..., :1]

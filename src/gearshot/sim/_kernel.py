@@ -1,10 +1,23 @@
 """Numba kernels of the batched Newmark integration (no input checking here).
 
-:func:`newmark_batch` advances a batch of signals that share one integrator (the
-Newmark matrices of :mod:`gearshot.sim._system`) through given mesh positions, with
-per-signal fault tables and profile errors; the effective-stiffness inverse for the
-current mesh stiffness follows from one precomputed inverse by the Sherman-Morrison
-formula (a rank-one update along the line-of-action vector).
+One integration step is split into what every signal of a batch shares and what is its
+own:
+
+* :func:`contact_slots` (once per batch): the tooth pairs in contact at every step,
+  their anti-aliasing weights and contact positions (the steps' mesh positions are the
+  same for the whole batch);
+* :func:`spur_shared` / :func:`table_shared` (once per batch): everything of a contact
+  that depends on its position only (the healthy pair stiffness, table indices, the phase
+  of the profile-error waviness);
+* :func:`newmark_spur` / :func:`newmark_tables` (per signal, parallel over the batch): the
+  signal's own mesh stiffness and excitation, and the Newmark update
+  (:func:`_modal_step`, shared by both).
+
+The Newmark update runs in the mass-normalised modal coordinates of the mean-stiffness
+system, where mass and (modal) damping are diagonal and the mesh stiffness is a rank-one
+change along the line-of-action vector: the effective stiffness is diagonal plus rank one
+and is solved exactly by the Sherman-Morrison formula in O(ndof) per step
+(:func:`gearshot.sim._system.integrator` builds the coefficients).
 """
 
 from __future__ import annotations
@@ -14,198 +27,299 @@ import math
 import numba as nb
 import numpy as np
 
-__all__ = ["G0", "newmark_batch", "newmark_batch_tables"]
+__all__ = ["G0", "contact_slots", "spur_shared", "table_shared", "newmark_spur",
+           "newmark_tables"]
 
 G0 = 9.80665  # m/s^2 per g
 
-
-@nb.njit(cache=True, fastmath=False)
-def _interp_table(tab, u):
-    n = tab.shape[0] - 1
-    p = u * n
-    i = int(p)
-    if i >= n:
-        return tab[n]
-    f = p - i
-    return tab[i] * (1.0 - f) + tab[i + 1] * f
+# columns of the modal coefficient table ``mc`` (one row per mode)
+_ALPHA, _BETA, _GAMMA, _VT, _LOAD, _MOTOR, _INVD, _G, _OUT = range(9)
 
 
 @nb.njit(cache=True)
-def _tooth_error(slope, wav, phase, noise, nwaves, t, s):
-    knots = noise.shape[1]
-    p = s * (knots - 1)
-    i = int(p)
-    if i > knots - 2:
-        i = knots - 2
-    f = p - i
-    return (slope[t] * s + 0.5 * wav[t] * math.sin(2.0 * math.pi * nwaves * s + phase[t])
-            + noise[t, i] * (1.0 - f) + noise[t, i + 1] * f)
+def contact_slots(mesh_pos, span):
+    """The tooth pairs in contact at every step (shared by a batch).
 
+    A pair's entry/exit is anti-aliased: its contribution is weighted by the fraction of
+    a step-wide window around the mesh position that lies inside its contact
+    (``0 ... span`` mesh periods after its start).
 
-@nb.njit(cache=True, parallel=True, fastmath=True)
-def newmark_batch(mesh_pos, motor_acc, load, k_tab, kf_tab, ef_tab, f_tooth,
-                  g_slope, g_wav, g_phase, g_noise, g_nw,
-                  p_slope, p_wav, p_phase, p_noise, p_nw,
-                  eps, z_gear, B1, B2, B3, w, s, v, c_load, c_motor, X, V, A, coef,
-                  rec_start, out):
-    """Integrate ``out.shape[0]`` signals over ``mesh_pos`` (in mesh periods); the state
-    ``X, V, A`` (n_batch, ndof) is updated in place and the vertical acceleration (g) of
-    steps ``rec_start ... rec_start + out.shape[1] - 1`` is written into ``out``."""
-    n_batch = out.shape[0]
+    Returns
+    -------
+    pair_id : int64 (n_steps, n_slots)
+        Index of the tooth pair (mesh period in which it started contact).
+    wgt, pos : float64 (n_steps, n_slots)
+        Weight and contact position (fraction of ``span``, clipped to [0, 1]).
+    count : int64 (n_steps,)
+        Slots in use at each step.
+    """
     n_steps = mesh_pos.shape[0]
-    n_rec = out.shape[1]
-    ndof = X.shape[1]
-    a0, a2, a3, a6, a7 = coef[0], coef[1], coef[2], coef[3], coef[4]
-    n_pairs = int(math.ceil(eps)) + 1
-    z_pin = p_slope.shape[1]
-    for b in nb.prange(n_batch):
-        x = X[b].copy()
-        vel = V[b].copy()
-        acc = A[b].copy()
-        xb = np.zeros(ndof)
-        for n in range(n_steps):
-            tm = mesh_pos[n]
-            # a pair's entry/exit is anti-aliased: its contribution is weighted by the
-            # fraction of a step-wide window around tm that lies inside its contact
-            if n > 0:
-                half = 0.5 * abs(tm - mesh_pos[n - 1])
-            else:
-                half = 0.5 * abs(mesh_pos[min(1, n_steps - 1)] - tm)
-            base = math.floor(tm)
-            kk = 0.0
-            fex = 0.0
-            for j in range(-1, n_pairs):
-                nn = base - j
-                lo = tm - half - nn
-                hi = tm + half - nn
-                if hi <= 0.0 or lo >= eps:
-                    continue
-                if hi > lo:
-                    wgt = (min(hi, eps) - max(lo, 0.0)) / (hi - lo)
-                else:
-                    wgt = 1.0
-                u = (tm - nn) / eps
-                if u < 0.0:
-                    u = 0.0
-                elif u > 1.0:
-                    u = 1.0
-                gt = int(nn % z_gear)
-                pt = int(nn % z_pin)
-                faulty = gt == f_tooth[b]
-                if faulty:
-                    k = _interp_table(kf_tab[b], u)
-                else:
-                    k = _interp_table(k_tab, u)
-                # both wheels' errors run along the path of contact (as in the lab's
-                # model): their slope terms add into a mesh-periodic sawtooth
-                e = (_tooth_error(g_slope[b], g_wav[b], g_phase[b], g_noise[b], g_nw, gt, u)
-                     + _tooth_error(p_slope[b], p_wav[b], p_phase[b], p_noise[b], p_nw, pt,
-                                    u))
-                if faulty:
-                    e += _interp_table(ef_tab[b], u)
-                kk += wgt * k
-                fex += wgt * k * e
-            ld = load[n]
-            ma = motor_acc[n]
-            for i in range(ndof):
-                acc_i = w[i] * fex + c_load[i] * ld + c_motor[i] * ma
-                for jj in range(ndof):
-                    acc_i += B1[i, jj] * x[jj] + B2[i, jj] * vel[jj] + B3[i, jj] * acc[jj]
-                xb[i] = acc_i
-            proj = 0.0
-            for i in range(ndof):
-                proj += v[i] * xb[i]
-            corr = kk * proj / (1.0 + kk * s)
-            for i in range(ndof):
-                xn = xb[i] - corr * w[i]
-                an = a0 * (xn - x[i]) - a2 * vel[i] - a3 * acc[i]
-                vel[i] = vel[i] + a6 * acc[i] + a7 * an
-                acc[i] = an
-                x[i] = xn
-            r = n - rec_start
-            if r >= 0 and r < n_rec:
-                out[b, r] = (acc[1] + acc[4]) / G0
-        X[b] = x
-        V[b] = vel
-        A[b] = acc
-
-
-@nb.njit(cache=True, parallel=True, fastmath=True)
-def newmark_batch_tables(mesh_pos, motor_acc, load, k_tab, kf_tab, f_tooth, fg_tab, fp_tab,
-                         fpf_tab, span, B1, B2, B3, w, s, v, c_load, c_motor, X, V, A, coef,
-                         rec_start, out):
-    """As :func:`newmark_batch`, with every tooth pair's stiffness and error force read
-    from tables over the delay since the pair's first contact (0 ... ``span`` mesh
-    periods): ``k_tab`` (healthy) or ``kf_tab[b]`` (the faulty gear tooth
-    ``f_tooth[b]``); force ``fg_tab[b, gear tooth] + fp_tab[b, pinion tooth]`` (or
-    ``fpf_tab`` when the gear tooth is the faulty one). Used for helical pairs."""
-    n_batch = out.shape[0]
-    n_steps = mesh_pos.shape[0]
-    n_rec = out.shape[1]
-    ndof = X.shape[1]
-    a0, a2, a3, a6, a7 = coef[0], coef[1], coef[2], coef[3], coef[4]
     n_pairs = int(math.ceil(span)) + 1
-    z_gear = fg_tab.shape[1]
-    z_pin = fp_tab.shape[1]
-    for b in nb.prange(n_batch):
-        x = X[b].copy()
-        vel = V[b].copy()
-        acc = A[b].copy()
-        xb = np.zeros(ndof)
-        for n in range(n_steps):
-            tm = mesh_pos[n]
-            if n > 0:
-                half = 0.5 * abs(tm - mesh_pos[n - 1])
+    n_slots = n_pairs + 1
+    pair_id = np.zeros((n_steps, n_slots), np.int64)
+    wgt = np.zeros((n_steps, n_slots))
+    pos = np.zeros((n_steps, n_slots))
+    count = np.zeros(n_steps, np.int64)
+    for n in range(n_steps):
+        tm = mesh_pos[n]
+        if n > 0:
+            half = 0.5 * abs(tm - mesh_pos[n - 1])
+        else:
+            half = 0.5 * abs(mesh_pos[min(1, n_steps - 1)] - tm)
+        base = math.floor(tm)
+        c = 0
+        for j in range(-1, n_pairs):
+            nn = base - j
+            lo = tm - half - nn
+            hi = tm + half - nn
+            if hi <= 0.0 or lo >= span:
+                continue
+            if hi > lo:
+                w = (min(hi, span) - max(lo, 0.0)) / (hi - lo)
             else:
-                half = 0.5 * abs(mesh_pos[min(1, n_steps - 1)] - tm)
-            base = math.floor(tm)
-            kk = 0.0
-            fex = 0.0
-            for j in range(-1, n_pairs):
-                nn = base - j
-                lo = tm - half - nn
-                hi = tm + half - nn
-                if hi <= 0.0 or lo >= span:
-                    continue
-                if hi > lo:
-                    wgt = (min(hi, span) - max(lo, 0.0)) / (hi - lo)
-                else:
-                    wgt = 1.0
-                u = (tm - nn) / span
-                if u < 0.0:
-                    u = 0.0
-                elif u > 1.0:
-                    u = 1.0
-                gt = int(nn % z_gear)
-                pt = int(nn % z_pin)
-                if gt == f_tooth[b]:
-                    k = _interp_table(kf_tab[b], u)
-                    f = _interp_table(fg_tab[b, gt], u) + _interp_table(fpf_tab[b, pt], u)
-                else:
-                    k = _interp_table(k_tab, u)
-                    f = _interp_table(fg_tab[b, gt], u) + _interp_table(fp_tab[b, pt], u)
-                kk += wgt * k
-                fex += wgt * f
-            ld = load[n]
-            ma = motor_acc[n]
-            for i in range(ndof):
-                acc_i = w[i] * fex + c_load[i] * ld + c_motor[i] * ma
-                for jj in range(ndof):
-                    acc_i += B1[i, jj] * x[jj] + B2[i, jj] * vel[jj] + B3[i, jj] * acc[jj]
-                xb[i] = acc_i
-            proj = 0.0
-            for i in range(ndof):
-                proj += v[i] * xb[i]
-            corr = kk * proj / (1.0 + kk * s)
-            for i in range(ndof):
-                xn = xb[i] - corr * w[i]
-                an = a0 * (xn - x[i]) - a2 * vel[i] - a3 * acc[i]
-                vel[i] = vel[i] + a6 * acc[i] + a7 * an
-                acc[i] = an
-                x[i] = xn
-            r = n - rec_start
-            if r >= 0 and r < n_rec:
-                out[b, r] = (acc[1] + acc[4]) / G0
-        X[b] = x
-        V[b] = vel
-        A[b] = acc
+                w = 1.0
+            u = (tm - nn) / span
+            if u < 0.0:
+                u = 0.0
+            elif u > 1.0:
+                u = 1.0
+            pair_id[n, c] = nn
+            wgt[n, c] = w
+            pos[n, c] = u
+            c += 1
+        count[n] = c
+    return pair_id, wgt, pos, count
+
+
+@nb.njit(cache=True, inline="always")
+def _table_index(n, u):
+    """Cell and fraction of position ``u`` in [0, 1] on a table of ``n + 1`` points."""
+    p = u * n
+    i = int(p)
+    if i >= n:
+        return n - 1, 1.0
+    return i, p - i
+
+
+@nb.njit(cache=True)
+def table_shared(pos, count, k_tab):
+    """Per contact: cell and fraction on tables as long as ``k_tab``, and the healthy
+    stiffness ``k_tab`` there."""
+    n_steps, n_slots = pos.shape
+    n = k_tab.shape[0] - 1
+    cell = np.zeros((n_steps, n_slots), np.int64)
+    frac = np.zeros((n_steps, n_slots))
+    k_h = np.zeros((n_steps, n_slots))
+    for m in range(n_steps):
+        for c in range(count[m]):
+            i, f = _table_index(n, pos[m, c])
+            cell[m, c] = i
+            frac[m, c] = f
+            k_h[m, c] = k_tab[i] * (1.0 - f) + k_tab[i + 1] * f
+    return cell, frac, k_h
+
+
+@nb.njit(cache=True)
+def spur_shared(pos, count, n_knots, g_nw, p_nw):
+    """Per contact: the profile-error noise cell and fraction (``n_knots`` knots) and
+    sin/cos of the waviness angle ``2 pi n_waves u`` of gear and pinion."""
+    n_steps, n_slots = pos.shape
+    cell = np.zeros((n_steps, n_slots), np.int64)
+    frac = np.zeros((n_steps, n_slots))
+    trig = np.zeros((n_steps, n_slots, 4))
+    for m in range(n_steps):
+        for c in range(count[m]):
+            s = pos[m, c]
+            p = s * (n_knots - 1)
+            i = int(p)
+            if i > n_knots - 2:
+                i = n_knots - 2
+            cell[m, c] = i
+            frac[m, c] = p - i
+            ag = 2.0 * math.pi * g_nw * s
+            ap = 2.0 * math.pi * p_nw * s
+            trig[m, c, 0] = math.sin(ag)
+            trig[m, c, 1] = math.cos(ag)
+            trig[m, c, 2] = math.sin(ap)
+            trig[m, c, 3] = math.cos(ap)
+    return cell, frac, trig
+
+
+@nb.njit(cache=True, inline="always")
+def _interp_table(tab, u):
+    i, f = _table_index(tab.shape[0] - 1, u)
+    return tab[i] * (1.0 - f) + tab[i + 1] * f
+
+
+@nb.njit(cache=True, inline="always")
+def _modal_step(x, vel, acc, y, corr, kk, fex, ld, ma, mc, sc, o):
+    """One Newmark step (beta 1/4, gamma 1/2) in modal coordinates for a group of
+    signals (the last axis, ``lanes``), in place; ``o`` receives the output (vertical
+    acceleration, g). ``sc`` = (a0, a2, a3, a6, a7, k_mean, sum vt^2 / D). The signals of
+    a group are independent: their arithmetic runs side by side (SIMD lanes), which
+    hides the latency of the step's dependency chain."""
+    ndof, lanes = x.shape
+    for g in range(lanes):
+        corr[g] = 0.0
+    for i in range(ndof):
+        al, be, ga = mc[i, _ALPHA], mc[i, _BETA], mc[i, _GAMMA]
+        vt, invd = mc[i, _VT], mc[i, _INVD]
+        ext = mc[i, _LOAD] * ld + mc[i, _MOTOR] * ma
+        for g in range(lanes):
+            yy = (al * x[i, g] + be * vel[i, g] + ga * acc[i, g] + vt * fex[g] + ext) * invd
+            y[i, g] = yy
+            corr[g] += vt * yy
+    k_mean, s_vd = sc[5], sc[6]
+    for g in range(lanes):
+        dk = kk[g] - k_mean
+        corr[g] = dk * corr[g] / (1.0 + dk * s_vd)
+        o[g] = 0.0
+    a0, a2, a3, a6, a7 = sc[0], sc[1], sc[2], sc[3], sc[4]
+    for i in range(ndof):
+        gi, oi = mc[i, _G], mc[i, _OUT]
+        for g in range(lanes):
+            xn = y[i, g] - corr[g] * gi
+            an = a0 * (xn - x[i, g]) - a2 * vel[i, g] - a3 * acc[i, g]
+            vel[i, g] = vel[i, g] + a6 * acc[i, g] + a7 * an
+            acc[i, g] = an
+            x[i, g] = xn
+            o[g] += oi * an
+
+
+@nb.njit(cache=True, inline="always")
+def _load_group(X, V, A, b0, lanes):
+    ndof = X.shape[1]
+    x = np.empty((ndof, lanes))
+    vel = np.empty((ndof, lanes))
+    acc = np.empty((ndof, lanes))
+    for g in range(lanes):
+        for i in range(ndof):
+            x[i, g] = X[b0 + g, i]
+            vel[i, g] = V[b0 + g, i]
+            acc[i, g] = A[b0 + g, i]
+    return x, vel, acc
+
+
+@nb.njit(cache=True, inline="always")
+def _store_group(X, V, A, b0, x, vel, acc):
+    ndof, lanes = x.shape
+    for g in range(lanes):
+        for i in range(ndof):
+            X[b0 + g, i] = x[i, g]
+            V[b0 + g, i] = vel[i, g]
+            A[b0 + g, i] = acc[i, g]
+
+
+@nb.njit(cache=True, inline="always")
+def _record(out, b0, o, r):
+    if r >= 0 and r < out.shape[1]:
+        for g in range(o.shape[0]):
+            out[b0 + g, r] = o[g]
+
+
+@nb.njit(cache=True, parallel=True, fastmath=True)
+def newmark_spur(load, motor_acc, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_frac,
+                 trig, kf_tab, ef_tab, f_tooth, g_slope, g_wa, g_wb, g_noise, p_slope, p_wa,
+                 p_wb, p_noise, mc, sc, X, V, A, lanes, rec_start, out):
+    """Integrate ``X.shape[0]`` spur signals (a multiple of ``lanes``, integrated
+    ``lanes`` at a time) over the steps of :func:`contact_slots`.
+
+    Per signal ``b``: faulty gear tooth ``f_tooth[b]`` (-1: none) with stiffness
+    ``kf_tab[b]`` and displacement excitation ``ef_tab[b]`` over the contact position;
+    profile errors of tooth t at position s: ``slope[t, b] s + wa[t, b] sin(2 pi n s) +
+    wb[t, b] cos(2 pi n s) + noise[t, :, b](s)`` (``wa, wb`` = half the waviness times
+    cos, sin of the tooth's phase; tooth-major, signals last). The modal state ``X, V, A``
+    (n_batch, ndof) is updated in place and the output of steps ``rec_start ...
+    rec_start + out.shape[1] - 1`` is written into ``out``."""
+    n_steps = count.shape[0]
+    for grp in nb.prange(X.shape[0] // lanes):
+        b0 = grp * lanes
+        x, vel, acc = _load_group(X, V, A, b0, lanes)
+        y = np.empty_like(x)
+        corr = np.empty(lanes)
+        kk = np.empty(lanes)
+        fex = np.empty(lanes)
+        o = np.empty(lanes)
+        for n in range(n_steps):
+            for g in range(lanes):
+                kk[g] = 0.0
+                fex[g] = 0.0
+            for c in range(count[n]):
+                u = pos[n, c]
+                gt = gtooth[n, c]
+                pt = ptooth[n, c]
+                i = n_cell[n, c]
+                f = n_frac[n, c]
+                fm = 1.0 - f
+                w = wgt[n, c]
+                sg, cg, sp, cp = trig[n, c, 0], trig[n, c, 1], trig[n, c, 2], trig[n, c, 3]
+                kh = k_h[n, c]
+                hit = False
+                for g in range(lanes):
+                    if f_tooth[b0 + g] == gt:
+                        hit = True
+                for g in range(lanes):
+                    b = b0 + g
+                    e = (g_slope[gt, b] * u + g_wa[gt, b] * sg + g_wb[gt, b] * cg
+                         + g_noise[gt, i, b] * fm + g_noise[gt, i + 1, b] * f
+                         + p_slope[pt, b] * u + p_wa[pt, b] * sp + p_wb[pt, b] * cp
+                         + p_noise[pt, i, b] * fm + p_noise[pt, i + 1, b] * f)
+                    k = kh
+                    if hit and f_tooth[b] == gt:
+                        k = _interp_table(kf_tab[b], u)
+                        e += _interp_table(ef_tab[b], u)
+                    kk[g] += w * k
+                    fex[g] += w * k * e
+            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
+            _record(out, b0, o, n - rec_start)
+        _store_group(X, V, A, b0, x, vel, acc)
+
+
+@nb.njit(cache=True, parallel=True, fastmath=True)
+def newmark_tables(load, motor_acc, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_tab,
+                   f_tooth, fg_tab, fp_tab, fpf_tab, mc, sc, X, V, A, lanes, rec_start, out):
+    """As :func:`newmark_spur`, with every tooth pair's stiffness and error force read
+    from tables over the delay since the pair's first contact: ``k_h`` (healthy, per
+    contact) or ``kf_tab[b]`` (the faulty gear tooth ``f_tooth[b]``); force
+    ``fg_tab[gear tooth, :, b] + fp_tab[pinion tooth, :, b]`` (``fpf_tab[b, pinion
+    tooth]`` instead of ``fp_tab`` when the gear tooth is the faulty one; tables
+    tooth-major, signals last). Used for helical pairs."""
+    n_steps = count.shape[0]
+    for grp in nb.prange(X.shape[0] // lanes):
+        b0 = grp * lanes
+        x, vel, acc = _load_group(X, V, A, b0, lanes)
+        y = np.empty_like(x)
+        corr = np.empty(lanes)
+        kk = np.empty(lanes)
+        fex = np.empty(lanes)
+        o = np.empty(lanes)
+        for n in range(n_steps):
+            for g in range(lanes):
+                kk[g] = 0.0
+                fex[g] = 0.0
+            for c in range(count[n]):
+                gt = gtooth[n, c]
+                pt = ptooth[n, c]
+                i = cell[n, c]
+                f = frac[n, c]
+                fm = 1.0 - f
+                w = wgt[n, c]
+                kh = k_h[n, c]
+                hit = False
+                for g in range(lanes):
+                    if f_tooth[b0 + g] == gt:
+                        hit = True
+                for g in range(lanes):
+                    b = b0 + g
+                    fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                        fp_tab[pt, i, b] * fm + fp_tab[pt, i + 1, b] * f)
+                    k = kh
+                    if hit and f_tooth[b] == gt:
+                        k = kf_tab[b, i] * fm + kf_tab[b, i + 1] * f
+                        fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                            fpf_tab[b, pt, i] * fm + fpf_tab[b, pt, i + 1] * f)
+                    kk[g] += w * k
+                    fex[g] += w * fo
+            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
+            _record(out, b0, o, n - rec_start)
+        _store_group(X, V, A, b0, x, vel, acc)

@@ -25,12 +25,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import newmark_batch, newmark_batch_tables
-from ._slices import box
+from ._ftff_batch import ftff_cached, is_ftff
+from ._helical import helical_batch_tables
+from ._kernel import (
+    G0,
+    contact_slots,
+    newmark_spur,
+    newmark_tables,
+    spur_shared,
+    table_shared,
+)
 from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors
-from .stiffness import _N_TABLE, _pair_table, band_arrays, fault_tables, helical_tables
+from .stiffness import _N_TABLE, _pair_table, fault_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
            "make_batch", "warmup_time"]
@@ -48,6 +56,12 @@ def system_matrices(pair: GearPair):
     omega : ndarray (7,)
         Natural angular frequencies (rad/s) of the mean-mesh-stiffness system.
     """
+    return _modal_system(pair)[:5]
+
+
+def _modal_system(pair: GearPair):
+    """:func:`system_matrices` plus the mean system's squared natural frequencies and
+    mass-normalised modes (columns)."""
     m1, m2 = pair.masses
     j1, j2 = pair.inertias
     kt1, kt2 = pair.shaft_torsional_stiffness
@@ -79,28 +93,31 @@ def system_matrices(pair: GearPair):
     phi = Li.T @ psi                          # mass-normalised modes
     omega = np.sqrt(np.maximum(w2, 0.0))
     C = M @ phi @ np.diag(2 * pair.damping_ratio * omega) @ phi.T @ M
-    return M, K0, C, v, omega
+    return M, K0, C, v, omega, w2, phi
 
 
 @dataclass(frozen=True)
 class Integrator:
-    """Newmark (beta 1/4, gamma 1/2) update matrices for one pair and time step."""
+    """Newmark (beta 1/4, gamma 1/2) coefficients for one pair and time step, in the
+    mass-normalised modal coordinates of the mean-stiffness system.
 
-    B1: np.ndarray
-    B2: np.ndarray
-    B3: np.ndarray
-    w: np.ndarray
-    s: float
-    v: np.ndarray
-    c_load: np.ndarray
-    c_motor: np.ndarray
+    ``mc`` (ndof, 9) per mode: the factors of displacement, velocity and acceleration in
+    the right-hand side, the modal line-of-action, load and motor vectors, 1/D (D: the
+    diagonal effective stiffness), line-of-action / D and the output factor (g per modal
+    acceleration); ``sc`` = (a0, a2, a3, a6, a7, k_mean, sum vt^2 / D); ``to_modal``
+    maps a physical state to modal coordinates (Phi^T M); ``x_static`` is the static
+    state under the mean mesh stiffness (modal).
+    """
+
+    mc: np.ndarray
+    sc: np.ndarray
+    to_modal: np.ndarray
     x_static: np.ndarray
-    coef: np.ndarray      # a0, a2, a3, a6, a7
     omega_min: float
 
 
 def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
-    M, K0, C, v, omega = system_matrices(pair)
+    M, K0, C, v, omega, w2, phi = _modal_system(pair)
     beta, gamma = 0.25, 0.5
     a0 = 1 / (beta * dt ** 2)
     a1 = gamma / (beta * dt)
@@ -110,13 +127,7 @@ def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
     a5 = dt / 2 * (gamma / beta - 2)
     a6 = dt * (1 - gamma)
     a7 = gamma * dt
-    A = K0 + a0 * M + a1 * C
-    Ai = np.linalg.inv(A)
-    Ai = 0.5 * (Ai + Ai.T)
-    B1 = Ai @ (a0 * M + a1 * C)
-    B2 = Ai @ (a2 * M + a4 * C)
-    B3 = Ai @ (a3 * M + a5 * C)
-    w = Ai @ v
+    damp = 2 * pair.damping_ratio * omega          # modal damping, diagonal
     f_load = np.zeros(v.size)
     f_load[6] = -1.0                      # brake torque opposes rotation (per N m)
     ratio = pair.z_pinion / pair.z_gear
@@ -124,8 +135,17 @@ def integrator(pair: GearPair, dt: float, load0: float) -> Integrator:
     f_motor[:7] = -np.array([0, 0, M[2, 2], 0, 0, M[5, 5] * ratio, M[6, 6] * ratio])
     k_mean = float(np.mean(_pair_table(pair, None))) * pair.contact_ratio
     x_static = np.linalg.solve(K0 + k_mean * np.outer(v, v), f_load * load0)
-    return Integrator(B1, B2, B3, w, float(v @ w), v, Ai @ f_load, Ai @ f_motor, x_static,
-                      np.array([a0, a2, a3, a6, a7]), float(omega[omega > 0].min()))
+    # Phi^T (K0 + a0 M + a1 C) Phi = diag(w2 + a0 + a1 damp) - k_mean vt vt^T: the mesh
+    # stiffness k_m enters as the rank-one term (k_m - k_mean) vt vt^T
+    d = w2 + a0 + a1 * damp
+    vt = phi.T @ v
+    mc = np.column_stack([a0 + a1 * damp, a2 + a4 * damp, a3 + a5 * damp, vt,
+                          phi.T @ f_load, phi.T @ f_motor, 1.0 / d, vt / d,
+                          (phi[1] + phi[4]) / G0])
+    sc = np.array([a0, a2, a3, a6, a7, k_mean, float(np.sum(vt * vt / d))])
+    to_modal = phi.T @ M
+    return Integrator(np.ascontiguousarray(mc), sc, to_modal, to_modal @ x_static,
+                      float(omega[omega > 0].min()))
 
 
 def warmup_time(pair: GearPair, integ: Integrator) -> float:
@@ -140,6 +160,7 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
     """Per-signal tables over the contact position u of the faulty pair's stiffness and
     displacement excitation (from the fault's hooks), and the faulty tooth index."""
     n = len(faults)
+    prefetch_ftff(pair, faults)
     kf = np.empty((n, _N_TABLE))
     ef = np.zeros((n, _N_TABLE))
     tooth = np.full(n, -1, dtype=np.int64)
@@ -153,10 +174,53 @@ def _fault_arrays(pair: GearPair, faults: list[ToothFault]):
     return kf, ef, tooth
 
 
+def prefetch_ftff(pair: GearPair, faults) -> None:
+    """Compute the tables of every FTFF among ``faults`` (and their face bands) in one
+    batch (:func:`._ftff_batch.ftff_cached`)."""
+    todo = [band for f in faults if f is not None and not f.is_healthy
+            for _, _, band in f.face_bands(pair) if is_ftff(band)]
+    if todo:
+        ftff_cached(pair, todo)
+
+
 def _stack_errors(errs: list[ToothProfileErrors]):
-    return (np.stack([e.slope for e in errs]), np.stack([e.waviness for e in errs]),
-            np.stack([e.phase for e in errs]), np.stack([e.noise for e in errs]),
+    """Slope, the waviness as sine/cosine amplitudes (half the waviness times cos/sin of
+    each tooth's phase) and noise knots of every signal; the waves per profile."""
+    half = 0.5 * np.stack([e.waviness for e in errs])
+    phase = np.stack([e.phase for e in errs])
+    return ((np.stack([e.slope for e in errs]), half * np.cos(phase), half * np.sin(phase),
+             np.ascontiguousarray(np.stack([e.noise for e in errs]))),
             float(errs[0].n_waves))
+
+
+LANES = 8      # signals integrated side by side by one thread (_kernel._modal_step)
+
+
+def _lanes(n: int) -> tuple[int, int]:
+    """(lanes, padded batch size) for ``n`` signals."""
+    lanes = min(LANES, n)
+    return lanes, -(-n // lanes) * lanes
+
+
+def _pad(a: np.ndarray, n_pad: int) -> np.ndarray:
+    """``a`` with its first axis padded to ``n_pad`` by repeating the last row."""
+    if a.shape[0] == n_pad:
+        return a
+    return np.concatenate([a, np.repeat(a[-1:], n_pad - a.shape[0], axis=0)])
+
+
+def _signals_last(a: np.ndarray, n_pad: int) -> np.ndarray:
+    """Per-signal array (n, ...) padded and moved to (..., n_pad), contiguous."""
+    return np.ascontiguousarray(np.moveaxis(_pad(a, n_pad), 0, -1))
+
+
+def _contacts(mesh_pos, span, k_tab):
+    """The batch-shared contact data of :func:`._kernel.contact_slots` and
+    :func:`._kernel.table_shared`."""
+    pair_id, wgt, pos, count = contact_slots(np.ascontiguousarray(mesh_pos, dtype=float),
+                                             float(span))
+    cell, frac, k_h = table_shared(pos, count, k_tab)
+    return pair_id, wgt, pos, count, cell, frac, k_h
 
 
 class Batch:
@@ -165,25 +229,41 @@ class Batch:
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
         self.kf, self.ef, self.tooth = _fault_arrays(pair, faults)
-        self.g = _stack_errors(gear_errs)
-        self.p = _stack_errors(pin_errs)
         n = len(faults)
-        self.X = np.tile(integ.x_static, (n, 1))
-        self.V = np.zeros((n, integ.x_static.size))
-        self.A = np.zeros((n, integ.x_static.size))
+        self.lanes, n_pad = _lanes(n)
+        tooth = np.full(n_pad, -1, dtype=np.int64)
+        tooth[:n] = self.tooth
+        self.tooth = tooth
+        self.kf, self.ef = _pad(self.kf, n_pad), _pad(self.ef, n_pad)
+        g, self.g_nw = _stack_errors(gear_errs)
+        p, self.p_nw = _stack_errors(pin_errs)
+        self.g = tuple(_signals_last(a, n_pad) for a in g)
+        self.p = tuple(_signals_last(a, n_pad) for a in p)
+        self._init_state(n)
+
+    def _init_state(self, n):
+        x0 = self.integ.x_static
+        self.n = n
+        n_pad = _lanes(n)[1]
+        self.X = np.tile(x0, (n_pad, 1))          # modal coordinates
+        self.V = np.zeros((n_pad, x0.size))
+        self.A = np.zeros((n_pad, x0.size))
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
         """Advance over the given steps; return the vertical acceleration (g) of steps
         ``rec_start ... rec_start + n_rec - 1``."""
         pair, integ = self.pair, self.integ
+        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, pair.contact_ratio,
+                                                        _pair_table(pair, None))
+        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[1], self.g_nw,
+                                           self.p_nw)
         out = np.empty((self.X.shape[0], n_rec))
-        newmark_batch(np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
-                      np.ascontiguousarray(load), _pair_table(pair, None), self.kf,
-                      self.ef, self.tooth, *self.g, *self.p, pair.contact_ratio,
-                      pair.z_gear, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
-                      integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef,
-                      rec_start, out)
-        return out
+        newmark_spur(np.ascontiguousarray(load, dtype=float),
+                     np.ascontiguousarray(motor_acc, dtype=float), count, wgt, pos,
+                     pair_id % self.g[0].shape[0], pair_id % self.p[0].shape[0], k_h,
+                     n_cell, n_frac, trig, self.kf, self.ef, self.tooth, *self.g, *self.p,
+                     integ.mc, integ.sc, self.X, self.V, self.A, self.lanes, rec_start, out)
+        return out[:self.n]
 
 
 class HelicalBatch(Batch):
@@ -192,50 +272,27 @@ class HelicalBatch(Batch):
 
     def __init__(self, pair, integ, faults, gear_errs, pin_errs):
         self.pair, self.integ = pair, integ
-        ea, eb = pair.contact_ratio, pair.overlap_ratio
-        self.span, self.k, _ = helical_tables(pair)
-        tau = np.linspace(0.0, self.span, self.k.size)
-        u = np.linspace(0.0, 1.0, _N_TABLE)
-        k_sp = _pair_table(pair, None)
         n = len(faults)
-
-        def errors(errs):
-            teeth = np.arange(errs[0].slope.size)[:, None]
-            return np.stack([e(teeth, u[None, :]) for e in errs])
-
-        e_g, e_p = errors(gear_errs), errors(pin_errs)
-        self.fg = box(k_sp * e_g, ea, eb, 0.0, eb, tau)
-        self.fp = box(k_sp * e_p, ea, eb, 0.0, eb, tau)
-        self.fpf = self.fp.copy()
-        self.kf = np.tile(self.k, (n, 1))
-        self.tooth = np.full(n, -1, dtype=np.int64)
-        for i, f in enumerate(faults):
-            if f is None or f.is_healthy:
-                continue
-            t = f.tooth % pair.z_gear
-            _, self.kf[i], bands = helical_tables(pair, f)
-            self.tooth[i] = t
-            if not bands:
-                continue
-            # every band in one call each; added band by band (the order of the sums)
-            lo, hi, dk, kd = band_arrays(bands)
-            for part in box(dk * e_g[i, t] + kd, ea, eb, lo, hi, tau):
-                self.fg[i, t] += part
-            for part in box(dk[:, None, :] * e_p[i][None], ea, eb, lo, hi, tau):
-                self.fpf[i] += part
-        self.X = np.tile(integ.x_static, (n, 1))
-        self.V = np.zeros((n, integ.x_static.size))
-        self.A = np.zeros((n, integ.x_static.size))
+        self.lanes, n_pad = _lanes(n)
+        prefetch_ftff(pair, faults)
+        (self.span, self.k, self.kf, tooth, self.fg, self.fp,
+         self.fpf) = helical_batch_tables(pair, faults, gear_errs, pin_errs, n_pad)
+        self.tooth = np.full(n_pad, -1, dtype=np.int64)
+        self.tooth[:n] = tooth
+        self.kf, self.fpf = _pad(self.kf, n_pad), _pad(self.fpf, n_pad)
+        self._init_state(n)
 
     def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
         integ = self.integ
+        pair_id, wgt, _, count, cell, frac, k_h = _contacts(mesh_pos, self.span, self.k)
         out = np.empty((self.X.shape[0], n_rec))
-        newmark_batch_tables(
-            np.ascontiguousarray(mesh_pos), np.ascontiguousarray(motor_acc),
-            np.ascontiguousarray(load), self.k, self.kf, self.tooth, self.fg, self.fp,
-            self.fpf, self.span, integ.B1, integ.B2, integ.B3, integ.w, integ.s, integ.v,
-            integ.c_load, integ.c_motor, self.X, self.V, self.A, integ.coef, rec_start, out)
-        return out
+        newmark_tables(
+            np.ascontiguousarray(load, dtype=float),
+            np.ascontiguousarray(motor_acc, dtype=float), count, wgt,
+            pair_id % self.fg.shape[0], pair_id % self.fp.shape[0], k_h, cell, frac,
+            self.kf, self.tooth, self.fg, self.fp, self.fpf, integ.mc, integ.sc, self.X,
+            self.V, self.A, self.lanes, rec_start, out)
+        return out[:self.n]
 
 
 def make_batch(pair, integ, faults, gear_errs, pin_errs) -> Batch:

@@ -27,6 +27,7 @@ import json
 import os
 import shutil
 import sys
+import time
 import zlib
 from pathlib import Path
 
@@ -35,7 +36,15 @@ import numpy as np
 from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
-from .._validation import check_finite, check_int, describe
+from .._validation import check_finite, check_int, check_load, check_speed, describe
+from ._block_read import read_block, resume_problem
+from ._integrity import (
+    block_content_problem,
+    block_draws,
+    manifest_diff,
+    manifest_digest,
+    store_lock,
+)
 from .dynamics import simulate_sa
 from .fault_types import FAULT_MODEL_VERSIONS, FAULT_TYPES, check_fault_type
 from .geometry import GearPair
@@ -153,12 +162,13 @@ def _write_checksums(folder: Path, manifest: dict) -> None:
             if rel != _ROOT and not name.startswith("."):
                 files[rel] = list(_file_digest(full))
     meta = json.loads((folder / _ROOT).read_text())
-    meta.setdefault("attributes", {})[_ATTR] = {"files": files, "manifest": manifest}
+    meta.setdefault("attributes", {})[_ATTR] = {"files": files, "manifest": manifest,
+                                                "manifest_sha256": manifest_digest(manifest)}
     write_json_atomic(meta, folder / _ROOT, indent=2, sort_keys=False)
 
 
 def _block_record(path: Path) -> dict:
-    """The checksum list of a block; ``{}`` for a block from before checksum lists."""
+    """The checksum list of a block; ``{}`` when it has none."""
     meta = json.loads((path / _ROOT).read_text())
     record = meta.get("attributes", {}).get(_ATTR, {})
     if not isinstance(record, dict):
@@ -175,7 +185,7 @@ def _block_problem(path: Path) -> str | None:
     except (OSError, ValueError) as exc:
         return f"its metadata file {_ROOT!r} is unreadable ({exc})"
     if not record:
-        return _legacy_block_problem(path)
+        return f"its checksum list (attribute {_ATTR!r}) is missing"
     files = record.get("files")
     if not isinstance(files, dict) or not files:
         return f"its checksum list (attribute {_ATTR!r}) is damaged"
@@ -192,31 +202,50 @@ def _block_problem(path: Path) -> str | None:
     return None
 
 
-def _legacy_block_problem(path: Path) -> str | None:
-    """A block written before checksum lists: decode it and look for holes (fill values)."""
+def _ownership_problem(path: Path, manifest: dict, i: int, j: int, k: int,
+                       fault_type: str) -> str | None:
+    """Whether a whole block belongs to the build ``manifest`` (``None``: it does).
+
+    A block records the digest of the manifest its builder was given; a block from before
+    digests is checked by its content (coordinates, seeds) once and then given the digest.
+    """
+    record = _block_record(path)
+    digest = record.get("manifest_sha256")
+    if digest is not None:
+        if digest == manifest_digest(manifest):
+            return None
+        recorded = record.get("manifest")
+        theirs: dict = recorded if isinstance(recorded, dict) else {}
+        return f"it was built by another build (differs in {manifest_diff(theirs, manifest)})"
     import xarray as xr
 
     try:
-        ds = xr.open_zarr(path, consolidated=False).load()
-    except Exception as exc:  # a decoder's error on a damaged chunk
+        ds = xr.open_zarr(path, consolidated=False)
+        problem = block_content_problem(ds, manifest, i, j, k, fault_type,
+                                        list(FAULT_TYPES).index(fault_type))
+    except Exception as exc:  # a decoder's error on a damaged block
         return f"it cannot be decoded ({type(exc).__name__}: {exc})"
-    for name in ("sa", "fault_size", "seed", "grade"):
-        if name not in ds.variables:
-            return f"its array {name!r} is missing"
-    if not (np.all(np.isfinite(ds["sa"].values))
-            and np.all(np.isfinite(ds["fault_size"].values))):
-        return "a chunk of it is missing (its arrays hold fill values)"
-    return None
+    if problem is None:
+        meta = json.loads((path / _ROOT).read_text())
+        meta["attributes"][_ATTR].update(manifest=manifest,
+                                         manifest_sha256=manifest_digest(manifest))
+        write_json_atomic(meta, path / _ROOT, indent=2, sort_keys=False)
+    return problem
 
 
 def _block_manifest(path: Path) -> dict | None:
+    """The manifest a block records, if its digest vouches for it."""
     try:
-        return _block_record(path).get("manifest")
+        record = _block_record(path)
     except (OSError, ValueError):
         return None
+    man = record.get("manifest")
+    if not isinstance(man, dict) or record.get("manifest_sha256") != manifest_digest(man):
+        return None
+    return man
 
 
-def _rebuild_hint(store: Path, man: dict) -> str:
+def _rebuild_hint(store: Path, man: dict, blocks=()) -> str:
     def many(opt, values, fmt):
         return " ".join(f"{opt} {fmt(v)}" for v in values)
 
@@ -228,8 +257,37 @@ def _rebuild_hint(store: Path, man: dict) -> str:
            f"--seed {man.get('seed')}"
            + "".join(f" --fault-type {t}" for t in man.get("fault_types", []))
            + ("" if man.get("paired") else " --no-paired"))   # paired is the default
-    return (f"run `{cmd}` (or build_database with the same arguments): it rebuilds only "
-            f"the damaged block and reuses the rest")
+    what = (f"it (re)builds {', '.join(blocks)} and reuses the other blocks" if blocks else
+            "it restores manifest.json from the blocks' copies and rebuilds no block")
+    return f"run `{cmd}` (or build_database with the same arguments): {what}"
+
+
+def _check_against_manifest(store: Path, path: Path, part, man: dict, where: str,
+                            i: int, j: int, k: int, fault_type: str) -> None:
+    """Raise unless a loaded block is the one ``manifest.json`` describes at its position.
+
+    Two checks: the manifest digest the block's builder recorded (absent in blocks built
+    before digests) and the block's own coordinates (:func:`block_content_problem`). The
+    repair named is the blocks' build when every block vouches for another manifest than
+    ``manifest.json`` (the file was edited), else a rebuild of this block.
+    """
+    digest = _block_record(path).get("manifest_sha256")
+    problem: str | None
+    if digest is not None and digest != manifest_digest(man):
+        problem = ("it records another build than manifest.json (differs in "
+                   f"{manifest_diff(_block_manifest(path) or {}, man)})")
+    else:
+        problem = block_content_problem(part, man, i, j, k, fault_type,
+                                        list(FAULT_TYPES).index(fault_type))
+    if problem is None:
+        return
+    theirs = _block_manifest(path)
+    if theirs is not None and theirs != man and all(
+            _block_manifest(b) == theirs for b in (store / "blocks").glob("*.zarr")):
+        raise GearshotError(f"{where} contradicts manifest.json: {problem}; manifest.json "
+                            f"was changed after the build; {_rebuild_hint(store, theirs)}")
+    raise GearshotError(f"{where} does not belong to this store's build: {problem}; "
+                        f"{_rebuild_hint(store, man, [path.name])}")
 
 
 def _read_manifest(store: Path) -> dict:
@@ -242,14 +300,14 @@ def _read_manifest(store: Path) -> dict:
         raise GearshotError(
             f"store {str(store)!r}: manifest.json is damaged ({exc}); run build_database / "
             f"`gearshot simulate` on this store with its original arguments: the manifest "
-            f"is restored from the blocks' copies and damaged blocks are rebuilt") from None
+            f"is restored from the blocks' copies (no block is rebuilt)") from None
     return man
 
 
 def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: float,
                  load: float, grade: int, n_healthy: int, n_faulty: int, seed: int,
                  n_points: int, single_thread: bool = False, fault_type: str = "ftff",
-                 paired: bool = False) -> str:
+                 paired: bool = False, manifest: dict | None = None) -> str:
     import xarray as xr
 
     if single_thread:
@@ -259,13 +317,11 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     final = blocks / _block_name(i, j, k, fault_type)
     if final.exists():
         return final.name
-    manifest = json.loads((Path(store) / "manifest.json").read_text())
+    if manifest is None:   # the builder's manifest, never one found on disk
+        raise GearshotError("_build_block needs the build's manifest")
     code = list(FAULT_TYPES).index(fault_type)
-    ss = np.random.SeedSequence(seed, spawn_key=(i, j, k) if code == 0 else (i, j, k, code))
-    block_rng = np.random.default_rng(ss)
     n = n_healthy + n_faulty
-    sizes = np.concatenate([np.zeros(n_healthy), block_rng.uniform(0.0, 1.0, n_faulty)])
-    sig_seeds = block_rng.integers(0, 2 ** 63 - 1, n, dtype=np.int64)
+    sizes, sig_seeds = block_draws(seed, i, j, k, code, n_healthy, n_faulty)
     sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
                      n_points=n_points, rng=[int(s) for s in sig_seeds],
                      fault_type=fault_type)
@@ -358,6 +414,10 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         raise GearshotError(f"pair must be a GearPair; got {describe(pair)}")
     speeds = _check_values(speeds, "speeds", lo=0)
     loads = _check_values(loads, "loads", lo=0)
+    for v in speeds:
+        check_speed(float(v), "speeds")
+    for v in loads:
+        check_load(float(v), "loads")
     grades = _check_values(grades, "grades", integer=True, hi=12)
     n_healthy = check_int(n_healthy, "n_healthy", minimum=0)
     n_faulty = check_int(n_faulty, "n_faulty", minimum=0)
@@ -374,8 +434,25 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         raise GearshotError(f"paired must be True or False; got {describe(paired)}")
     manifest = _manifest(pair, speeds, loads, grades, n_healthy, n_faulty, seed, n_points,
                          fault_types, bool(paired))
-    _prepare_store(store, manifest)
+    check_writable(store, "store", folder=True)
+    try:
+        store.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise GearshotError(f"store {str(store)!r} cannot be created "
+                            f"({exc.strerror or exc})") from None
+    with store_lock(store, manifest, progress=progress):
+        try:
+            _prepare_store(store, manifest, progress)
+            _build_locked(store, pair, manifest, speeds, loads, grades, fault_types,
+                          n_healthy, n_faulty, seed, n_points, client, progress,
+                          bool(paired))
+        finally:   # temporaries of this run (a failed or killed worker): we hold the lock
+            _remove_temporaries(store)
+    return store
 
+
+def _build_locked(store, pair, manifest, speeds, loads, grades, fault_types, n_healthy,
+                  n_faulty, seed, n_points, client, progress, paired):
     tasks = [(i, j, k, float(s), float(ld), int(g), ft)
              for i, s in enumerate(speeds) for j, ld in enumerate(loads)
              for k, g in enumerate(grades) for ft in fault_types]
@@ -385,10 +462,9 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
     for t in tasks:
         path = blocks / _block_name(*t[:3], t[6])
         if path.exists():
-            problem = _block_problem(path)
+            problem = resume_problem(path) or _ownership_problem(path, manifest, *t[:3],
+                                                                 t[6])
             if problem is None:
-                if not _block_record(path):   # a block from before checksum lists
-                    _write_checksums(path, manifest)
                 continue
             damaged.append(f"{path.name} ({problem})")
             remove_tree(path)
@@ -404,38 +480,57 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         client = Client(own_cluster)
     try:
         _run_tasks(store, pair, todo, len(tasks), n_healthy, n_faulty, seed, n_points,
-                   client if client else None, progress, bool(paired))
+                   client if client else None, progress, paired, manifest)
     finally:
         if own_cluster is not None:
             client.close()
             own_cluster.close()
-    return store
 
 
-def _prepare_store(store: Path, manifest: dict) -> None:
-    check_writable(store, "store", folder=True)
+def _remove_temporaries(store: Path) -> None:
+    """Remove hidden temporary folders/files (``.*.tmp``) of blocks and the manifest."""
+    for folder in (store, store / "blocks"):
+        if folder.is_dir():
+            for leftover in folder.glob(".*.tmp*"):
+                if leftover.is_dir():
+                    shutil.rmtree(leftover, ignore_errors=True)
+                else:
+                    leftover.unlink(missing_ok=True)
+
+
+def _prepare_store(store: Path, manifest: dict, progress: bool = True) -> None:
+    """Check (or write, or restore) the manifest; called with the store's lock held."""
+    _remove_temporaries(store)          # of killed runs
     mpath = store / "manifest.json"
     if mpath.exists():
         try:
             old = _read_manifest(store)
         except GearshotError:
-            # restore a damaged manifest only from blocks that say they are this build
-            copies = [_block_manifest(b) for b in (store / "blocks").glob("*.zarr")]
-            if not copies or any(c != manifest for c in copies):
-                raise
-            old = manifest
-            write_json_atomic(manifest, mpath, sort_keys=False)
+            old = None
         if old != manifest:
-            diff = sorted(k for k in manifest if old.get(k) != manifest[k])
-            hint = ""
-            if diff == ["paired"]:
-                hint = (" (it was built without healthy twins: finish it with paired=False"
-                        " / --no-paired)" if manifest.get("paired") else
-                        " (it was built with healthy twins: finish it with paired=True"
-                        " / --paired)")
-            raise GearshotError(f"store {str(store)!r} holds a different build "
-                                f"(differs in {', '.join(diff)}){hint}; use a new store "
-                                f"(--store / store=)")
+            # manifest.json is damaged or says another build: restore it only when the
+            # blocks (by their recorded digests) all vouch for this build
+            copies = [_block_manifest(b) for b in (store / "blocks").glob("*.zarr")]
+            if copies and all(c == manifest for c in copies):
+                if progress:
+                    what = ("is damaged" if old is None else
+                            f"contradicts its blocks (differs in {manifest_diff(old, manifest)})")
+                    print(f"store {str(store)!r}: manifest.json {what}; restored from the "
+                          f"blocks' copies", file=sys.stderr)
+                write_json_atomic(manifest, mpath, sort_keys=False)
+            elif old is None:
+                _read_manifest(store)     # raises its error
+            else:
+                diff = sorted(k for k in manifest if old.get(k) != manifest[k])
+                hint = ""
+                if diff == ["paired"]:
+                    hint = (" (it was built without healthy twins: finish it with "
+                            "paired=False / --no-paired)" if manifest.get("paired") else
+                            " (it was built with healthy twins: finish it with paired=True"
+                            " / --paired)")
+                raise GearshotError(f"store {str(store)!r} holds a different build "
+                                    f"(differs in {', '.join(diff)}){hint}; use a new store "
+                                    f"(--store / store=)")
     try:
         (store / "blocks").mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -443,39 +538,38 @@ def _prepare_store(store: Path, manifest: dict) -> None:
             from None
     if not mpath.exists():
         write_json_atomic(manifest, mpath, sort_keys=False)
-    for leftover in (store / "blocks").glob(".*.tmp"):   # from interrupted runs
-        shutil.rmtree(leftover, ignore_errors=True)
 
 
 def _run_tasks(store, pair, todo, n_total, n_healthy, n_faulty, seed, n_points, client,
-               progress, paired=False):
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+               progress, paired=False, manifest=None):
+    from .._progress import progress as progress_of
 
-    columns = (TextColumn("simulating blocks"), BarColumn(), MofNCompleteColumn(),
-               TimeElapsedColumn(), TimeRemainingColumn())
-    with Progress(*columns, disable=not progress) as bar:
-        task = bar.add_task("blocks", total=n_total, completed=n_total - len(todo))
+    with progress_of("simulating blocks", n_total, completed=n_total - len(todo),
+                     enabled=progress) as bar:
         if client is None:
             for t in todo:
                 _build_block(str(store), pair, *t[:6], n_healthy, n_faulty, seed, n_points,
-                             fault_type=t[6], paired=paired)
-                bar.advance(task)
+                             fault_type=t[6], paired=paired, manifest=manifest)
+                bar.advance()
             return
         from dask.distributed import as_completed
         futures = [client.submit(_build_block, str(store), pair, *t[:6], n_healthy,
-                                 n_faulty, seed, n_points, True, t[6], paired,
+                                 n_faulty, seed, n_points, True, t[6], paired, manifest,
                                  pure=False)
                    for t in todo]
-        for fut in as_completed(futures):
-            fut.result()
-            bar.advance(task)
+        try:
+            for fut in as_completed(futures):
+                fut.result()
+                bar.advance()
+        except Exception:
+            # a failed block (a full disk, ...): drop the queued blocks, and give the
+            # running ones a minute to finish or to remove their temporary folders
+            client.cancel(futures)
+            deadline = time.monotonic() + 60
+            while (any((Path(store) / "blocks").glob(".*.tmp"))
+                   and time.monotonic() < deadline):
+                time.sleep(0.2)
+            raise
 
 
 def load_database(store, *, speed: float, load: float, grade: int | None = None,
@@ -533,20 +627,22 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
             where = (f"block {path.name} (speed={speed!r}, load={load!r}, "
                      f"grade={man['grades'][k]!r}, fault_type={ft!r}) of store {str(store)!r}")
             if not path.exists():
-                raise GearshotError(f"{where} is not built yet; {_rebuild_hint(store, man)}")
-            problem = _block_problem(path)
-            if problem is None:
-                try:
-                    part = xr.open_zarr(path, consolidated=False).load()
-                except Exception as exc:  # a decoder's error on a damaged chunk
-                    problem = f"it cannot be decoded ({type(exc).__name__}: {exc})"
-                else:
-                    if any(name in part and not np.all(np.isfinite(part[name].values))
-                           for name in ("sa", "sa_twin")) or "sa" not in part:
-                        problem = "its SA array is incomplete (non-finite values)"
+                raise GearshotError(f"{where} is not built yet; "
+                                    f"{_rebuild_hint(store, man, [path.name])}")
+            part, problem = read_block(path)
+            if part is not None and (
+                    "sa" not in part or any(
+                        name in part and not np.all(np.isfinite(part[name].values))
+                        for name in ("sa", "sa_twin"))):
+                problem = "its SA array is incomplete (non-finite values)"
+            elif part is not None and problem is None:
+                _check_against_manifest(store, path, part, man, where, i, j, k, ft)
             if problem is not None:
+                if "is corrupt" in problem:   # resuming checks sizes and times only
+                    problem += (f" (should the rebuild find nothing to do, remove "
+                                f"{str(path)!r} first)")
                 raise GearshotError(f"{where} is damaged: {problem}; "
-                                    f"{_rebuild_hint(store, man)}")
+                                    f"{_rebuild_hint(store, man, [path.name])}")
             part.attrs.pop(_ATTR, None)
             part.attrs.pop("fault_type", None)
             parts.append(part.assign_coords(

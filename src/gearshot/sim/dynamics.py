@@ -21,7 +21,7 @@ import numpy as np
 import scipy.fft as sp_fft
 
 from .._errors import GearshotError
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_load, check_positive, check_speed
 from ._decimate import StreamingDecimator, fir_half_length
 from ._inputs import as_rng, check_grade, check_pair, draw_errors, profile_fn, resolve_faults
 from ._system import integrator, make_batch, system_matrices, warmup_time
@@ -86,8 +86,8 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
         Vertical acceleration SAs, g.
     """
     check_pair(pair)
-    speed = check_positive(speed, "speed")
-    load = check_positive(load, "load")
+    speed = check_speed(speed)
+    load = check_load(load)
     grade = check_grade(grade)
     faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type)
     n_sig = len(faults)

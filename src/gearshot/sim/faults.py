@@ -316,12 +316,9 @@ class FullToothFaceFault(ToothFault):
 
 @functools.lru_cache(maxsize=1024)
 def _bridge(fault: FullToothFaceFault, pair: GearPair):
-    s0, s1 = fault.window
-    knots = np.linspace(s0, s1, 129)   # smooth but for the edge switch: interpolate
-    ret, radius = fault._retreat(pair, 1.0 - knots)
-    rb = pair.base_radius(pair.z_gear)
-    _, (l_lo, l_hi) = pair.roll_limits
-    contact = (np.sqrt(np.maximum(radius ** 2 - rb ** 2, 0.0)) - l_lo) / (l_hi - l_lo)
+    from ._ftff_batch import bridge_batch  # one code path for one fault and a batch
+
+    knots, ret, contact = (a[0] for a in bridge_batch(pair, [fault]))
     for arr in (knots, ret, contact):
         arr.setflags(write=False)
     return knots, ret, contact

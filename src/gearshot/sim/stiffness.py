@@ -23,6 +23,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array
+from ._ftff_batch import ftff_cached, is_ftff
 from ._slices import box, tau_grid
 from .faults import ToothFault
 from .geometry import GearPair, involute_half_angle
@@ -202,6 +203,8 @@ def _faulty_gear_compliance(pair: GearPair, fault: ToothFault) -> np.ndarray:
 
 @functools.lru_cache(maxsize=256)
 def _pair_table(pair: GearPair, fault: ToothFault | None) -> np.ndarray:
+    if is_ftff(fault):                  # FTFFs: batch tables (gearshot.sim._ftff_batch)
+        return ftff_cached(pair, [fault])[0][0]
     inv_p, inv_g = _healthy_compliances(pair)
     if fault is not None and not fault.is_healthy:
         inv_g = _faulty_gear_compliance(pair, fault)
@@ -223,8 +226,11 @@ def _band_tables(pair: GearPair, fault: ToothFault):
     for z0, z1, f in fault.face_bands(pair):
         if z1 <= z0 or f is None or f.is_healthy:
             continue
-        d = np.asarray(f.displacement(pair, 1.0 - u), dtype=float)
-        d.setflags(write=False)
+        if is_ftff(f):
+            d = ftff_cached(pair, [f])[0][1]
+        else:
+            d = np.asarray(f.displacement(pair, 1.0 - u), dtype=float)
+            d.setflags(write=False)
         out.append((float(z0), float(z1), _pair_table(pair, f), d))
     return tuple(out)
 
@@ -235,6 +241,8 @@ def fault_tables(pair: GearPair, fault: ToothFault):
     (N/m) and the displacement excitation e_f (m) such that the pair's force is
     ``k_f (e + e_f)`` for profile errors e; bands weighted by their face width."""
     u = np.linspace(0.0, 1.0, _N_TABLE)
+    if is_ftff(fault):
+        return ftff_cached(pair, [fault])[0]
     if _whole_face(fault, pair):
         ef = np.asarray(fault.displacement(pair, 1.0 - u), dtype=float)
         return _pair_table(pair, fault), ef
@@ -250,7 +258,8 @@ def fault_tables(pair: GearPair, fault: ToothFault):
     return k, ef
 
 
-def helical_tables(pair: GearPair, fault: ToothFault | None = None):
+def helical_tables(pair: GearPair, fault: ToothFault | None = None, *,
+                   stiffness: bool = True):
     """Slice-method tables of one helical tooth pair over the delay tau.
 
     Returns
@@ -263,6 +272,9 @@ def helical_tables(pair: GearPair, fault: ToothFault | None = None):
         Per face band (delays lo ... hi in mesh periods): the band's stiffness change
         ``k_band - k_healthy`` and force per displacement ``k_band d_band`` over u (spur
         tables, full-width scale), to be boxed with the profile errors.
+
+    ``stiffness=False`` leaves the faulty tooth's stiffness out (``k`` is then the
+    healthy one): a batch boxes its faults' bands together.
     """
     ea, eb = pair.contact_ratio, pair.overlap_ratio
     tau = tau_grid(ea, eb, _N_TABLE)
@@ -273,6 +285,8 @@ def helical_tables(pair: GearPair, fault: ToothFault | None = None):
     if fault is not None and not fault.is_healthy:
         bands = tuple((z0 * eb, z1 * eb, kb - healthy, kb * d)
                       for z0, z1, kb, d in _band_tables(pair, fault))
+        if not stiffness:
+            return span, k, bands
         k = k.copy()
         if bands:
             lo, hi, dk, _ = band_arrays(bands)

@@ -124,7 +124,11 @@ def propagate(signals, tf) -> np.ndarray:
     if tf.shape[-1] != signals.shape[-1]:
         raise GearshotError(
             f"tf has {tf.shape[-1]} points but signals have {signals.shape[-1]} per cycle")
-    return scipy.fft.ifft(scipy.fft.fft(signals, axis=-1) * tf, axis=-1).real
+    # real signals: real(IDFT(tf X)) = IDFT of the Hermitian part of tf X, whose positive
+    # half is X_k (tf_k + conj(tf_{-k})) / 2: one real FFT pair instead of complex ones
+    n = signals.shape[-1]
+    half = 0.5 * (tf + np.conj(tf[(-np.arange(n)) % n]))[: n // 2 + 1]
+    return scipy.fft.irfft(scipy.fft.rfft(signals, axis=-1) * half, n=n, axis=-1)
 
 
 def rms_normalize(signals, reference) -> np.ndarray:

@@ -1,0 +1,134 @@
+"""Operating conditions in the user's terms: the database's speeds as tacho-shaft speeds,
+every recording's tacho speed checked against the condition it is estimated at.
+
+A simulated database of a machine stores the speed of the monitored gear's mate (the
+simulator's input, :meth:`gearshot.Machine.sim_speed`); a user types and reads the
+speed of the shaft the tacho watches, in Hz (revolutions per second). Everything here
+speaks tacho-shaft Hz.
+
+Speed tolerance
+---------------
+:data:`SPEED_TOLERANCE` (5 %): a recording whose tacho speed lies further than this from
+the database's condition is refused, with one line naming the file, its speed, the nearest
+condition and the tolerance. The PHM 2009 gearbox, for one, runs 0-3 % below its nominal
+speed under load (its README: 0.97-1.00 x nominal), so 5 % accepts a record at its
+nominal condition and refuses one at the next 5 Hz step (35 Hz against a 30 or 40 Hz
+database: 12-14 %). Within the tolerance the record is estimated; its own tacho speed
+and the condition are both in the output (``speed_hz``, ``database_speed_hz``).
+
+Load
+----
+A database slice is one (speed, load) condition. When the load is not quantified (the PHM
+2009 records say only High / Low), build the database at one nominal load and leave
+``--load`` out: the database's only load is used and reported; a database over several
+loads needs ``--load``, and the error lists them.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+from .._errors import GearshotError
+
+__all__ = ["SPEED_TOLERANCE", "database_conditions", "choose_condition", "check_speeds"]
+
+#: Largest relative distance between a recording's tacho speed and the database condition
+SPEED_TOLERANCE = 0.05
+
+
+def database_conditions(store: str | Path, machine=None) -> tuple[list[float], list[float]]:
+    """The (speeds, loads) of a database; speeds as tacho-shaft Hz with ``machine``.
+
+    Raises
+    ------
+    GearshotError
+        ``store`` is not a gearshot database (no readable ``manifest.json``).
+    """
+    path = Path(store) / "manifest.json"
+    try:
+        man = json.loads(path.read_text())
+        speeds, loads = [float(s) for s in man["speeds"]], [float(x) for x in man["loads"]]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        what = "does not exist" if not Path(store).exists() else \
+            f"is not a gearshot database ({type(exc).__name__}: {exc})"
+        raise GearshotError(f"--database {str(store)!r} {what}") from None
+    if machine is not None:
+        ratio = machine.sim_speed(1.0)
+        speeds = [s / ratio for s in speeds]
+    return speeds, loads
+
+
+def _fmt(values: Sequence[float]) -> str:
+    return "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
+
+
+def choose_condition(store: str | Path, machine, *, speed: float | None,
+                     load: float | None, measured: Sequence[float]) -> tuple[float, float]:
+    """The database condition (tacho-shaft Hz, load) to estimate at.
+
+    Parameters
+    ----------
+    store : path
+        The database.
+    machine : gearshot.Machine or None
+        Speeds are tacho-shaft Hz with a machine, the database's own unit without.
+    speed : float or None
+        What the user typed; None: the condition nearest to the median of ``measured``.
+    load : float or None
+        What the user typed; None: the database's only load.
+    measured : sequence of float
+        Tacho speeds of the healthy recordings (used when ``speed`` is None).
+    """
+    speeds, loads = database_conditions(store, machine)
+    unit = "Hz (tacho shaft)" if machine is not None else "rps"
+    if speed is None:
+        if not measured:
+            raise GearshotError("--speed is needed: no recording to read the speed from")
+        mid = sorted(measured)[len(measured) // 2]
+        speed = min(speeds, key=lambda s: abs(s - mid))
+    else:
+        match = [s for s in speeds if abs(s - speed) <= 1e-6 * max(1.0, abs(speed))]
+        if not match:
+            raise GearshotError(f"--speed {speed:g} is not a condition of database "
+                                f"{str(store)!r}: it holds {_fmt(speeds)} {unit}")
+        speed = match[0]
+    if load is None:
+        if len(loads) != 1:
+            raise GearshotError(f"--load is needed: database {str(store)!r} holds loads "
+                                f"{_fmt(loads)} N m (an unquantified load: build the "
+                                f"database at one load and leave --load out)")
+        load = loads[0]
+    elif not any(abs(x - load) <= 1e-9 * max(1.0, abs(load)) for x in loads):
+        raise GearshotError(f"--load {load:g} is not a condition of database "
+                            f"{str(store)!r}: it holds {_fmt(loads)} N m")
+    return float(speed), float(load)
+
+
+def check_speeds(measured: Sequence[tuple[str, float]], condition: float, *,
+                 conditions: Sequence[float] = (),
+                 tolerance: float = SPEED_TOLERANCE) -> None:
+    """Refuse a recording whose tacho speed is further than ``tolerance`` from
+    ``condition``.
+
+    Parameters
+    ----------
+    measured : sequence of (file, tacho speed in Hz)
+    condition : float
+        The database condition the records are estimated at, tacho-shaft Hz.
+    conditions : sequence of float
+        Every speed of the database (the nearest is named in the error).
+    tolerance : float
+        Relative; :data:`SPEED_TOLERANCE` by default.
+    """
+    for name, hz in measured:
+        off = abs(hz - condition) / condition
+        if off > tolerance:
+            nearest = min([*conditions, condition], key=lambda s: abs(s - hz))
+            raise GearshotError(
+                f"recording {name!r}: its tacho reads {hz:.4g} Hz, {100 * off:.0f} % from the "
+                f"database condition {condition:.4g} Hz (nearest condition {nearest:.4g} Hz, "
+                f"tolerance {100 * tolerance:.0f} %); estimate it against a database "
+                f"simulated at its speed (gearshot simulate --machine ... --speed "
+                f"{round(hz):d})")

@@ -1,0 +1,368 @@
+"""Stiffness and displacement tables of many full tooth face faults at once.
+
+A database block simulates hundreds of FTFFs of continuous random sizes, so their tables
+are never cache hits. Per fault the work is the bridge of the cut
+(:meth:`FullToothFaceFault.bridge`: the mating flank's rigid retreat at 129 contact
+positions against 90 points of the cut flank) and the faulty tooth's compliance at the
+knots of its smooth segments (potential-energy integrals over 241 Simpson nodes each).
+Here the bridge runs as one numpy evaluation over the whole batch (element by element
+the same operations as for one fault, so the same numbers) and the compliance integrals
+as one numba loop over every knot of every fault (the per-knot sums in sequence instead
+of numpy's pairwise order: a last-bit difference). The tables follow
+:func:`gearshot.sim.stiffness._faulty_gear_compliance` and
+:meth:`FullToothFaceFault.displacement` exactly otherwise; those stay the reference
+(generic faults) and the tests compare both.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numba as nb
+import numpy as np
+
+from .geometry import GearPair, involute_half_angle
+
+__all__ = ["bridge_batch", "ftff_gear_compliance"]
+
+_N_KNOTS = 129      # bridge samples across the cut
+_MARGIN = 0.04      # FullToothFaceFault._flank_points defaults
+_N_ARC = 80
+_N_INVOLUTE = 5     # involute points beyond each edge of the cut
+
+
+def _arcs(pair: GearPair, faults):
+    """:meth:`FullToothFaceFault._arc` of every fault, as arrays (n,): window s0, s1 and
+    the cut's xa, xb, cx, ch, radius."""
+    z = pair.z_gear
+    rb = pair.base_radius(z)
+    _, (l_lo, l_hi) = pair.roll_limits
+    size = np.array([f.size for f in faults], dtype=float)
+    centre = np.array([f.center for f in faults], dtype=float)
+    depth = np.array([f.depth for f in faults], dtype=float)
+    s0, s1 = centre - 0.5 * size, centre + 0.5 * size
+    ends = []
+    for sv in (s0, s1):
+        r = np.hypot(rb, l_lo + sv * (l_hi - l_lo))
+        psi = involute_half_angle(z, pair.transverse_pressure_angle, r, rb)
+        ends.append((r * np.cos(psi), r * np.sin(psi)))
+    (xa, ha), (xb, hb) = ends
+    chord = np.hypot(xb - xa, hb - ha)
+    radius = chord / 4 * (depth + 1 / depth)
+    sag = depth * chord / 2
+    tx, th = (xb - xa) / chord, (hb - ha) / chord
+    sign = np.where(-tx > 0, -1.0, 1.0)       # normal pointing into the tooth
+    nx, nh = sign * th, sign * -tx
+    mx, mh = 0.5 * (xa + xb), 0.5 * (ha + hb)
+    cx, ch = mx - nx * (radius - sag), mh - nh * (radius - sag)
+    return s0, s1, np.column_stack([xa, xb, cx, ch, radius])
+
+
+def _flank_points(pair: GearPair, s0, s1, arcs):
+    """:meth:`FullToothFaceFault._flank_points` of every fault: (n, 90) radius and angle
+    from the tooth centre line."""
+    z = pair.z_gear
+    rb = pair.base_radius(z)
+    _, (l_lo, l_hi) = pair.roll_limits
+    pieces = [np.linspace(np.maximum(s0 - _MARGIN, -0.02), s0, _N_INVOLUTE, axis=-1),
+              np.linspace(s1, np.minimum(s1 + _MARGIN, 1.0), _N_INVOLUTE, axis=-1)]
+    ls = l_lo + np.concatenate(pieces, axis=-1) * (l_hi - l_lo)
+    r = np.hypot(rb, np.maximum(ls, 0.0))
+    psi = involute_half_angle(z, pair.transverse_pressure_angle, r, rb)
+    xa, xb, cx, ch, radius = (arcs[:, m:m + 1] for m in range(5))
+    xx = np.linspace(xa[:, 0], xb[:, 0], _N_ARC, axis=-1)
+    hh = ch - np.sqrt(np.maximum(radius ** 2 - (xx - cx) ** 2, 0.0))
+    return (np.concatenate([r, np.hypot(xx, hh)], axis=-1),
+            np.concatenate([psi, np.arctan2(hh, xx)], axis=-1))
+
+
+def bridge_batch(pair: GearPair, faults, geometry=None):
+    """:meth:`FullToothFaceFault.bridge` of every fault: arrays (n, 129) of knots,
+    retreat (m) and touched roll fraction (``geometry``: :func:`_arcs` of the faults)."""
+    s0, s1, arcs = _arcs(pair, faults) if geometry is None else geometry
+    knots = np.linspace(s0, s1, _N_KNOTS, axis=-1)
+    r, ang = _flank_points(pair, s0, s1, arcs)
+    ret, radius = _retreat(pair, 1.0 - knots, r, ang)
+    rb = pair.base_radius(pair.z_gear)
+    _, (l_lo, l_hi) = pair.roll_limits
+    contact = (np.sqrt(np.maximum(radius ** 2 - rb ** 2, 0.0)) - l_lo) / (l_hi - l_lo)
+    return knots, ret, contact
+
+
+def _retreat(pair: GearPair, u, r, ang):
+    """:meth:`FullToothFaceFault._retreat` over a batch: ``u`` (n, n_u) line-of-action
+    fractions, flank points ``r, ang`` (n, n_pts). The per-knot part is numpy (the same
+    operations as for one fault); the search over the flank points runs in numba with
+    one arctangent per point (:func:`_min_gap`)."""
+    z1, z2 = pair.z_pinion, pair.z_gear
+    a0 = pair.transverse_pressure_angle
+    rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
+    ra1 = pair.tip_radius(z1)
+    (p_lo, p_hi), _ = pair.roll_limits
+    inv0 = math.tan(a0) - a0
+
+    def inv_r(rr, rb):
+        al = np.arccos(np.clip(rb / rr, -1.0, 1.0))
+        return np.tan(al) - al
+
+    d = np.array([math.sin(a0), math.cos(a0)])
+    t1 = rb1 * np.array([math.cos(a0), -math.sin(a0)])
+    o2 = np.array([pair.center_distance, 0.0])
+    lam = p_lo + u * (p_hi - p_lo)
+    cx, cy = t1[0] + lam * d[0], t1[1] + lam * d[1]
+    phi_p = np.arctan2(cy, cx) + inv_r(np.hypot(cx, cy), rb1)
+    gx, gy = cx - o2[0], cy - o2[1]
+    phi_g = np.arctan2(gy, gx) + inv_r(np.hypot(gx, gy), rb2)
+    centre = phi_g - math.pi / (2 * z2) - inv0
+    return _min_gap(np.cos(centre), np.sin(centre), phi_p, r, np.cos(ang), np.sin(ang),
+                    o2[0], rb1, ra1)
+
+
+@nb.njit(cache=True)
+def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
+    """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot.
+
+    A flank point at gear radius r and angle ``centre + ang`` lies at P = o2 + r
+    (cos, sin)(centre + ang) (angle addition); its pinion involute angle is
+    ``atan2(P) + inv(|P|)``, ``inv(rho) = tan(acos(rb1/rho)) - acos(rb1/rho)``, computed as
+    the angle of P turned back by ``acos(rb1/rho)`` (one arctangent) plus
+    ``sqrt(1 - c^2) / c``, c = rb1/|P|; the gap is wrapped to one base pitch circle as in
+    :meth:`FullToothFaceFault._retreat` (equal up to rounding). Points on the pinion's
+    flank ends (base and tip circle) count within a relative 1e-12."""
+    n, n_u = cc.shape
+    n_pts = r.shape[1]
+    ret = np.empty((n, n_u))
+    rad = np.empty((n, n_u))
+    circ = 2.0 * math.pi * rb1
+    half = math.pi * rb1
+    # the pinion flank's ends count (rounding of the rotated points must not drop the
+    # point at the pinion tip, where the contact at u = 1 lies)
+    lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
+    for f in range(n):
+        for m in range(n_u):
+            best = np.inf
+            kb = 0
+            cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
+            for k in range(n_pts):
+                cth = cm * ca[f, k] - sm * sa[f, k]
+                sth = sm * ca[f, k] + cm * sa[f, k]
+                px = o2x + r[f, k] * cth
+                py = r[f, k] * sth
+                rp = math.hypot(px, py)
+                if rp < lo_r or rp > hi_r:
+                    continue
+                c = rb1 / rp
+                s = math.sqrt(max(1.0 - c * c, 0.0))
+                theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
+                gap = rb1 * (theta - pp)
+                gap = (gap + half) % circ - half
+                if gap < best:
+                    best = gap
+                    kb = k
+            ret[f, m] = max(best, 0.0)
+            rad[f, m] = r[f, kb]
+    return ret, rad
+
+
+@functools.lru_cache(maxsize=32)
+def _involute_tables(pair: GearPair):
+    """The gear's involute (x, h) tables of ``_tooth_compliance`` (1200 points, to 1.001
+    of the tip) and of ``FullToothFaceFault.section_loss`` (601 points)."""
+    z = pair.z_gear
+    rb = pair.base_radius(z)
+    a0 = pair.transverse_pressure_angle
+    out = []
+    for r_tab in (np.linspace(rb, pair.tip_radius(z) * 1.001, 1200),
+                  np.linspace(rb, pair.tip_radius(z), 601)):
+        psi = involute_half_angle(z, a0, r_tab, rb)
+        x, h = r_tab * np.cos(psi), r_tab * np.sin(psi)
+        x.setflags(write=False)
+        h.setflags(write=False)
+        out.append((x, h))
+    return tuple(out)
+
+
+def ftff_gear_compliance(pair: GearPair, roll, arcs):
+    """Compliance (m/N) of the faulty gear tooth at roll lengths ``roll`` (m, 1-D), each
+    point with its fault's cut ``arcs`` (n_points, 5): xa, xb, cx, ch, radius of
+    :meth:`FullToothFaceFault._arc`. As ``_tooth_compliance(pair, z_gear, roll,
+    fault.section_loss)``."""
+    from .stiffness import _N_NODES, _SAINSOT
+
+    z = pair.z_gear
+    E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
+    G = E / (2 * (1 + nu))
+    rb, rf = pair.base_radius(z), pair.root_radius(z)
+    a0 = pair.transverse_pressure_angle
+    roll = np.asarray(roll, dtype=float)
+    rc = np.hypot(rb, roll)
+    psi_c = involute_half_angle(z, a0, rc, rb)
+    xc, hc = rc * np.cos(psi_c), rc * np.sin(psi_c)
+    beta = np.arccos(rb / rc) - psi_c
+    psi_b = float(involute_half_angle(z, a0, np.array(rb), rb))
+    hb = rb * math.sin(psi_b)
+    xb = rb * math.cos(psi_b)
+    x0 = min(rf, xb)
+    (x_tab, h_tab), (xs_tab, hs_tab) = _involute_tables(pair)
+    xi = np.linspace(0.0, 1.0, _N_NODES + 1)
+    w = np.ones(_N_NODES + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    w /= 3.0 * _N_NODES
+    inv = _node_sums(xc, hc, np.cos(beta), np.sin(beta), np.ascontiguousarray(arcs), x0,
+                     xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab, E, G, L)
+    theta_f = math.asin(min(hb / rf, 1.0))
+    s_f = 2 * rf * theta_f
+    h_fi = rf / pair.bore_radius
+    basis = np.array([1 / theta_f ** 2, h_fi ** 2, h_fi / theta_f, 1 / theta_f, h_fi, 1.0])
+    Ls, Ms, Ps, Qs = _SAINSOT @ basis
+    u_f = xc - hc * np.tan(beta) - rf
+    cbeta = np.cos(beta)
+    inv_kf = cbeta ** 2 / (E * L) * (Ls * (u_f / s_f) ** 2 + Ms * (u_f / s_f)
+                                    + Ps * (1 + Qs * np.tan(beta) ** 2))
+    return inv + inv_kf
+
+
+@nb.njit(cache=True, inline="always")
+def _interp_walk(x, xp, fp, j):
+    """np.interp of one point on an increasing table, searching on from cell ``j``;
+    returns (value, cell)."""
+    n = xp.shape[0]
+    if x < xp[0]:
+        return fp[0], 0
+    if x >= xp[n - 1]:
+        return fp[n - 1], j
+    while j < n - 2 and xp[j + 1] <= x:
+        j += 1
+    while j > 0 and xp[j] > x:
+        j -= 1
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    return slope * (x - xp[j]) + fp[j], j
+
+
+@nb.njit(cache=True)
+def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab,
+               E, G, L):
+    """Bending + shear + axial compliance: the Simpson sums of ``_tooth_compliance``
+    with the FTFF's section loss, one contact point per entry."""
+    n = xc.shape[0]
+    out = np.empty(n)
+    n_nodes = xi.shape[0]
+    for p in range(n):
+        xa, xe, cx, ch, rad = arcs[p, 0], arcs[p, 1], arcs[p, 2], arcs[p, 3], arcs[p, 4]
+        span = xc[p] - x0
+        cbp, sbp = cb[p], sb[p]
+        sb_kb = 0.0
+        sb_t = 0.0
+        j = 0
+        js = 0
+        for k in range(n_nodes):
+            x = x0 + span * xi[k]
+            if x <= xb:
+                h = hb
+            else:
+                h, j = _interp_walk(x, x_tab, h_tab, j)
+            t = 2.0 * h
+            loss = 0.0
+            if x > xa and x < xe:
+                h_flank, js = _interp_walk(x, xs_tab, hs_tab, js)
+                q = rad * rad - (x - cx) * (x - cx)
+                h_arc = ch - math.sqrt(q if q > 0.0 else 0.0)
+                loss = h_flank - h_arc
+                if loss < 0.0:
+                    loss = 0.0
+            t = max(t - loss, 0.05 * t)
+            it = 1.0 / t
+            arm = cbp * (xc[p] - x) - sbp * hc[p]
+            wk = w[k] * span
+            sb_kb += wk * arm * arm * (it * it * it)
+            sb_t += wk * it
+        # bending 12 / (E L t^3), shear 1.2 cos^2 / (G L t), axial sin^2 / (E L t)
+        out[p] = (12.0 / (E * L)) * sb_kb + (1.2 * cbp * cbp / (G * L)
+                                              + sbp * sbp / (E * L)) * sb_t
+    return out
+
+
+_RETREAT_CHUNK = 8          # faults per numpy evaluation of the bridge (memory bound)
+_CACHE: dict = {}           # (pair, fault) -> (k, ef), insertion-ordered
+_CACHE_SIZE = 4096
+
+
+def ftff_tables(pair: GearPair, faults):
+    """Tables over the spur contact position u (``_N_TABLE`` points) of non-healthy
+    FTFFs: pair stiffness k (N/m) and displacement excitation e_f (m), arrays (n, n_u);
+    as ``_pair_table(pair, fault)`` and ``fault.displacement(pair, 1 - u)``."""
+    from .stiffness import _N_SEGMENT, _N_TABLE, _healthy_compliances
+
+    n = len(faults)
+    s0s, s1s, arcs_all = _arcs(pair, faults)
+    parts = [bridge_batch(pair, faults[i:i + _RETREAT_CHUNK],
+                          (s0s[i:i + _RETREAT_CHUNK], s1s[i:i + _RETREAT_CHUNK],
+                           arcs_all[i:i + _RETREAT_CHUNK]))
+             for i in range(0, n, _RETREAT_CHUNK)]
+    knots, ret, contact = (np.concatenate([p[m] for p in parts]) for m in range(3))
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    s = 1.0 - u
+    inv_p, inv_g = _healthy_compliances(pair)
+    _, (g_lo, g_hi) = pair.roll_limits
+    rolls, arcs, segs = [], [], []
+    for i in range(n):
+        kn, ct = knots[i], contact[i]
+        j = int(np.argmax(np.abs(np.diff(ct))))          # FullToothFaceFault._switch
+        sw = 0.5 * (kn[j] + kn[j + 1])
+        s0, s1 = s0s[i], s1s[i]
+        edges = np.unique(np.clip(np.concatenate([[s0, 1.0], [s0, sw, s1]]), s0, 1.0))
+        k_hi, k_lo = kn > sw, kn <= sw
+        for a, b in zip(edges[:-1], edges[1:]):
+            if b - a <= 0:
+                continue
+            sel = (s >= a) & (s <= b) if b == 1.0 else (s >= a) & (s < b)
+            if not sel.any():
+                continue
+            eta = 1e-9 * (b - a)
+            kts = np.linspace(a + eta, b - eta, _N_SEGMENT)
+            cr = kts.copy()                               # FullToothFaceFault.contact_roll
+            hi = (kts > sw) & (kts < s1)
+            lo = (kts > s0) & (kts <= sw)
+            if hi.any():
+                cr[hi] = np.interp(kts[hi], kn[k_hi], ct[k_hi])
+            if lo.any():
+                cr[lo] = np.interp(kts[lo], kn[k_lo], ct[k_lo])
+            rolls.append(g_lo + cr * (g_hi - g_lo))
+            arcs.append(np.broadcast_to(arcs_all[i], (_N_SEGMENT, 5)))
+            segs.append((i, sel, kts))
+    vals = ftff_gear_compliance(pair, np.concatenate(rolls), np.concatenate(arcs))
+    inv = np.tile(inv_g, (n, 1))
+    for m, (i, sel, kts) in enumerate(segs):
+        inv[i, sel] = np.interp(s[sel], kts, vals[m * _N_SEGMENT:(m + 1) * _N_SEGMENT])
+    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+    k = 1.0 / (1.0 / k_h + inv_p + inv)
+    ef = np.zeros((n, _N_TABLE))
+    for i, f in enumerate(faults):                        # FullToothFaceFault.displacement
+        s0, s1 = s0s[i], s1s[i]
+        inside = (s > s0) & (s < s1)
+        if inside.any():
+            ef[i, inside] = -f.transmission * np.interp(s[inside], knots[i], ret[i])
+    return k, ef
+
+
+def ftff_cached(pair: GearPair, faults):
+    """``[(k, ef), ...]`` of non-healthy FTFFs (read-only arrays), the missing ones
+    computed in one :func:`ftff_tables` call and kept (the last 4096)."""
+    missing = [f for f in dict.fromkeys(faults) if (pair, f) not in _CACHE]
+    if missing:
+        k, ef = ftff_tables(pair, missing)
+        for f, kr, er in zip(missing, k, ef, strict=True):
+            kr.setflags(write=False)
+            er.setflags(write=False)
+            _CACHE[(pair, f)] = (kr, er)
+        while len(_CACHE) > _CACHE_SIZE:
+            del _CACHE[next(iter(_CACHE))]
+    return [_CACHE[(pair, f)] for f in faults]
+
+
+def is_ftff(fault) -> bool:
+    """True for a non-healthy fault handled here (exactly the FTFF class)."""
+    from .faults import FullToothFaceFault
+
+    return type(fault) is FullToothFaceFault and not fault.is_healthy

@@ -1,0 +1,329 @@
+"""Machines without a tachometer (issue #24): speed and angle from the vibration, and the
+regular / difference / residual / non-synchronous parts of a synchronous average."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from gearshot import GearshotError, Machine
+from gearshot.io import Recording
+from gearshot.signal import (
+    angle_pulse_times,
+    demodulate_angle,
+    difference_signal,
+    estimate_shaft_angle,
+    nonsynchronous_signal,
+    regular_signal,
+    residual_signal,
+    speed_ridge,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+PHM09 = ROOT.parent / "shared" / "data" / "phm09"
+MACHINES = ROOT / "examples" / "machines"
+needs_phm09 = pytest.mark.skipif(not (PHM09 / "spur2_30hz_High_1.zip").is_file(),
+                                 reason="../shared/data/phm09 is not here")
+
+
+def _ramp(fs=20_000.0, seconds=4.0, start=20.0, end=24.0):
+    t = np.arange(int(seconds * fs)) / fs
+    return t, start * t + 0.5 * (end - start) / seconds * t ** 2
+
+
+# --------------------------------------------------------------------------- analytic
+def test_run_up_angle_and_speed_follow_the_analytic_ramp():
+    fs = 20_000.0
+    t, revs = _ramp(fs)
+    rng = np.random.default_rng(3)
+    x = (np.sin(2 * np.pi * 32 * revs) + 0.5 * np.sin(2 * np.pi * 16 * revs + 1.0)
+         + 0.5 * rng.standard_normal(t.size))
+    est = estimate_shaft_angle(x, fs, orders=[32, 16], speed_range=(15, 30))
+    true = 20.0 * est.times + 0.5 * est.times ** 2
+    err = est.angle - true
+    err -= err.mean()  # the origin is arbitrary
+    inner = (est.times > 0.25) & (est.times < 3.75)
+    assert np.std(err[inner]) * 360 < 0.05          # degrees of shaft angle
+    assert abs(est.mean_speed / (20.0 + 0.5 * (est.times[0] + est.times[-1])) - 1) < 1e-4
+    speed_true = 20.0 + est.times
+    assert np.max(np.abs(est.speed[inner] - speed_true[inner])) < 0.02
+    assert est.order == 32 and est.snr_db > 20
+    # the stated uncertainty is of the size of the observed speed noise
+    observed = np.std(est.speed[inner] - speed_true[inner])
+    assert est.speed_std / 5 < observed < est.speed_std * 5
+    # virtual pulses sit at equal angle steps of the true angle
+    inner_pulses = est.pulse_times[(est.pulse_times > 0.25) & (est.pulse_times < 3.75)]
+    marks = 20.0 * inner_pulses + 0.5 * inner_pulses ** 2
+    steps = np.diff(marks)
+    assert np.allclose(steps, 1 / est.pulses_per_rev, atol=2e-4)
+
+
+def test_run_down_and_the_comb_picks_the_speed_not_half_of_it():
+    fs = 20_000.0
+    t, revs = _ramp(fs, start=30.0, end=26.0)
+    rng = np.random.default_rng(5)
+    # the idler-stage mesh (order 16) stronger than the shaft's own (32), as on PHM09
+    x = (0.5 * np.sin(2 * np.pi * 32 * revs) + np.sin(2 * np.pi * 16 * revs)
+         + 0.3 * np.sin(2 * np.pi * 48 * revs) + 0.4 * rng.standard_normal(t.size))
+    ridge = speed_ridge(x, fs, orders=[32, 16], speed_range=(20, 38))
+    true = 30.0 - ridge.times
+    assert np.max(np.abs(ridge.speed - true)) < 0.3
+    assert ridge.order % 32 == 0  # the shaft's own mesh is demodulated, not order 16
+    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
+                                         ridge_speed=ridge.speed)
+    err = angle - (30.0 * times - 0.5 * times ** 2)
+    inner = (times > 0.25) & (times < 3.75)
+    assert np.std(err[inner] - err[inner].mean()) * 360 < 0.1 and snr > 10
+
+
+def test_noise_is_refused_with_the_snr_found():
+    x = np.random.default_rng(0).standard_normal(80_000)
+    with pytest.raises(GearshotError, match=r"no mesh harmonic stands out.*-?\d+\.\d dB above "
+                                            r"the noise.*min_snr_db=3"):
+        estimate_shaft_angle(x, 20_000.0, orders=[32, 16], speed_range=(20, 35))
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(orders=[32], speed_range=(30, 20)), r"speed_range must be \(low, high\) with 0 < low"),
+    (dict(orders=[32], speed_range="fast"), r"speed_range must be \(low, high\)"),
+    (dict(orders=[], speed_range=(20, 30)), r"orders must be a positive integer or a non-empty"),
+    (dict(orders=[0], speed_range=(20, 30)), r"orders\[0\] must be >= 1; got 0"),
+    (dict(orders=[32], speed_range=(20, 30), track=400), r"track=400 at 30 rev/s is above"),
+    (dict(orders=[32], speed_range=(20, 30), bandwidth=0.0), r"bandwidth must"),
+    (dict(orders=[500], speed_range=(20, 30)), r"orders=\[500\] .* above the Nyquist"),
+])
+def test_bad_options_name_the_parameter(kwargs, message):
+    x = np.random.default_rng(1).standard_normal(20_000)
+    with pytest.raises(GearshotError, match=message):
+        estimate_shaft_angle(x, 20_000.0, **kwargs)
+
+
+def test_a_lone_tone_is_not_taken_for_a_gear_mesh():
+    fs = 20_000.0
+    t = np.arange(int(2 * fs)) / fs
+    x = np.sin(2 * np.pi * 777.0 * t) + 0.1 * np.random.default_rng(2).standard_normal(t.size)
+    with pytest.raises(GearshotError, match=r"1 of 3 comb lines stand out \(min_lines=2\)"):
+        estimate_shaft_angle(x, fs, orders=[32], speed_range=(20, 30))
+
+
+def test_angle_pulse_times_needs_a_turning_shaft():
+    t = np.linspace(0, 1, 11)
+    with pytest.raises(GearshotError, match=r"angle must increase .* t=0\.4"):
+        angle_pulse_times(t, np.r_[0, 1, 2, 3, 4, 4, 5, 6, 7, 8, 9.0])
+    with pytest.raises(GearshotError, match="same length"):
+        angle_pulse_times(t, t[:-1])
+
+
+# --------------------------------------------------------------------------- parts of a SA
+def _sa(n=256, seed=0):
+    return np.random.default_rng(seed).standard_normal((3, n))
+
+
+def test_regular_plus_residual_is_the_sa_without_its_mean():
+    sa = _sa()
+    reg = regular_signal(sa, [32, 16])
+    res = residual_signal(sa, [32, 16])
+    assert np.allclose(reg + res, sa - sa.mean(axis=-1, keepdims=True), atol=1e-12)
+    spec = np.abs(np.fft.rfft(res, axis=-1))
+    assert np.all(spec[:, [0, 1, 2, 16, 32, 48, 64, 128]] < 1e-10)  # mesh, shaft, DC gone
+    assert np.all(spec[:, [3, 15, 17, 31, 33]] > 1e-3)  # sidebands and the rest kept
+
+
+def test_the_parts_match_the_features_decomposition():
+    from gearshot.features import _Parts
+
+    sa = _sa(seed=4)
+    parts = _Parts(sa, (32, 16), 2, None, (1, 2))
+    assert np.allclose(residual_signal(sa, [32, 16]), parts.residual, atol=1e-12)
+    assert np.allclose(difference_signal(sa, [32, 16], n_sidebands=1, shaft_orders=(1, 2)),
+                       parts.zakrajsek_diff, atol=1e-12)
+    assert np.allclose(regular_signal(sa, [32, 16], shaft_orders=(), n_sidebands=1),
+                       parts.regular_mesh - parts.regular_mesh.mean(axis=-1, keepdims=True),
+                       atol=1e-12)
+    # without shaft_orders, the paper's difference signal is unchanged
+    assert np.allclose(difference_signal(sa, [32, 16]), parts.diff, atol=1e-12)
+
+
+def test_part_options_are_checked():
+    sa = _sa()
+    with pytest.raises(GearshotError, match=r"shaft_orders\[0\]=300 is above the Nyquist"):
+        residual_signal(sa, 32, shaft_orders=[300])
+    with pytest.raises(GearshotError, match=r"shaft_orders\[1\] must be >= 0"):
+        regular_signal(sa, 32, shaft_orders=[1, -2])
+    with pytest.raises(GearshotError, match="fewer than one cycle"):
+        nonsynchronous_signal(np.ones(10), 16)
+
+
+def test_nonsynchronous_signal_keeps_what_changes_from_cycle_to_cycle():
+    spc, n_cycles = 64, 20
+    k = np.arange(spc * n_cycles)
+    synchronous = np.cos(2 * np.pi * 5 * k / spc)
+    other = np.cos(2 * np.pi * 5.5 * k / spc)  # half an order off: changes every cycle
+    x = synchronous + other
+    non = nonsynchronous_signal(x, spc)
+    blocks = non.reshape(n_cycles, spc)
+    assert np.allclose(blocks.mean(axis=0), 0.0, atol=1e-12)
+    corr = np.corrcoef(non, other)[0, 1]
+    assert corr > 0.99
+    assert np.std(non) == pytest.approx(np.std(other), rel=0.1)
+
+
+# --------------------------------------------------------------------------- machines
+NO_TACHO = """
+name = "two stages, no tacho"
+shafts = ["in", "mid", "out"]
+[[stage]]
+driver = "in"
+driver_teeth = 20
+driven = "mid"
+driven_teeth = 50
+[[stage]]
+driver = "mid"
+driver_teeth = 25
+driven = "out"
+driven_teeth = 35
+{speed}
+[[sensor]]
+name = "acc"
+"""
+
+
+def _machine(tmp_path, speed=""):
+    p = tmp_path / "m.toml"
+    p.write_text(NO_TACHO.format(speed=speed))
+    return Machine.from_toml(p)
+
+
+def test_a_machine_without_tacho_tracks_a_named_shaft(tmp_path):
+    m = _machine(tmp_path, '[speed]\nshaft = "mid"\nrange_hz = [5, 9]\ntrack = 50')
+    assert m.tacho is None and m.reference_shaft == "mid"
+    assert m.vibration_speed.speed_range == (5.0, 9.0) and m.vibration_speed.track == 50
+    assert m.speed_ratio("in") == Fraction(5, 2)
+    assert m.tacho_revs_per_cycle("out") == Fraction(7, 5)
+    default = _machine(tmp_path)
+    assert default.reference_shaft == "in" and default.vibration_speed.speed_range is None
+
+
+@pytest.mark.parametrize("speed, message", [
+    ('[speed]\nshaft = "brake"', r"speed.shaft='brake' is not one of the shafts"),
+    ('[speed]\nrange_hz = [9, 5]', r"speed.range_hz must be \[low, high\] with low < high"),
+    ('[speed]\nrange_hz = 7', r"speed.range_hz must be \[low, high\]"),
+    ('[speed]\nsensor = "mic"', r"speed.sensor='mic' is not a sensor"),
+    ('[speed]\nwindow = 1', r"unknown key\(s\) \['window'\] in \[speed\]"),
+])
+def test_bad_speed_tables_are_named(tmp_path, speed, message):
+    with pytest.raises(GearshotError, match=message):
+        _machine(tmp_path, speed)
+
+
+def test_a_recording_without_tacho_needs_orders_or_a_range():
+    rng = np.random.default_rng(2)
+    rec = Recording(rng.standard_normal(40_000), None, 20_000.0)
+    assert rec.speed_source == "vibration"
+    with pytest.raises(GearshotError, match="needs the mesh orders"):
+        rec.vibration_angle()
+    with pytest.raises(GearshotError, match=r"no tacho and no nominal speed.*range_hz"):
+        rec.vibration_angle(orders=[17])
+
+
+def test_a_machine_less_run_up_gives_gear_cycles_from_the_vibration():
+    fs = 20_000.0
+    t, revs = _ramp(fs, start=15.0, end=17.0)
+    rng = np.random.default_rng(8)
+    x = (np.sin(2 * np.pi * 17 * revs) + 0.5 * np.sin(2 * np.pi * 34 * revs)
+         + 0.3 * rng.standard_normal(t.size))
+    rec = Recording(x, None, fs, speed=16.0)
+    sa = rec.to_sa_segments(gear_teeth=38, pinion_teeth=17, cycles_per_segment=None,
+                            samples_per_cycle=256)
+    # one gear revolution holds 38 mesh cycles: the SA is a clean order-38 sinusoid
+    spec = np.abs(np.fft.rfft(sa[0]))
+    assert np.argmax(spec) == 38 and spec[38] > 10 * np.delete(spec, [38, 76]).max()
+    assert rec.speed_uncertainty is not None and rec.speed_uncertainty < 0.01
+    assert rec.shaft_speed() == pytest.approx(16.0, rel=1e-3)
+
+
+# --------------------------------------------------------------------------- PHM09
+@needs_phm09
+@pytest.mark.parametrize("name", ["spur2_30hz_High_1", "spur3_40hz_Low_1",
+                                  "helical2_40hz_High_1"])
+def test_phm09_speed_from_the_vibration_within_0p2_percent_of_the_tacho(name):
+    kind = "spur" if name.startswith("spur") else "helical"
+    path = PHM09 / f"{name}.zip"
+    rt = Recording.read(path, machine=MACHINES / f"phm09_{kind}.toml")
+    rv = Recording.read(path, machine=MACHINES / f"phm09_{kind}_notacho.toml")
+    assert rv.tacho is None and rv.speed_source == "vibration" and rt.speed_source == "tacho"
+    assert rv.shaft_speed() == pytest.approx(rt.shaft_speed(), rel=0.002)
+    assert rv.shaft_speed("output") == pytest.approx(rt.shaft_speed("output"), rel=0.002)
+    assert 0 < rv.speed_uncertainty < 0.1 and rt.speed_uncertainty is None
+    # the same number of whole idler revolutions, and SAs of the same level
+    a = rt.to_sa_segments(shaft="idler", sensor="acc_input", cycles_per_segment=None)
+    b = rv.to_sa_segments(shaft="idler", sensor="acc_input", cycles_per_segment=None)
+    assert a.shape == b.shape
+    assert np.std(b) == pytest.approx(np.std(a), rel=0.15)
+
+
+@needs_phm09
+def test_phm09_cli_indicators_without_tacho(tmp_path):
+    from gearshot.app.cli import app
+
+    out = tmp_path / "ind.json"
+    res = CliRunner().invoke(app, ["indicators", "--machine",
+                                   str(MACHINES / "phm09_spur_notacho.toml"), "--shaft",
+                                   "input", str(PHM09 / "spur2_30hz_High_1.zip"), "--json",
+                                   str(out)])
+    assert res.exit_code == 0, res.output
+    rec = json.loads(out.read_text())["records"][0]
+    assert rec["speed_source"] == "vibration"
+    assert rec["tacho_speed_hz"] == pytest.approx(29.89, rel=0.002)
+    assert 0 < rec["speed_uncertainty_hz"] < 0.1
+
+
+def test_cli_refuses_a_noise_record_in_one_line(tmp_path):
+    machine = tmp_path / "m.toml"
+    machine.write_text(NO_TACHO.format(speed='[speed]\nrange_hz = [20, 35]') +
+                       '[file]\ncolumns = ["acc"]\nfs = 20000\n')
+    rec = tmp_path / "noise.txt"
+    np.savetxt(rec, np.random.default_rng(0).standard_normal(20_000), fmt="%.5f")
+    res = subprocess.run([sys.executable, "-m", "gearshot.app.cli", "indicators", "--machine",
+                          str(machine), "--shaft", "in", str(rec), "--json",
+                          str(tmp_path / "o.json")], capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode != 0 and "Traceback" not in res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("gearshot: error: no mesh harmonic stands "
+                                                   "out"), res.stderr
+    assert " dB above the noise" in lines[0]
+
+
+def test_dataclass_replace_drops_the_angle_cache():
+    fs = 20_000.0
+    t, revs = _ramp(fs, seconds=2.0)
+    x = (np.sin(2 * np.pi * 32 * revs) + 0.5 * np.sin(2 * np.pi * 64 * revs)
+         + 0.1 * np.random.default_rng(1).standard_normal(t.size))
+    rec = Recording(x, None, fs, speed=22.0)
+    a = rec.vibration_angle(orders=[32])
+    assert rec.vibration_angle(orders=[32]) is a
+    assert dataclasses.replace(rec).vibration_angle(orders=[32]) is not a
+
+
+@needs_phm09
+def test_phm09_predict_segments_say_where_the_speed_came_from():
+    from gearshot.app.predict_machine import machine_segments
+
+    for machine, source in (("phm09_spur.toml", "tacho"),
+                            ("phm09_spur_notacho.toml", "vibration")):
+        info: dict = {}
+        sa, x, speed = machine_segments(PHM09 / "spur3_30hz_High_1.zip",
+                                        Machine.from_toml(MACHINES / machine),
+                                        cycles_per_segment=10, info=info)
+        assert info["speed_source"] == source and sa.shape == (11, 2048)
+        assert (info["speed_uncertainty_hz"] is None) == (source == "tacho")
+        assert speed == pytest.approx(29.92, rel=0.002)
