@@ -15,7 +15,8 @@ from gearshot import GearshotError, Machine
 from gearshot.features import available_features, extract_features
 from gearshot.io import Recording
 from gearshot.signal import angular_resample, difference_signal, pulse_times, synchronous_average
-from gearshot.signal.trains import antialias_filter, as_ratio, shaft_cycle_times
+from gearshot.signal.antialias import antialias_filter
+from gearshot.signal.trains import as_ratio, shaft_cycle_times
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples" / "machines"

@@ -284,9 +284,9 @@ API_CASES = {
     "pulse_times constant": lambda: gs.pulse_times(np.zeros(100), 100.0),
     "check_pulse_train strings": lambda: gs.check_pulse_train(["a"], pulses_per_rev=1,
                                                               label="rec"),
-    "gear_cycle_times empty": lambda: gs.gear_cycle_times([], gear_teeth=38, pinion_teeth=17),
-    "gear_cycle_times teeth 10**9": lambda: gs.gear_cycle_times(
-        np.arange(5.0), gear_teeth=1, pinion_teeth=10 ** 9),
+    "shaft_cycle_times empty": lambda: gs.shaft_cycle_times([], revs_per_cycle="38/17"),
+    "shaft_cycle_times ratio 1/10**9": lambda: gs.shaft_cycle_times(
+        np.arange(5.0), revs_per_cycle=(1, 10 ** 9)),
     "subtract_healthy upsample=10**9": lambda: gs.subtract_healthy(_sa(), _sa(), upsample=10**9),
     "minimum_phase zeros": lambda: gs.minimum_phase(np.zeros(8)),
     "na4_baseline_variance ragged": lambda: na4_baseline_variance([[1, 2], [3]], 5),
@@ -370,10 +370,6 @@ FUZZ = {
     "check_pulse_train": (gs.check_pulse_train, st.tuples(_arg),
                           st.fixed_dictionaries({"pulses_per_rev": _ints,
                                                  "label": st.just("fuzz")})),
-    "gear_cycle_times": (gs.gear_cycle_times, st.tuples(_arg),
-                         st.fixed_dictionaries({"gear_teeth": _ints, "pinion_teeth": _ints},
-                                               optional={"pulses_per_rev": _ints,
-                                                         "tacho_shaft": _arg})),
     "shaft_cycle_times": (gs.shaft_cycle_times, st.tuples(_arg),
                           st.fixed_dictionaries({"revs_per_cycle": _arg},
                                                 optional={"pulses_per_rev": _ints})),

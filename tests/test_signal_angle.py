@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
 from gearshot import GearshotError
 from gearshot.io import Recording
 from gearshot.rig import tacho_signal
-from gearshot.signal import gear_cycle_times
+from gearshot.signal import shaft_cycle_times
 
 FS = 50_000.0
 ZG, ZP = 38, 17
@@ -44,25 +46,25 @@ def first_pulse_gear_phase(rec, f0, **kw):
 
 
 def test_gear_cycle_times_constant_speed_and_output_shaft():
+    """Gear revolutions from an input-shaft (ratio 38/17) or output-shaft (ratio 1) tacho."""
     pulses = np.arange(40) / 15.0  # 15 rev/s input shaft
-    c = gear_cycle_times(pulses, gear_teeth=ZG, pinion_teeth=ZP)
+    c = shaft_cycle_times(pulses, revs_per_cycle=Fraction(ZG, ZP))
     period = ZG / ZP / 15.0
     np.testing.assert_allclose(c, np.arange(c.size) * period, atol=1e-12)
     assert c.size == int(39 * ZP / ZG) + 1
     # two pulses per output-shaft revolution
     out = np.arange(21) / (2 * 15.0 * ZP / ZG)
-    c2 = gear_cycle_times(out, gear_teeth=ZG, pinion_teeth=ZP, pulses_per_rev=2,
-                          tacho_shaft="output")
+    c2 = shaft_cycle_times(out, revs_per_cycle=1, pulses_per_rev=2)
     np.testing.assert_allclose(c2, np.arange(11) * period, atol=1e-12)
-    with pytest.raises(GearshotError, match="tacho_shaft"):
-        gear_cycle_times(pulses, gear_teeth=ZG, pinion_teeth=ZP, tacho_shaft="brake")
+    with pytest.raises(GearshotError, match="revs_per_cycle"):
+        shaft_cycle_times(pulses, revs_per_cycle=-2)
 
 
 def test_gear_cycle_times_follow_varying_speed():
     t = np.linspace(0.0, 10.0, 400_001)
     revs = pinion_revs(t, 15.0, drift=0.01, drift_period=4.0)
     pulses = np.interp(np.arange(1, int(revs[-1])), revs, t)
-    c = gear_cycle_times(pulses, gear_teeth=ZG, pinion_teeth=ZP)
+    c = shaft_cycle_times(pulses, revs_per_cycle=Fraction(ZG, ZP))
     # gear revolution m ends at pinion angle 1 + m * 38/17 (cycle 0 starts at pulse 1)
     expect = np.interp(1 + np.arange(c.size) * ZG / ZP, revs, t)
     np.testing.assert_allclose(c, expect, atol=2e-6)  # 2 us << 1 sample at 50 kHz

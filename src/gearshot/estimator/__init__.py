@@ -13,6 +13,7 @@
 from .._errors import NotFittedError
 from . import comparability, steps, uncertainty
 from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
+from ._params import check_estimator_params
 from .comparability import Comparability, ComparabilityReference, harmonic_profile
 from .persistence import load_estimator, save_estimator
 from .steps import (
@@ -60,4 +61,5 @@ __all__ = [
     "signature_weights",
     "save_estimator",
     "load_estimator",
+    "check_estimator_params",
 ]

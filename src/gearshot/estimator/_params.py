@@ -29,6 +29,7 @@ __all__ = [
     "ArrayOrObject",
     "RandomStateValue",
     "validate_params",
+    "check_estimator_params",
 ]
 
 
@@ -207,3 +208,31 @@ def validate_params(params: Mapping[str, Any],
         if not any(c.accepts(value) for c in allowed):
             expected = " or ".join(str(c) for c in allowed)
             raise GearshotError(f"{name} must be {expected}; got {describe(value)}")
+
+
+def check_estimator_params(estimator: Any) -> None:
+    """Check an estimator's parameters against its ``_parameter_constraints`` table.
+
+    The public entry for callers outside the estimator package (the CLI's ``--param``
+    parsing): the same check ``fit`` runs first, without fitting.
+
+    Parameters
+    ----------
+    estimator : object with ``get_params`` and ``_parameter_constraints``
+        E.g. a :class:`~gearshot.estimator.OneFaultShotEstimator`.
+
+    Raises
+    ------
+    GearshotError
+        Naming the first parameter no constraint accepts, and its value.
+
+    Examples
+    --------
+    >>> from gearshot.estimator import OneFaultShotEstimator, check_estimator_params
+    >>> check_estimator_params(OneFaultShotEstimator())
+    >>> check_estimator_params(OneFaultShotEstimator(n_neighbors=0))
+    Traceback (most recent call last):
+    ...
+    gearshot._errors.GearshotError: n_neighbors must be ...
+    """
+    validate_params(estimator.get_params(deep=False), estimator._parameter_constraints)

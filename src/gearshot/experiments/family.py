@@ -570,8 +570,7 @@ def parse_params(items, *, option="--param") -> dict:
     Unknown names and values the estimator refuses raise a :class:`GearshotError` that
     names ``option`` and quotes the item.
     """
-    from ..estimator import OneFaultShotEstimator
-    from ..estimator._params import validate_params
+    from ..estimator import OneFaultShotEstimator, check_estimator_params
 
     known = OneFaultShotEstimator().get_params(deep=False)
     params = {}
@@ -588,7 +587,7 @@ def parse_params(items, *, option="--param") -> dict:
             params[name] = value
     est = OneFaultShotEstimator(**params)
     try:
-        validate_params(est.get_params(deep=False), est._parameter_constraints)
+        check_estimator_params(est)
     except GearshotError as exc:
         raise GearshotError(f"{option}: {exc}") from None
     return params

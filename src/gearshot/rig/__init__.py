@@ -13,10 +13,15 @@ Reading recordings (real or virtual) lives in :mod:`gearshot.io`; the transfer p
 
 from __future__ import annotations
 
-from .irregular import IrregularBreakage, IrregularDestruction, IrregularPartialFace
+from .irregular import (
+    IrregularBreakage,
+    IrregularDestruction,
+    IrregularFaceFault,
+    IrregularPartialFace,
+)
 from .path import synthetic_path_tfs
 from .reality import RigReality, draw_reality
-from .sim_engine import IrregularFaceFault, SimulatorEngine
+from .sim_engine import SimulatorEngine
 from .surrogate import SurrogateEngine
 from .tacho import tacho_signal
 from .virtual import VirtualRig

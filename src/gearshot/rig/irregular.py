@@ -46,10 +46,58 @@ from ..sim.fault_types import (
 )
 from ..sim.faults import FullToothFaceFault, ToothFault
 from .reality import RigReality
-from .sim_engine import IrregularFaceFault
 
-__all__ = ["IrregularPartialFace", "IrregularBreakage", "IrregularDestruction",
-           "physical_fault_of_type"]
+__all__ = ["IrregularFaceFault", "IrregularPartialFace", "IrregularBreakage",
+           "IrregularDestruction", "physical_fault_of_type"]
+
+
+@dataclass(frozen=True)
+class IrregularFaceFault(FullToothFaceFault):
+    """A full tooth face fault whose depth varies along the profile: the arc-shaped cut of
+    :class:`~gearshot.sim.FullToothFaceFault` scaled by
+    ``1 + sum_k roughness[k] cos((k + 1) pi x)``, x = 0 ... 1 across the cut, in both the
+    section loss (stiffness) and the displacement excitation.
+
+    Parameters
+    ----------
+    roughness : tuple of float
+        Relative amplitudes; their absolute sum must stay below 1 (the cut stays a cut).
+    """
+
+    roughness: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        rough = tuple(float(r) for r in self.roughness)
+        if not all(np.isfinite(rough)) or sum(abs(r) for r in rough) >= 1.0:
+            raise GearshotError(f"roughness must be finite with absolute sum < 1; got "
+                                f"{self.roughness!r}")
+        object.__setattr__(self, "roughness", rough)
+
+    def depth_profile(self, s: np.ndarray) -> np.ndarray:
+        """Depth factor at roll fractions ``s`` (1 outside the cut)."""
+        s = np.asarray(s, dtype=float)
+        s0, s1 = self.window
+        if s1 <= s0:
+            return np.ones_like(s)
+        x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
+        profile = np.ones_like(x)
+        for k, r in enumerate(self.roughness):
+            profile = profile + r * np.cos((k + 1) * np.pi * x)
+        return profile
+
+    def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
+        base = super().section_loss(pair, x)
+        if self.is_healthy:
+            return base
+        (xa, _), (xb, _) = self._edges(pair)
+        s0, s1 = self.window
+        s = s0 + (np.asarray(x, dtype=float) - xa) / (xb - xa) * (s1 - s0)  # ~linear map
+        return base * self.depth_profile(s)
+
+    def displacement(self, pair, s: np.ndarray) -> np.ndarray:
+        return super().displacement(pair, s) * self.depth_profile(s)
+
 
 
 def check_roughness(roughness) -> tuple[float, ...]:

@@ -24,60 +24,11 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import GearshotError
 from .._validation import check_int
-from ..sim.faults import FullToothFaceFault
+from .irregular import IrregularFaceFault, physical_fault_of_type
 from .reality import RigReality
 
-__all__ = ["SimulatorEngine", "IrregularFaceFault", "perturbed_pair", "physical_fault"]
-
-
-@dataclass(frozen=True)
-class IrregularFaceFault(FullToothFaceFault):
-    """A full tooth face fault whose depth varies along the profile: the arc-shaped cut of
-    :class:`~gearshot.sim.FullToothFaceFault` scaled by
-    ``1 + sum_k roughness[k] cos((k + 1) pi x)``, x = 0 ... 1 across the cut, in both the
-    section loss (stiffness) and the displacement excitation.
-
-    Parameters
-    ----------
-    roughness : tuple of float
-        Relative amplitudes; their absolute sum must stay below 1 (the cut stays a cut).
-    """
-
-    roughness: tuple[float, ...] = ()
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        rough = tuple(float(r) for r in self.roughness)
-        if not all(np.isfinite(rough)) or sum(abs(r) for r in rough) >= 1.0:
-            raise GearshotError(f"roughness must be finite with absolute sum < 1; got "
-                                f"{self.roughness!r}")
-        object.__setattr__(self, "roughness", rough)
-
-    def depth_profile(self, s: np.ndarray) -> np.ndarray:
-        """Depth factor at roll fractions ``s`` (1 outside the cut)."""
-        s = np.asarray(s, dtype=float)
-        s0, s1 = self.window
-        if s1 <= s0:
-            return np.ones_like(s)
-        x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
-        profile = np.ones_like(x)
-        for k, r in enumerate(self.roughness):
-            profile = profile + r * np.cos((k + 1) * np.pi * x)
-        return profile
-
-    def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
-        base = super().section_loss(pair, x)
-        if self.is_healthy:
-            return base
-        (xa, _), (xb, _) = self._edges(pair)
-        s0, s1 = self.window
-        s = s0 + (np.asarray(x, dtype=float) - xa) / (xb - xa) * (s1 - s0)  # ~linear map
-        return base * self.depth_profile(s)
-
-    def displacement(self, pair, s: np.ndarray) -> np.ndarray:
-        return super().displacement(pair, s) * self.depth_profile(s)
+__all__ = ["SimulatorEngine", "perturbed_pair", "physical_fault"]
 
 
 def perturbed_pair(pair, reality: RigReality | None):
@@ -150,8 +101,6 @@ class SimulatorEngine:
             grade, prng = reality.grade, np.random.default_rng(reality.profile_seed)
         fault: dict[str, Any]
         if self.fault_type != "ftff":
-            from .irregular import physical_fault_of_type
-
             fault = (dict(faults=[physical_fault_of_type(self.fault_type, fault_size,
                                                          reality)])
                      if fault_size > 0 else dict(fault_sizes=[0.0]))

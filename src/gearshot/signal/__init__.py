@@ -7,8 +7,9 @@ synchronous averages). Options are keyword-only. Bad input raises
 """
 
 from .alignment import fractional_shift, subtract_healthy
-from .angle import check_pulse_train, gear_cycle_times
+from .angle import check_pulse_train
 from .angular import angle_to_time, angular_resample, pulse_times
+from .antialias import antialias_filter
 from .averaging import nonsynchronous_signal, synchronous_average
 from .cepstrum import minimum_phase, real_cepstrum
 from .envelope import envelope
@@ -24,7 +25,7 @@ from .orders import (
 from .ridge import speed_ridge
 from .spectra import acs_background, amplitude_spectrum
 from .tracking import angle_pulse_times, demodulate_angle, estimate_shaft_angle
-from .trains import antialias_filter, shaft_cycle_times
+from .trains import shaft_cycle_times
 
 __all__ = [
     "pulse_times",
@@ -33,7 +34,6 @@ __all__ = [
     "antialias_filter",
     "shaft_cycle_times",
     "check_pulse_train",
-    "gear_cycle_times",
     "synchronous_average",
     "harmonic_signal",
     "difference_signal",

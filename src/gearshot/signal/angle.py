@@ -12,7 +12,8 @@ re-sampled directly on the gear angle:
 2. The gear angle is the tacho-shaft angle times ``pinion_teeth / gear_teeth`` (input-shaft
    tacho) or 1 (output-shaft tacho). Gear revolution m therefore starts at tacho-shaft angle
    m * gear_teeth / pinion_teeth revolutions.
-3. The time of that angle comes from :func:`gearshot.signal.angle_to_time` (cubic spline of
+3. The time of that angle comes from :func:`gearshot.signal.shaft_cycle_times` (the exact
+   ratio as a fraction) through :func:`gearshot.signal.angle_to_time` (cubic spline of
    the pulse times against angle) -- the same curve the angular re-sampler uses. These
    "virtual gear pulses" (one per gear revolution) go to ``angular_resample`` with
    ``pulses_per_rev=1`` and ``samples_per_rev = samples_per_cycle``.
@@ -31,12 +32,10 @@ from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
 from .._typing import FloatArray
-from .._validation import MAX_POINTS, check_int, finite_result
-from .angular import angle_to_time
+from .._validation import MAX_POINTS, check_int
 
 __all__ = [
     "check_pulse_train",
-    "gear_cycle_times",
     "uniform_cycle_times",
     "TACHO_SHAFTS",
 ]
@@ -116,58 +115,6 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
             pieces.append(pulses[at + 1: stop])
         pulses = np.concatenate(pieces)
     return pulses
-
-
-@finite_result
-def gear_cycle_times(pulses: np.ndarray, *, gear_teeth: int, pinion_teeth: int,
-                     pulses_per_rev: int = 1, tacho_shaft: str = "input") -> np.ndarray:
-    """Times (s) at which the driven gear completes whole revolutions.
-
-    Parameters
-    ----------
-    pulses : ndarray, shape (n_pulses,)
-        Tacho pulse times in s, ``pulses_per_rev`` per revolution of the tacho shaft.
-    gear_teeth, pinion_teeth : int
-        Tooth counts of the driven gear and the pinion.
-    pulses_per_rev : int
-        Tacho pulses per revolution of its shaft.
-    tacho_shaft : {"input", "output"}
-        The shaft the tacho watches: the input (pinion) or output (gear) shaft.
-
-    Returns
-    -------
-    ndarray, shape (n_cycles + 1,)
-        Start time of gear revolution 0 (the first pulse), 1, ... up to the last revolution
-        that ends before the last pulse.
-
-    Examples
-    --------
-    The paper's pair with a once-per-revolution tacho on the 17-tooth pinion turning at
-    10 rev/s: one gear revolution takes 38/17 pinion revolutions, 0.2235 s.
-
-    >>> import numpy as np
-    >>> from gearshot.signal import gear_cycle_times
-    >>> times = gear_cycle_times(np.arange(81) * 0.1, gear_teeth=38, pinion_teeth=17)
-    >>> print(np.round(times[:4], 4) + 0.0)
-    [0.     0.2235 0.4471 0.6706]
-    """
-    from .angular import _check_pulses
-
-    gear_teeth = check_int(gear_teeth, "gear_teeth", minimum=1, maximum=100_000)
-    pinion_teeth = check_int(pinion_teeth, "pinion_teeth", minimum=1, maximum=100_000)
-    pulses_per_rev = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
-    if not isinstance(tacho_shaft, str) or tacho_shaft not in TACHO_SHAFTS:
-        raise GearshotError(f"tacho_shaft must be one of {TACHO_SHAFTS}; got {tacho_shaft!r}")
-    pulses = _check_pulses(pulses, "pulses")
-    revs_total = (pulses.size - 1) / pulses_per_rev
-    if revs_total * pinion_teeth / gear_teeth > MAX_POINTS:
-        raise GearshotError(f"pulses span {revs_total:g} tacho revolutions, more than "
-                            f"{MAX_POINTS} gear cycles")
-    shaft_revs = np.arange(pulses.size) / pulses_per_rev
-    revs_per_cycle = gear_teeth / pinion_teeth if tacho_shaft == "input" else 1.0
-    n_cycles = int(np.floor(shaft_revs[-1] / revs_per_cycle + 1e-9))
-    targets = np.arange(n_cycles + 1) * revs_per_cycle
-    return angle_to_time(pulses, targets, pulses_per_rev=pulses_per_rev)
 
 
 def uniform_cycle_times(cycle_times: ArrayLike) -> FloatArray:

@@ -19,6 +19,7 @@ from .._validation import (
     describe,
     finite_result,
 )
+from .antialias import bandlimited_resynthesis, min_shaft_rate
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
 
@@ -240,8 +241,6 @@ def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples
     angles = np.arange(n_revs * spr) / spr
     times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
     if antialias:
-        from .trains import bandlimited_resynthesis, min_shaft_rate
-
         # band-limit below the angular Nyquist and re-synthesize at upsample x the Nyquist
         # rate of what is left (coarser than fs for slow shafts: cheaper, equally exact)
         cutoff = 0.5 * spr * min_shaft_rate(pulses, pulses_per_rev=ppr)
