@@ -188,39 +188,16 @@ def ftff_gear_compliance(pair: GearPair, roll, arcs):
     point with its fault's cut ``arcs`` (n_points, 5): xa, xb, cx, ch, radius of
     :meth:`FullToothFaceFault._arc`. As ``_tooth_compliance(pair, z_gear, roll,
     fault.section_loss)``."""
-    from .stiffness import _N_NODES, _SAINSOT
+    from .stiffness import _contact_frame, _fillet_compliance, _materials, _simpson_nodes
 
     z = pair.z_gear
-    E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
-    G = E / (2 * (1 + nu))
-    rb, rf = pair.base_radius(z), pair.root_radius(z)
-    a0 = pair.transverse_pressure_angle
-    roll = np.asarray(roll, dtype=float)
-    rc = np.hypot(rb, roll)
-    psi_c = involute_half_angle(z, a0, rc, rb)
-    xc, hc = rc * np.cos(psi_c), rc * np.sin(psi_c)
-    beta = np.arccos(rb / rc) - psi_c
-    psi_b = float(involute_half_angle(z, a0, np.array(rb), rb))
-    hb = rb * math.sin(psi_b)
-    xb = rb * math.cos(psi_b)
-    x0 = min(rf, xb)
+    E, G, L = _materials(pair)
+    xc, hc, beta, hb, xb, x0 = _contact_frame(pair, z, roll)
     (x_tab, h_tab), (xs_tab, hs_tab) = _involute_tables(pair)
-    xi = np.linspace(0.0, 1.0, _N_NODES + 1)
-    w = np.ones(_N_NODES + 1)
-    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
-    w /= 3.0 * _N_NODES
+    xi, w = _simpson_nodes()
     inv = _node_sums(xc, hc, np.cos(beta), np.sin(beta), np.ascontiguousarray(arcs), x0,
                      xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab, E, G, L)
-    theta_f = math.asin(min(hb / rf, 1.0))
-    s_f = 2 * rf * theta_f
-    h_fi = rf / pair.bore_radius
-    basis = np.array([1 / theta_f ** 2, h_fi ** 2, h_fi / theta_f, 1 / theta_f, h_fi, 1.0])
-    Ls, Ms, Ps, Qs = _SAINSOT @ basis
-    u_f = xc - hc * np.tan(beta) - rf
-    cbeta = np.cos(beta)
-    inv_kf = cbeta ** 2 / (E * L) * (Ls * (u_f / s_f) ** 2 + Ms * (u_f / s_f)
-                                    + Ps * (1 + Qs * np.tan(beta) ** 2))
-    return inv + inv_kf
+    return inv + _fillet_compliance(pair, z, xc, hc, beta, hb)
 
 
 @nb.njit(cache=True, inline="always")

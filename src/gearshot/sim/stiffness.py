@@ -66,28 +66,16 @@ def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
                       section_loss=None) -> np.ndarray:
     """Bending + shear + axial + fillet compliance (m/N) of one tooth of a ``z``-tooth wheel
     loaded along the line of action at roll lengths ``roll`` (m)."""
-    E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
-    G = E / (2 * (1 + nu))
-    rb, rf = pair.base_radius(z), pair.root_radius(z)
+    E, G, L = _materials(pair)
+    rb = pair.base_radius(z)
     a0 = pair.transverse_pressure_angle
-    roll = np.asarray(roll, dtype=float)
-    rc = np.hypot(rb, roll)
-    psi_c = involute_half_angle(z, a0, rc, rb)
-    xc, hc = rc * np.cos(psi_c), rc * np.sin(psi_c)
-    beta = np.arccos(rb / rc) - psi_c          # load angle to the tooth's transverse axis
-    psi_b = float(involute_half_angle(z, a0, np.array(rb), rb))
-    hb = rb * math.sin(psi_b)
-    xb = rb * math.cos(psi_b)
-    x0 = min(rf, xb)
+    xc, hc, beta, hb, xb, x0 = _contact_frame(pair, z, roll)
     # involute table for h(x)
     r_tab = np.linspace(rb, pair.tip_radius(z) * 1.001, 1200)
     psi_t = involute_half_angle(z, a0, r_tab, rb)
     x_tab, h_tab = r_tab * np.cos(psi_t), r_tab * np.sin(psi_t)
     # composite Simpson nodes from the root circle to each contact point
-    xi = np.linspace(0.0, 1.0, _N_NODES + 1)
-    w = np.ones(_N_NODES + 1)
-    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
-    w /= 3.0 * _N_NODES
+    xi, w = _simpson_nodes()
     span = (xc - x0)[:, None]
     x = x0 + span * xi[None, :]
     h = np.where(x <= xb, hb, np.interp(x, x_tab, h_tab))
@@ -102,7 +90,46 @@ def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
     inv_kb = np.sum(wk * moment_arm ** 2 / (E * inertia), axis=1)
     inv_ks = np.sum(wk * 1.2 * cb ** 2 / (G * area), axis=1)
     inv_ka = np.sum(wk * sb ** 2 / (E * area), axis=1)
-    # fillet foundation (Sainsot 2004)
+    return inv_kb + inv_ks + inv_ka + _fillet_compliance(pair, z, xc, hc, beta, hb)
+
+
+def _materials(pair: GearPair) -> tuple[float, float, float]:
+    """Young's modulus, shear modulus (Pa) and face width (m) of the pair."""
+    E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
+    return E, E / (2 * (1 + nu)), L
+
+
+def _contact_frame(pair: GearPair, z: int,
+                   roll) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, float]:
+    """Contact point ``xc, hc`` (m, tooth frame), load angle ``beta`` to the tooth's
+    transverse axis at roll lengths ``roll`` (m), and the base-circle point ``hb, xb`` and
+    integration start ``x0`` of a ``z``-tooth wheel's tooth."""
+    rb, rf = pair.base_radius(z), pair.root_radius(z)
+    a0 = pair.transverse_pressure_angle
+    roll = np.asarray(roll, dtype=float)
+    rc = np.hypot(rb, roll)
+    psi_c = involute_half_angle(z, a0, rc, rb)
+    xc, hc = rc * np.cos(psi_c), rc * np.sin(psi_c)
+    beta = np.arccos(rb / rc) - psi_c          # load angle to the tooth's transverse axis
+    psi_b = float(involute_half_angle(z, a0, np.array(rb), rb))
+    hb = rb * math.sin(psi_b)
+    xb = rb * math.cos(psi_b)
+    return xc, hc, beta, hb, xb, float(min(rf, xb))
+
+
+def _simpson_nodes() -> tuple[np.ndarray, np.ndarray]:
+    """Composite Simpson nodes on [0, 1] and their weights (``_N_NODES`` intervals)."""
+    xi = np.linspace(0.0, 1.0, _N_NODES + 1)
+    w = np.ones(_N_NODES + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    w /= 3.0 * _N_NODES
+    return xi, w
+
+
+def _fillet_compliance(pair: GearPair, z: int, xc, hc, beta, hb) -> np.ndarray:
+    """Fillet-foundation compliance (m/N) of a ``z``-tooth wheel's tooth (Sainsot 2004)."""
+    E, _, L = _materials(pair)
+    rf = pair.root_radius(z)
     theta_f = math.asin(min(hb / rf, 1.0))
     s_f = 2 * rf * theta_f
     h_fi = rf / pair.bore_radius
@@ -110,9 +137,8 @@ def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
     Ls, Ms, Ps, Qs = _SAINSOT @ basis
     u_f = xc - hc * np.tan(beta) - rf
     cbeta = np.cos(beta)
-    inv_kf = cbeta ** 2 / (E * L) * (Ls * (u_f / s_f) ** 2 + Ms * (u_f / s_f)
-                                    + Ps * (1 + Qs * np.tan(beta) ** 2))
-    return inv_kb + inv_ks + inv_ka + inv_kf
+    return cbeta ** 2 / (E * L) * (Ls * (u_f / s_f) ** 2 + Ms * (u_f / s_f)
+                                   + Ps * (1 + Qs * np.tan(beta) ** 2))
 
 
 def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = None
