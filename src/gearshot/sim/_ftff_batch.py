@@ -22,7 +22,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import GearPair, involute_half_angle
+from .geometry import GearPair, contact_angles, involute_half_angle
 
 __all__ = ["bridge_batch", "ftff_gear_compliance"]
 
@@ -95,28 +95,10 @@ def _retreat(pair: GearPair, u, r, ang):
     fractions, flank points ``r, ang`` (n, n_pts). The per-knot part is numpy (the same
     operations as for one fault); the search over the flank points runs in numba with
     one arctangent per point (:func:`_min_gap`)."""
-    z1, z2 = pair.z_pinion, pair.z_gear
-    a0 = pair.transverse_pressure_angle
-    rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
-    ra1 = pair.tip_radius(z1)
-    (p_lo, p_hi), _ = pair.roll_limits
-    inv0 = math.tan(a0) - a0
-
-    def inv_r(rr, rb):
-        al = np.arccos(np.clip(rb / rr, -1.0, 1.0))
-        return np.tan(al) - al
-
-    d = np.array([math.sin(a0), math.cos(a0)])
-    t1 = rb1 * np.array([math.cos(a0), -math.sin(a0)])
-    o2 = np.array([pair.center_distance, 0.0])
-    lam = p_lo + u * (p_hi - p_lo)
-    cx, cy = t1[0] + lam * d[0], t1[1] + lam * d[1]
-    phi_p = np.arctan2(cy, cx) + inv_r(np.hypot(cx, cy), rb1)
-    gx, gy = cx - o2[0], cy - o2[1]
-    phi_g = np.arctan2(gy, gx) + inv_r(np.hypot(gx, gy), rb2)
-    centre = phi_g - math.pi / (2 * z2) - inv0
+    rb1, ra1 = pair.base_radius(pair.z_pinion), pair.tip_radius(pair.z_pinion)
+    phi_p, centre = contact_angles(pair, u)
     return _min_gap(np.cos(centre), np.sin(centre), phi_p, r, np.cos(ang), np.sin(ang),
-                    o2[0], rb1, ra1)
+                    pair.center_distance, rb1, ra1)
 
 
 @nb.njit(cache=True)

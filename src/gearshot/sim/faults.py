@@ -28,7 +28,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from .geometry import GearPair, involute_half_angle
+from .geometry import GearPair, _involute_function, contact_angles, involute_half_angle
 
 __all__ = ["ToothFault", "Fault", "FullToothFaceFault"]
 
@@ -244,31 +244,15 @@ class FullToothFaceFault(ToothFault):
         pinion involute (through the nominal contact point) and the remaining gear flank
         (cut arc and the involute beyond its edges), points within the pinion's flank;
         and the gear radius (m) of the point where the pinion then touches."""
-        z1, z2 = pair.z_pinion, pair.z_gear
-        a0 = pair.transverse_pressure_angle
-        rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
-        ra1 = pair.tip_radius(z1)
-        (p_lo, p_hi), _ = pair.roll_limits
-        inv0 = math.tan(a0) - a0
-
-        def inv_r(r, rb):
-            al = np.arccos(np.clip(rb / r, -1.0, 1.0))
-            return np.tan(al) - al
-
-        d = np.array([math.sin(a0), math.cos(a0)])
-        t1 = rb1 * np.array([math.cos(a0), -math.sin(a0)])
+        rb1, ra1 = pair.base_radius(pair.z_pinion), pair.tip_radius(pair.z_pinion)
+        phi_p, centre = contact_angles(pair, u)
         o2 = np.array([pair.center_distance, 0.0])
-        lam = p_lo + np.asarray(u, dtype=float) * (p_hi - p_lo)
-        c = t1[None, :] + lam[:, None] * d[None, :]               # contact points
-        phi_p = np.arctan2(c[:, 1], c[:, 0]) + inv_r(np.hypot(c[:, 0], c[:, 1]), rb1)
-        cg = c - o2
-        phi_g = np.arctan2(cg[:, 1], cg[:, 0]) + inv_r(np.hypot(cg[:, 0], cg[:, 1]), rb2)
-        centre = phi_g - math.pi / (2 * z2) - inv0                 # gear tooth centre line
         r, ang = self._flank_points(pair)
         px = o2[0] + r[None, :] * np.cos(centre[:, None] + ang[None, :])
         py = o2[1] + r[None, :] * np.sin(centre[:, None] + ang[None, :])
         rp = np.hypot(px, py)
-        gap = rb1 * (np.arctan2(py, px) + inv_r(np.maximum(rp, rb1), rb1) - phi_p[:, None])
+        gap = rb1 * (np.arctan2(py, px) + _involute_function(np.maximum(rp, rb1), rb1)
+                     - phi_p[:, None])
         gap = (gap + math.pi * rb1) % (2 * math.pi * rb1) - math.pi * rb1
         gap = np.where((rp >= rb1) & (rp <= ra1), gap, np.inf)
         best = np.argmin(gap, axis=1)

@@ -277,3 +277,29 @@ def involute_half_angle(z: int, pressure_angle: float, r: np.ndarray, rb: float)
     inv0 = math.tan(pressure_angle) - pressure_angle
     a = np.arccos(np.clip(rb / r, -1.0, 1.0))
     return math.pi / (2 * z) + inv0 - (np.tan(a) - a)
+
+
+def _involute_function(r: np.ndarray, rb: float) -> np.ndarray:
+    """inv(alpha) = tan(alpha) - alpha at radius ``r`` of an involute of base radius ``rb``."""
+    al = np.arccos(np.clip(rb / r, -1.0, 1.0))
+    return np.tan(al) - al
+
+
+def contact_angles(pair: GearPair, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pinion involute angle at the nominal contact point and the driven gear's tooth
+    centre-line angle (rad, gear frame at the centre distance) when the contact lies at
+    line-of-action fraction ``u`` (any shape, 0 = start of active contact, 1 = end).
+    Elementwise, so one fault's ``u`` and a batch's give the same numbers."""
+    z1, z2 = pair.z_pinion, pair.z_gear
+    a0 = pair.transverse_pressure_angle
+    rb1, rb2 = pair.base_radius(z1), pair.base_radius(z2)
+    (p_lo, p_hi), _ = pair.roll_limits
+    inv0 = math.tan(a0) - a0
+    d0, d1 = math.sin(a0), math.cos(a0)
+    t0, t1 = rb1 * math.cos(a0), rb1 * -math.sin(a0)
+    lam = p_lo + np.asarray(u, dtype=float) * (p_hi - p_lo)
+    cx, cy = t0 + lam * d0, t1 + lam * d1                       # contact points
+    phi_p = np.arctan2(cy, cx) + _involute_function(np.hypot(cx, cy), rb1)
+    gx, gy = cx - pair.center_distance, cy - 0.0
+    phi_g = np.arctan2(gy, gx) + _involute_function(np.hypot(gx, gy), rb2)
+    return phi_p, phi_g - math.pi / (2 * z2) - inv0             # gear tooth centre line
