@@ -40,18 +40,14 @@ def check_declared_teeth(have: tuple[int, int] | None, gear_teeth: int | None,
     if have is None:
         return
     pinion, gear = have
-    if gear_teeth is not None and int(gear_teeth) != gear:
-        raise GearshotError(
-            f"gear_teeth={int(gear_teeth)}: the target SAs are segmented for a "
-            f"{int(gear_teeth)}-tooth gear, but the database was simulated for the "
-            f"{pinion}/{gear} pair (gear_teeth={gear}); simulate a database of the "
-            f"recordings' pair, or segment them for the {gear}-tooth gear")
-    if pinion_teeth is not None and int(pinion_teeth) != pinion:
-        raise GearshotError(
-            f"pinion_teeth={int(pinion_teeth)}: the target SAs are segmented for a "
-            f"{int(pinion_teeth)}-tooth pinion, but the database was simulated for the "
-            f"{pinion}/{gear} pair (pinion_teeth={pinion}); simulate a database of the "
-            f"recordings' pair, or segment them for the {pinion}-tooth pinion")
+    for name, value, wanted, wheel in (("gear_teeth", gear_teeth, gear, "gear"),
+                                       ("pinion_teeth", pinion_teeth, pinion, "pinion")):
+        if value is not None and int(value) != wanted:
+            raise GearshotError(
+                f"{name}={int(value)}: the target SAs are segmented for a "
+                f"{int(value)}-tooth {wheel}, but the database was simulated for the "
+                f"{pinion}/{gear} pair ({name}={wanted}); simulate a database of the "
+                f"recordings' pair, or segment them for the {wanted}-tooth {wheel}")
 
 
 def as_orders(mesh_order: int | Sequence[int] | None) -> tuple[int, ...]:
