@@ -42,6 +42,7 @@ from ._params import (
     NoneValue,
     Options,
     RandomStateValue,
+    Resolvable,
     validate_params,
 )
 from .calibration import (
@@ -53,6 +54,7 @@ from .calibration import (
     setting_log_likelihoods,
 )
 from .comparability import Comparability, ComparabilityReference, fit_comparability
+from .options import EstimatorOptions, resolve_options
 from .steps import KnnModel
 from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
 from .zero_shot import healthy_signature, match_grade, residue_mean_square, signature_weights
@@ -69,25 +71,6 @@ STEP_SEEDS = ("select_features", "fit_knn", "match_noise")
 #: Fault types a database may hold (:data:`gearshot.sim.FAULT_TYPES`; named here so that the
 #: estimator does not import the simulator).
 FAULT_TYPE_NAMES = ("ftff", "partial_face", "breakage", "destruction")
-
-
-class _CalibrationValue(Constraint):
-    """A calibration strategy name, a :class:`CalibrationOptions` or a mapping of its fields."""
-
-    def accepts(self, value: Any) -> bool:
-        if isinstance(value, str):
-            return value in CALIBRATION_STRATEGIES
-        if isinstance(value, (CalibrationOptions, Mapping)):
-            try:
-                resolve_calibration(value)
-            except (GearshotError, TypeError):
-                return False
-            return True
-        return False
-
-    def __str__(self) -> str:
-        return ("one of " + ", ".join(repr(v) for v in CALIBRATION_STRATEGIES)
-                + ", a CalibrationOptions or a mapping of its fields")
 
 
 def _select_fault_type(database: Any, fault_type: str | None) -> Any:
@@ -299,30 +282,49 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
     ----------
     features : sequence of str, optional
         Candidate features (default the paper's four).
-    selection_threshold : float > 0, default 0.10
-        Keep features whose invariance error is below this (step 1).
-    selection_fallback : {"best", "all"}, default "best"
-        What step 1 keeps when no feature passes the threshold: the one with the smallest
-        error, or every candidate (the invariance test then tells the features apart by
-        how badly each fails, and "all" does not stake the estimate on one of them).
+    feature_selection : bool, default True
+        Run step 1 (keep the candidates invariant to what the TF estimate leaves); False
+        keeps every candidate.
     grades : iterable of int in [1, 12], default range(1, 13)
-        DIN grades tried by simulation tuning (step 2); those absent from the database
-        are skipped.
-    select_features : bool, default True
-    tune_simulation : bool, default True
-        When False, ``nominal_grade`` is used.
+        DIN grades the grade choice tries (step 2); those absent from the database are
+        skipped.
     nominal_grade : int in [1, 12], default 7
-        Grade used without tuning and for feature selection. It must be in the database
-        whenever it is used (``select_features=True``, or ``tune_simulation=False``
-        without ``zero_shot``).
-    rms_normalization : bool, default True
+        Grade of feature selection and of ``calibration="nominal"``. It must be in the
+        database whenever it is used.
+    calibration : str, CalibrationOptions or mapping, default "grade"
+        The grade-choice strategy: what the one example (or, without one, the healthy
+        data) calibrates.
+
+        * ``"grade"``: every grade's model, weighted by how well it predicts the example's
+          size (a Gaussian likelihood whose width is half the 90 % validation-residual
+          quantile of the best grade; :func:`~gearshot.estimator.grade_weights`): one
+          example cannot pin the grade down, and averaging over the grades it leaves
+          plausible is steadier.
+        * ``"tuned"``: the paper's step 2, the one grade whose model predicts the example
+          best.
+        * ``"joint"`` (paired databases; otherwise ``"grade"``): every setting of a grid of
+          grade × fault gain × fault width × TF mode (× noise scale) on the twin
+          differences, weighted by how well it explains the example's whole feature
+          vector (:mod:`gearshot.estimator.calibration`); a :class:`CalibrationOptions`
+          (or a mapping of its fields) is ``"joint"`` with that grid. On the rig family's
+          development range (issue #19) "joint" scored 12.0 % (11.6 % matching the
+          selected features only) against 11.3 % for "grade", within the draw-to-draw
+          noise (± 0.8), with more even conditions (worst 13.2 against 15.7 %) but a worse
+          p90; "grade" was kept.
+        * ``"nominal"``: no tuning, ``nominal_grade``.
+        * ``"zero_shot"``: no faulty example: the grades are weighted by how well their
+          simulated healthy SAs match the target's healthy statistics
+          (:func:`~gearshot.estimator.match_grade`,
+          :func:`~gearshot.estimator.signature_weights`), or uniformly when no grade's
+          simulation resembles the target's healthy data.
+
+        With one grade tried, every strategy but ``"zero_shot"`` uses that grade.
     transfer_function : {"estimate", "none"} or array_like of complex, default "estimate"
         Estimate the TF from ``healthy_long`` (step 3), use none, or use a given TF
         (on the SA grid, one-sided to be resampled, or an object with
         ``to_signal_grid(n)``).
-    n_neighbors : iterable of int >= 1, default range(1, 101)
-        Candidate K of step 8.
-    validation_fraction : float in (0, 1), default 0.3
+    rms_normalization : bool, default True
+        Step 5.
     mesh_order : None, int >= 1 or sequence of int >= 1, default None
         Gear-mesh order(s) in the SA cycle whose harmonics and sidebands the difference
         signal removes (step 7). ``None``: from the database's gear pair (its
@@ -333,22 +335,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         for the PHM09 spur input shaft, where the second stage's mesh falls at order 16
         (:meth:`gearshot.Machine.mesh_orders`); the simulated and target signals are
         treated alike. The orders used are ``mesh_orders_``.
-    zero_shot : bool, default False
-        No faulty example: choose the grade by matching healthy-signal statistics
-        (:func:`~gearshot.estimator.match_grade`). With soft weighting the grades are
-        weighted by that match, or uniformly when no grade's simulation resembles the
-        target's healthy data (:func:`~gearshot.estimator.signature_weights`).
-    upsample : int >= 1, default 100
-        Delay resolution (1/upsample sample) of target harmonic suppression.
-    tuning_smoothing : {"isotonic", "none"}, default "isotonic"
-        Fit the example's predicted size over the grades by a monotone curve before
-        choosing (robust to KNN scatter); "none" is the paper's literal nearest rule.
-    grade_weighting : {"soft", "best"}, default "soft"
-        "best" predicts with the one tuned grade (the paper). "soft" averages the models of
-        every grade, weighted by how well each predicts the faulty example (a Gaussian
-        likelihood whose width is half the 90 % validation-residual quantile of the best
-        grade): one example cannot pin the grade down, and averaging over the grades it
-        leaves plausible is steadier (see :func:`~gearshot.estimator.grade_weights`).
+    fault_type : str, optional
+        Fault type whose database slice trains the model (``fault_type`` coordinate of
+        :func:`gearshot.sim.load_database`); ``None``: the database's only type.
     model_discrepancy : float >= 0, default 0.12
         Standard deviation (fault-size units) of the simulation-to-reality error that
         :meth:`predict_interval` adds to the simulated validation residuals. Conformal
@@ -362,45 +351,13 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         intervals. There is no upper bound (intervals are clipped to [0, 1]).
     random_state : int >= 0, numpy RandomState or Generator, or None
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
-        step 1 and the validation split of step 8) gets its own child seed, so switching
-        one step off leaves the others' random numbers unchanged.
-    fault_type : str, optional
-        Fault type whose database slice trains the model (``fault_type`` coordinate of
-        :func:`gearshot.sim.load_database`); ``None``: the database's only type.
-    simulated_reference : {"auto", "first_healthy", "twin"}, default "auto"
-        What step 6 subtracts on the simulated side (in step 1's simulated sets and in
-        the grade models). "first_healthy" (the paper): the first healthy simulated SA,
-        a *different* gear from every other signal's (profile errors are drawn per
-        signal), so every simulated difference carries the profile-error difference of
-        two gears, a floor the target (one gear against itself) does not have. "twin":
-        each signal's own healthy twin (same profile errors, no fault; needs a paired
-        database, ``build_database(..., paired=True)``), so the simulated difference is
-        the fault signature alone; in the grade models the target's non-synchronous
-        residue is then matched by adding Gaussian noise with the power spectrum of the
-        target's healthy difference signals (noise matching, seeded by the
-        ``match_noise`` step seed). "auto": "twin" when the database holds twins, else
-        "first_healthy". The one used is ``simulated_reference_``. On the rig family's
-        development range the twin reference scored 11.3 % against 12.0 % (and 14.2 %
-        when step 1 kept the paper's reference: both steps must subtract the same).
-    zero_shot_signature : {"raw", "denoised"}, default "denoised"
-        The target's healthy signature of the zero-shot grade match: as measured, or with
-        the target's non-synchronous residue (half the mean square of its healthy
-        difference signals off the mesh harmonics) taken off the off-harmonic power
-        first (:func:`~gearshot.estimator.zero_shot.healthy_signature`); simulated SAs
-        have no residue, so the raw target signature points at rougher grades.
-        "denoised" was chosen on the rig family's development range (zero-shot MAE
-        16.4 % against 18.8 % raw, benchmarks/RESULTS.md).
-    calibration : {"grade", "joint"}, CalibrationOptions or mapping, default "grade"
-        What the one example calibrates (with soft grade weighting). "grade": the grade
-        only, each grade weighted by how well its model predicts the example's size.
-        "joint" (paired databases; otherwise "grade"): every setting of a grid of grade ×
-        fault gain × fault width × TF mode (× noise scale) on the twin differences,
-        weighted by how well it explains the example's whole feature vector
-        (:mod:`gearshot.estimator.calibration`); a :class:`CalibrationOptions` (or a
-        mapping of its fields) sets that grid. On the rig family's development range
-        (issue #19) "joint" scored 12.0 % (11.6 % matching the selected features only)
-        against 11.3 % for "grade", within the draw-to-draw noise (± 0.8), with more even
-        conditions (worst 13.2 against 15.7 %) but a worse p90; "grade" was kept.
+        step 1, the validation split of step 8 and the matched noise) gets its own child
+        seed, so switching one step off leaves the others' random numbers unchanged.
+    options : EstimatorOptions, mapping of its fields or None, default None
+        The research settings (:class:`~gearshot.estimator.EstimatorOptions`: step 1's
+        threshold and fallback, step 2's smoothing, the zero-shot signature and
+        weighting, the simulated reference of step 6, step 6's delay resolution, step
+        8's K candidates and split); None: their defaults, which are the product.
 
     Attributes
     ----------
@@ -413,8 +370,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         Step 1's paired candidate features through the estimated and the held-out TF
         (the paper's Fig. 11; see :func:`gearshot.plotting.plot_feature_invariance`).
     grade_strategy_ : {"tuned", "soft", "joint", "nominal", "zero_shot"}
-        The grade-choice strategy that ran ("joint": ``calibration="joint"`` on a paired
-        database).
+        The grade-choice strategy that ran ("soft": ``calibration="grade"``, or "joint"
+        on an unpaired database; "nominal" also when one grade was tried).
     grade_ : int
         The best grade (the paper's choice).
     grade_weights_ : dict grade → weight
@@ -429,14 +386,15 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
     target_healthy_mean_, target_healthy_features_ : ndarray
     target_residue_power_ : ndarray (n_points // 2 + 1,)
         Power spectrum of the target's healthy difference signals (step 6 output): what
-        ``simulated_reference="twin"`` adds to the simulated differences as noise.
+        the twin reference adds to the simulated differences as noise.
     n_neighbors_ : int
     n_points_ : int
     faulty_size_ : float or None
     step_seeds_ : dict step → int
         The seeds the random steps used.
     simulated_reference_ : {"first_healthy", "twin"}
-        The simulated reference step 6 used (``simulated_reference`` with "auto" resolved).
+        The simulated reference step 6 used (``options.simulated_reference`` with "auto"
+        resolved).
     calibration_ : dict
         What the example calibrated: ``strategy`` ("grade" or "joint"), ``settings`` (list
         of dicts ``grade, gain, width, tf, noise, weight`` — and ``log_likelihood`` with
@@ -455,66 +413,49 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
         "features": [NoneValue(), NameSequence(available_features)],
-        "selection_threshold": [Interval(float, 0, None, closed="neither")],
-        "selection_fallback": [Options(("best", "all"))],
+        "feature_selection": [Boolean()],
         "grades": [IntegerSequence(1, 12)],
-        "select_features": [Boolean()],
-        "tune_simulation": [Boolean()],
         "nominal_grade": [Interval(int, 1, 12)],
-        "rms_normalization": [Boolean()],
+        "calibration": [Resolvable(
+            resolve_calibration, "one of " + ", ".join(repr(v) for v in
+                                                      CALIBRATION_STRATEGIES)
+            + ", a CalibrationOptions or a mapping of its fields")],
         "transfer_function": [Options(("estimate", "none")), ArrayOrObject("to_signal_grid")],
-        "n_neighbors": [IntegerSequence(1, None)],
-        "validation_fraction": [Interval(float, 0, 1, closed="neither")],
+        "rms_normalization": [Boolean()],
         "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
-        "zero_shot": [Boolean()],
-        "upsample": [Interval(int, 1, None)],
-        "tuning_smoothing": [Options(("isotonic", "none"))],
-        "grade_weighting": [Options(("soft", "best"))],
+        "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
         "model_discrepancy": [Interval(float, 0, None)],
         "random_state": [RandomStateValue()],
-        "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
-        "simulated_reference": [Options(("auto", "first_healthy", "twin"))],
-        "zero_shot_signature": [Options(("raw", "denoised"))],
-        "calibration": [_CalibrationValue()],
+        "options": [NoneValue(), Resolvable(
+            resolve_options, "an EstimatorOptions or a mapping of its fields")],
     }
 
     def __init__(self, *, features: Sequence[str] | None = None,
-                 selection_threshold: float = 0.10, selection_fallback: str = "best",
-                 grades: Iterable[int] = range(1, 13),
-                 select_features: bool = True, tune_simulation: bool = True,
-                 nominal_grade: int = 7, rms_normalization: bool = True,
+                 feature_selection: bool = True, grades: Iterable[int] = range(1, 13),
+                 nominal_grade: int = 7,
+                 calibration: str | CalibrationOptions | Mapping[str, Any] = "grade",
                  transfer_function: str | ArrayLike | Any = "estimate",
-                 n_neighbors: Iterable[int] = range(1, 101), validation_fraction: float = 0.3,
-                 mesh_order: int | Sequence[int] | None = None, zero_shot: bool = False,
-                 upsample: int = 100,
-                 tuning_smoothing: str = "isotonic", grade_weighting: str = "soft",
-                 model_discrepancy: float = 0.12, random_state: Any = None,
-                 fault_type: str | None = None,
-                 simulated_reference: str = "auto",
-                 zero_shot_signature: str = "denoised",
-                 calibration: str | CalibrationOptions | Mapping[str, Any] = "grade") -> None:
-        self.calibration = calibration
-        self.fault_type = fault_type
-        self.zero_shot_signature = zero_shot_signature
-        self.simulated_reference = simulated_reference
+                 rms_normalization: bool = True,
+                 mesh_order: int | Sequence[int] | None = None,
+                 fault_type: str | None = None, model_discrepancy: float = 0.12,
+                 random_state: Any = None,
+                 options: EstimatorOptions | Mapping[str, Any] | None = None) -> None:
         self.features = features
-        self.selection_threshold = selection_threshold
-        self.selection_fallback = selection_fallback
+        self.feature_selection = feature_selection
         self.grades = grades
-        self.select_features = select_features
-        self.tune_simulation = tune_simulation
         self.nominal_grade = nominal_grade
-        self.rms_normalization = rms_normalization
+        self.calibration = calibration
         self.transfer_function = transfer_function
-        self.n_neighbors = n_neighbors
-        self.validation_fraction = validation_fraction
+        self.rms_normalization = rms_normalization
         self.mesh_order = mesh_order
-        self.zero_shot = zero_shot
-        self.upsample = upsample
-        self.tuning_smoothing = tuning_smoothing
-        self.grade_weighting = grade_weighting
+        self.fault_type = fault_type
         self.model_discrepancy = model_discrepancy
         self.random_state = random_state
+        self.options = options
+
+    def _options(self) -> EstimatorOptions:
+        """The research settings in effect (``options`` resolved)."""
+        return resolve_options(self.options)
 
     def _mesh_orders(self) -> int | list[int]:
         """The mesh orders as the signal functions take them (an int or a list of ints):
@@ -541,7 +482,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
             Healthy SAs of the target machine (≥ 5 recommended: the last fifth become
             harmonic-suppression references, the rest training data with label 0).
         faulty_example : array_like (n_points,)
-            The one faulty SA of known size (omit with ``zero_shot=True``).
+            The one faulty SA of known size (omit with ``calibration="zero_shot"``).
         faulty_size : float in (0, 1]
             Its size.
         healthy_long : array_like (n_samples,)
@@ -585,7 +526,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                                         healthy_long, selection_tf)
         database = _select_fault_type(database, self.fault_type)
         by_grade = _database_by_grade(database, inputs.n_points)
-        reference = self.simulated_reference
+        reference = self._options().simulated_reference
         if reference == "auto":
             reference = "twin" if _has_twins(database) else "first_healthy"
         twins = _database_twins(database, by_grade) if reference == "twin" else None
@@ -601,10 +542,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         cols = [names.index(n) for n in selection.selected]
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"], twins, seeds["match_noise"])
-        strategy = self._grade_strategy(grades)
         options = resolve_calibration(self.calibration)
-        if strategy == "soft" and options is not None and twins is not None:
-            strategy = "joint"
+        strategy = self._grade_strategy(grades, joint=options is not None and twins is not None)
         strategies: dict[str, Callable[[_FitContext], _GradeChoice]] = {
             "tuned": self._grade_tuned, "soft": self._grade_soft,
             "nominal": self._grade_nominal, "zero_shot": self._grade_zero_shot,
@@ -659,10 +598,10 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
             raise GearshotError(f"target_healthy holds {healthy.shape[0]} SA(s); at "
                                 f"least 2 are needed (5 or more recommended)")
         example, size = None, None
-        if not self.zero_shot:
+        if self._strategy_name() != "zero_shot":
             if faulty_example is None or faulty_size is None:
                 raise GearshotError("faulty_example and faulty_size are required unless "
-                                    "zero_shot=True")
+                                    "calibration='zero_shot'")
             example = as_signal_array(faulty_example, "faulty_example",
                                       max_ndim=2).reshape(-1)
             if example.size != n_points:
@@ -678,7 +617,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                 and long is None:
             raise GearshotError("healthy_long is required with transfer_function='estimate'")
         sel_tf = None
-        if self.select_features:
+        if self.feature_selection:
             if selection_tf is None:
                 selection_tf = default_selection_tf(self.random_state)
             sel_tf = _on_grid(selection_tf, n_points, "selection_tf")
@@ -695,8 +634,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
     def _nominal_grade_in(self, by_grade: Mapping[int, Any]) -> int | None:
         """``nominal_grade`` when it is used (feature selection, no tuning), else None."""
         used_by = [what for what, used in (
-            ("select_features=True", self.select_features),
-            ("tune_simulation=False", not self.tune_simulation and not self.zero_shot))
+            ("feature_selection=True", self.feature_selection),
+            ("calibration='nominal'", self._strategy_name() == "nominal"))
             if used]
         if not used_by:
             return None
@@ -716,7 +655,8 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         scaled = inputs.target_healthy / scale if self.rms_normalization \
             else inputs.target_healthy
         train_h, references = steps.split_target_healthy(scaled)
-        sub_h = steps.suppress_harmonics_target(train_h, references, upsample=self.upsample)
+        sub_h = steps.suppress_harmonics_target(train_h, references,
+                                                upsample=self._options().upsample)
         feats_h, mean_h = steps.centred_features(sub_h, mesh_order=self._mesh_orders(),
                                                  names=names,
                                                  healthy_mask=np.ones(len(sub_h), bool))
@@ -741,12 +681,13 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                          ) -> _Selection:
         """Step 1 on the nominal grade's simulated SAs (or every candidate when off); with
         twins, both simulated sets subtract each signal's twin, as the grade models do."""
-        if not self.select_features or nominal is None:
+        if not self.feature_selection or nominal is None:
             return _Selection(names, {}, None)
         sa, y = by_grade[nominal]
         selected, errors, features = steps.select_features(
             sa, y, inputs.selection_tf, mesh_order=self._mesh_orders(), names=names,
-            threshold=self.selection_threshold, fallback=self.selection_fallback,
+            threshold=self._options().selection_threshold,
+            fallback=self._options().selection_fallback,
             random_state=seed, return_features=True,
             twins=None if twins is None else twins[nominal])
         return _Selection(tuple(selected), errors, features)
@@ -790,17 +731,26 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
             random_state=noise_seed)
         X = np.vstack([X_sim[:, cols], target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
-        return steps.fit_knn(X, labels, n_neighbors=self.n_neighbors,
-                             validation_fraction=self.validation_fraction, random_state=seed)
+        opts = self._options()
+        return steps.fit_knn(X, labels, n_neighbors=opts.n_neighbors,
+                             validation_fraction=opts.validation_fraction, random_state=seed)
 
     # ------------------------------------------------------------------ fit: grade choice
-    def _grade_strategy(self, grades: Sequence[int]) -> str:
-        """Which grade-choice strategy the parameters ask for."""
-        if self.zero_shot:
+    def _strategy_name(self) -> str | None:
+        """``calibration`` when it is a strategy name (None for a joint grid)."""
+        return self.calibration if isinstance(self.calibration, str) else None
+
+    def _grade_strategy(self, grades: Sequence[int], joint: bool) -> str:
+        """Which grade-choice strategy ``calibration`` asks for with these grades
+        (``joint``: a joint grid and a paired database)."""
+        name = self._strategy_name()
+        if name == "zero_shot":
             return "zero_shot"
-        if not self.tune_simulation or len(grades) == 1:
+        if name == "nominal" or len(grades) == 1:
             return "nominal"
-        return "soft" if self.grade_weighting == "soft" else "tuned"
+        if name == "tuned":
+            return "tuned"
+        return "joint" if joint else "soft"
 
     def _grade_tuned(self, ctx: _FitContext) -> _GradeChoice:
         """Step 2 (the paper): the one grade whose model predicts the example best."""
@@ -808,7 +758,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         assert ctx.inputs.faulty_size is not None
         grade, curve = steps.tune_grade(lambda g: float(ctx.model_for(g).predict(x_example)[0]),
                                         ctx.grades, ctx.inputs.faulty_size,
-                                        smoothing=self.tuning_smoothing)
+                                        smoothing=self._options().tuning_smoothing)
         return _GradeChoice(grade, {grade: 1.0}, curve)
 
     def _grade_soft(self, ctx: _FitContext) -> _GradeChoice:
@@ -822,13 +772,14 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
 
     def _grade_nominal(self, ctx: _FitContext) -> _GradeChoice:
         """No tuning: ``nominal_grade`` (or the only grade tried)."""
-        grade = ctx.grades[0] if self.tune_simulation else ctx.nominal
+        grade = ctx.nominal if self._strategy_name() == "nominal" else ctx.grades[0]
         assert grade is not None
         return _GradeChoice(int(grade), {int(grade): 1.0}, None)
 
     def _grade_zero_shot(self, ctx: _FitContext) -> _GradeChoice:
         """No example: match healthy-signal statistics of target and simulation."""
-        residue = ctx.target.residue_ms if self.zero_shot_signature == "denoised" else 0.0
+        opts = self._options()
+        residue = ctx.target.residue_ms if opts.zero_shot_signature == "denoised" else 0.0
         target_sig = healthy_signature(ctx.target.scaled_healthy, self._mesh_orders(),
                                        residue_ms=residue)
         sims = {g: healthy_signature(
@@ -837,7 +788,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         grade, curve = match_grade(target_sig, sims)
         tuning_curve: dict[str, Any] = dict(curve)
         weights = {grade: 1.0}
-        if self.grade_weighting == "soft":
+        if opts.zero_shot_weighting == "soft":
             weights, tuning_curve["consistent"] = signature_weights(target_sig, sims)
         return _GradeChoice(grade, weights, tuning_curve)
 
@@ -964,8 +915,9 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                                           healthy_mask=healthy)
         X = np.vstack([feats[:, ctx.cols], ctx.target.healthy_features[:, ctx.cols]])
         labels = np.concatenate([y, np.zeros(len(ctx.target.healthy_features))])
-        return steps.fit_knn(X, labels, n_neighbors=self.n_neighbors,
-                             validation_fraction=self.validation_fraction,
+        opts = self._options()
+        return steps.fit_knn(X, labels, n_neighbors=opts.n_neighbors,
+                             validation_fraction=opts.validation_fraction,
                              random_state=ctx.knn_seed)
 
     # ------------------------------------------------------------------ predict
@@ -983,7 +935,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         x = np.atleast_2d(np.asarray(sa, dtype=float))
         if self.rms_normalization:
             x = x / scale
-        sub = steps.suppress_harmonics_target(x, references, upsample=self.upsample)
+        sub = steps.suppress_harmonics_target(x, references, upsample=self._options().upsample)
         feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=self._mesh_orders(),
                                           names=names)
         return feats

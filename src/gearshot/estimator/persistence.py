@@ -38,6 +38,7 @@ SAFE_TYPES = (
     "gearshot.estimator._model.OneFaultShotEstimator",
     "gearshot.estimator.steps.KnnModel",
     "gearshot.estimator.calibration.CalibrationOptions",
+    "gearshot.estimator.options.EstimatorOptions",
     "gearshot.estimator.comparability.Comparability",
     "gearshot.estimator.comparability.ComparabilityReference",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",
