@@ -273,6 +273,20 @@ class _FitContext:
     noise_seed: int = 0
     cache: dict[str, Any] = field(default_factory=dict)
 
+    def matched_noise(self, n_signals: int) -> FloatArray:
+        """The residue noise of ``n_signals`` simulated signals (noise matching).
+
+        Drawn from the ``match_noise`` step seed afresh for every set, so every grade and
+        setting of the same size gets the same draw: it is drawn once and kept."""
+        key = f"noise/{n_signals}"
+        if key not in self.cache:
+            rng = np.random.default_rng(
+                np.random.RandomState(self.noise_seed).randint(2**31 - 1))
+            self.cache[key] = steps.residue_noise(self.target.residue_power, n_signals,
+                                                  self.inputs.n_points, rng)
+        noise: FloatArray = self.cache[key]
+        return noise
+
 
 # scikit-learn ships no type information: its classes are Any to mypy
 class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc,unused-ignore]
@@ -703,9 +717,11 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
 
         def model_for(grade: int) -> KnnModel:
             if grade not in models:
+                sa = by_grade[grade][0]
                 models[grade] = self._fit_grade_model(
                     by_grade[grade], target, names, cols, seed,
-                    None if twins is None else twins[grade], noise_seed)
+                    None if twins is None else twins[grade],
+                    None if twins is None else ctx.matched_noise(sa.shape[0]))
             return models[grade]
 
         def example_features() -> FloatArray:
@@ -713,22 +729,23 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
                                           target.references, target.healthy_mean, names)
             return feats[:, cols]
 
-        return _FitContext(by_grade, grades, nominal, target, inputs, example_features,
-                           model_for, names, cols, twins, seed, noise_seed)
+        ctx = _FitContext(by_grade, grades, nominal, target, inputs, example_features,
+                          model_for, names, cols, twins, seed, noise_seed)
+        return ctx
 
     def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
                          names: tuple[str, ...], cols: list[int], seed: int,
-                         twins: FloatArray | None = None, noise_seed: int = 0) -> KnnModel:
+                         twins: FloatArray | None = None,
+                         noise: FloatArray | None = None) -> KnnModel:
         """Steps 4–8 for one grade: its simulated features with the target healthy, KNN.
 
         With twins (``simulated_reference="twin"``), step 6 subtracts each signal's twin
-        and the target's residue spectrum is added as noise."""
+        and ``noise`` (the target's residue) is added."""
         sa, y = grade_data
         X_sim = steps.simulated_features(
             sa, y == 0, target.transfer_function, mesh_order=self._mesh_orders(), names=names,
             rms_normalization=self.rms_normalization, twins=twins,
-            noise_power=None if twins is None else target.residue_power,
-            random_state=noise_seed)
+            noise=noise)
         X = np.vstack([X_sim[:, cols], target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
         opts = self._options()
@@ -908,9 +925,7 @@ class OneFaultShotEstimator(RegressorMixin, BaseEstimator):  # type: ignore[misc
         tf = ctx.target.transfer_function if setting["tf"] == "tf" else None
         d = setting_differences(sa - ctx.twins[g], tf, scale, gain=setting["gain"],
                                 width=setting["width"], centre=centre)
-        rng = np.random.default_rng(np.random.RandomState(ctx.noise_seed).randint(2**31 - 1))
-        d = d + np.sqrt(setting["noise"]) * steps.residue_noise(
-            ctx.target.residue_power, d.shape[0], d.shape[1], rng)
+        d = d + np.sqrt(setting["noise"]) * ctx.matched_noise(d.shape[0])
         feats, _ = steps.centred_features(d, mesh_order=self._mesh_orders(), names=ctx.names,
                                           healthy_mask=healthy)
         X = np.vstack([feats[:, ctx.cols], ctx.target.healthy_features[:, ctx.cols]])

@@ -318,8 +318,7 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
                        mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True, twins: ArrayLike | None = None,
-                       noise_power: ArrayLike | None = None,
-                       random_state: RandomStateLike = None) -> FloatArray:
+                       noise: ArrayLike | None = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
 
     Parameters
@@ -336,12 +335,10 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
     twins : ndarray (n_signals, n_points), optional
         Each signal's healthy twin: step 6 subtracts it (propagated and scaled like the
         signals) instead of the first healthy SA.
-    noise_power : ndarray (n_points // 2 + 1,), optional
-        Power spectrum of the residue to add to the difference signals (noise matching,
-        :func:`residue_power` of the target's healthy differences); with twins the
+    noise : ndarray (n_signals, n_points), optional
+        Residue added to the difference signals (noise matching: :func:`residue_noise`
+        of the target's healthy differences' :func:`residue_power`); with twins the
         simulated differences have no residue of their own.
-    random_state : int, RandomState or None
-        Seeds the matched noise.
 
     Returns
     -------
@@ -357,9 +354,8 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
             twin = normalize_rms(twin, sim[healthy])
         sim = normalize_rms(sim, sim[healthy])
     sim = suppress_harmonics_simulated(sim, healthy, twin)
-    if noise_power is not None:
-        rng = np.random.default_rng(check_random_state(random_state).randint(2**31 - 1))
-        sim = sim + residue_noise(noise_power, sim.shape[0], sim.shape[1], rng)
+    if noise is not None:
+        sim = sim + np.asarray(noise, dtype=float)
     feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
     return feats
 
