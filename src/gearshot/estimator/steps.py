@@ -347,13 +347,17 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         features).
     """
     healthy = np.asarray(healthy_mask, bool)
-    sim = propagate_simulated(sim_sa, tf)
-    twin = None if twins is None else propagate_simulated(twins, tf)
-    if rms_normalization:
-        if twin is not None:
-            twin = normalize_rms(twin, sim[healthy])
-        sim = normalize_rms(sim, sim[healthy])
-    sim = suppress_harmonics_simulated(sim, healthy, twin)
+    if twins is None:
+        sim = propagate_simulated(sim_sa, tf)
+        if rms_normalization:
+            sim = normalize_rms(sim, sim[healthy])
+        sim = suppress_harmonics_simulated(sim, healthy)
+    else:
+        # steps 4-6 are linear in the signals: the twin's difference goes through the TF
+        # once (half the propagation), scaled by the propagated healthy SAs' mean RMS
+        sim = propagate_simulated(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
+        if rms_normalization:
+            sim = normalize_rms(sim, propagate_simulated(np.asarray(sim_sa)[healthy], tf))
     if noise is not None:
         sim = sim + np.asarray(noise, dtype=float)
     feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
