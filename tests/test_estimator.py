@@ -334,11 +334,6 @@ def test_isotonic_tuning_ignores_a_lucky_outlier():
 
 
 # ------------------------------------------------------------------- soft grade weighting
-def test_moved_uncertainty_names_still_resolve_from_steps():
-    with pytest.warns(DeprecationWarning, match="uncertainty"):
-        assert steps.grade_weights is uncertainty.grade_weights
-
-
 def test_grade_weights_follow_a_gaussian_likelihood_of_the_example():
     residuals = np.full(99, 0.1)  # 90 % quantile 0.1 → sigma 0.05
     w = uncertainty.grade_weights([0.30, 0.35, 0.40, 0.90], [1, 2, 3, 4], 0.35, residuals)

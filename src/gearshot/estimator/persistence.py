@@ -36,7 +36,7 @@ _PICKLE_FORMAT = "gearshot-estimator/1"
 SAFE_TYPES = (
     "builtins.range",
     "gearshot.estimator._model.OneFaultShotEstimator",
-    "gearshot.estimator.steps.KnnModel",
+    "gearshot.estimator.knn.KnnModel",
     "gearshot.estimator.calibration.CalibrationOptions",
     "gearshot.estimator.options.EstimatorOptions",
     "gearshot.estimator.comparability.Comparability",
