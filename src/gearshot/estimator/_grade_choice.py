@@ -68,18 +68,23 @@ class _FitContext:
     cache: dict[str, Any] = field(default_factory=dict)
 
     def matched_noise(self, n_signals: int) -> FloatArray:
-        """The residue noise of ``n_signals`` simulated signals (noise matching).
+        """The residue noise of ``n_signals`` simulated signals (:func:`_matched_noise`)."""
+        return _matched_noise(self.cache, self.target.residue_power, self.inputs.n_points,
+                              self.noise_seed, n_signals)
 
-        Drawn from the ``match_noise`` step seed afresh for every set, so every grade and
-        setting of the same size gets the same draw: it is drawn once and kept."""
-        key = f"noise/{n_signals}"
-        if key not in self.cache:
-            rng = np.random.default_rng(
-                np.random.RandomState(self.noise_seed).randint(2**31 - 1))
-            self.cache[key] = steps.residue_noise(self.target.residue_power, n_signals,
-                                                  self.inputs.n_points, rng)
-        noise: FloatArray = self.cache[key]
-        return noise
+
+def _matched_noise(cache: dict[str, Any], power: FloatArray, n_points: int, seed: int,
+                   n_signals: int) -> FloatArray:
+    """The residue noise of ``n_signals`` simulated signals (noise matching).
+
+    Drawn from the ``match_noise`` step seed afresh for every set, so every grade and
+    setting of the same size gets the same draw: it is drawn once and kept in ``cache``."""
+    key = f"noise/{n_signals}"
+    if key not in cache:
+        rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
+        cache[key] = steps.residue_noise(power, n_signals, n_points, rng)
+    noise: FloatArray = cache[key]
+    return noise
 
 
 # scikit-learn ships no type information: its classes are Any to mypy
@@ -132,8 +137,12 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                      inputs: _FitInputs, names: tuple[str, ...], cols: list[int],
                      seed: int, twins: Mapping[int, FloatArray] | None = None,
                      noise_seed: int = 0) -> _FitContext:
-        """Bundle what the strategies need; grade models are fitted on first use and kept."""
+        """Bundle what the strategies need; grade models are fitted on first use and kept.
+
+        (The closures hold the context's parts, not the context: no reference cycle keeps
+        a fit's arrays alive after it.)"""
         models: dict[int, KnnModel] = {}
+        cache: dict[str, Any] = {}
 
         def model_for(grade: int) -> KnnModel:
             if grade not in models:
@@ -141,17 +150,18 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                 models[grade] = self._fit_grade_model(
                     by_grade[grade], target, names, cols, seed,
                     None if twins is None else twins[grade],
-                    None if twins is None else ctx.matched_noise(sa.shape[0]))
+                    None if twins is None else _matched_noise(
+                        cache, target.residue_power, inputs.n_points, noise_seed,
+                        sa.shape[0]))
             return models[grade]
 
         def example_features() -> FloatArray:
             feats = target_features(self, inputs.faulty_example, target.scale,
-                                          target.references, target.healthy_mean, names)
+                                    target.references, target.healthy_mean, names)
             return feats[:, cols]
 
-        ctx = _FitContext(by_grade, grades, nominal, target, inputs, example_features,
-                          model_for, names, cols, twins, seed, noise_seed)
-        return ctx
+        return _FitContext(by_grade, grades, nominal, target, inputs, example_features,
+                           model_for, names, cols, twins, seed, noise_seed, cache)
 
     def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
                          names: tuple[str, ...], cols: list[int], seed: int,

@@ -320,7 +320,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
              orders: tuple[int, ...]) -> Self:
         """``fit`` with checked parameters and resolved mesh orders."""
         inputs = check_fit_inputs(self, target_healthy, faulty_example, faulty_size,
-                                        healthy_long, selection_tf)
+                                  healthy_long, selection_tf)
         database = _select_fault_type(database, self.fault_type)
         by_grade = _database_by_grade(database, inputs.n_points)
         reference = self._options().simulated_reference
