@@ -20,7 +20,8 @@ def _is_number_row(line: str) -> bool:
     return True
 
 
-def read_frf_csv(path: Path) -> TransferFunction:
+def _split_csv(path: Path) -> tuple[dict[str, Any], list[str]]:
+    """The ``# key = value`` metadata and the data rows (header line dropped) of a CSV file."""
     check_readable(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -40,6 +41,11 @@ def read_frf_csv(path: Path) -> TransferFunction:
         body.append(s)
     if body and not _is_number_row(body[0]):
         body = body[1:]  # column header line, e.g. "freq_hz,re,im"
+    return meta, body
+
+
+def _csv_values(path: Path, body: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies and complex values of the data rows, checked as a UFF58 dataset is."""
     if not body:
         raise fail(path, "no data rows (expected columns freq_hz, re, im)")
     try:
@@ -54,6 +60,13 @@ def read_frf_csv(path: Path) -> TransferFunction:
         raise fail(path, f"only {x.size} frequency line(s); need >= 2")
     if x[0] < 0:
         raise fail(path, f"negative frequency {float(x[0])!r} Hz")
+    return x, y
+
+
+def read_frf_csv(path: Path) -> TransferFunction:
+    """The FRF of a CSV file written by :func:`write_frf_csv` (or by hand, same layout)."""
+    meta, body = _split_csv(path)
+    x, y = _csv_values(path, body)
 
     def _int(key: str) -> int:
         try:
@@ -73,6 +86,7 @@ def read_frf_csv(path: Path) -> TransferFunction:
 
 
 def write_frf_csv(path: Path, tf: TransferFunction) -> None:
+    """``tf`` as CSV: metadata lines, a header, then 17-significant-digit rows."""
     lines = [f"# name = {tf.name}", f"# response_node = {tf.response_node}",
              f"# response_direction = {tf.response_direction}",
              f"# reference_node = {tf.reference_node}",

@@ -33,10 +33,12 @@ KEEP_FIELDS = ("id2", "id3", "id4", "id5", "rsp_ent_name", "ref_ent_name", "load
 
 
 def fail(path: Path, problem: str) -> GearshotError:
+    """The error for a problem with the file ``path`` (named first)."""
     return GearshotError(f"{path}: {problem}")
 
 
 def as_path(path: Any) -> Path:
+    """``path`` as a :class:`~pathlib.Path`; a non-path argument raises."""
     try:
         return Path(os.fspath(path))
     except TypeError:
@@ -44,6 +46,7 @@ def as_path(path: Any) -> Path:
 
 
 def check_readable(path: Path) -> None:
+    """Refuse a missing, non-regular or empty file."""
     if not path.exists():
         raise fail(path, "file does not exist")
     if not path.is_file():
@@ -84,6 +87,8 @@ def read_uff_sets(path: Path) -> list[dict]:
 
 
 def check_dataset(path: Path, i: int, dset: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Abscissa and ordinate of dataset ``i``: point count as announced, finite values,
+    strictly increasing abscissa."""
     x = np.asarray(dset.get("x"), dtype=float)
     y = np.asarray(dset.get("data"))
     n_expected = int(dset.get("num_pts", y.size))
@@ -109,6 +114,7 @@ def check_dataset(path: Path, i: int, dset: dict) -> tuple[np.ndarray, np.ndarra
 
 
 def frf_from_dataset(path: Path, i: int, dset: dict) -> TransferFunction:
+    """The checked FRF (function type 4) of dataset ``i`` as a :class:`TransferFunction`."""
     x, y = check_dataset(path, i, dset)
     if x.size < 2:
         raise fail(path, f"dataset {i} has only {x.size} frequency line(s); need >= 2")
