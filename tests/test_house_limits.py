@@ -29,8 +29,6 @@ _PENDING: frozenset[str] = frozenset(
         "app/cli.py",
         "app/demo.py",
         "app/predict_machine.py",
-        "estimator/_model.py",
-        "estimator/steps.py",
         "experiments/family.py",
         "io/recording.py",
         "machine.py",
