@@ -220,11 +220,17 @@ def test_every_parameter_has_a_constraint():
     ("random_state", "seed", "seed"),
 ])
 def test_bad_parameter_is_named_with_its_value_at_fit(data, tfs, name, value, shown):
-    est = OneFaultShotEstimator(**{**FAST, name: value})
+    _assert_refused_at_fit(OneFaultShotEstimator(**{**FAST, name: value}), data, tfs,
+                           f"{name} must be ", shown)
+
+
+def _assert_refused_at_fit(est, data, tfs, start, shown):
+    """``fit`` refuses ``est`` with a message that starts with ``start`` and quotes the
+    value as ``shown``, and leaves it unfitted."""
     with pytest.raises(GearshotError) as info:
         _fit(est, data, tfs)
     message = str(info.value)
-    assert message.startswith(f"{name} must be "), message
+    assert message.startswith(start), message
     assert shown in message, message
     assert not hasattr(est, "model_")
 
@@ -250,13 +256,8 @@ def test_bad_option_is_named_with_its_value(data, tfs, name, value, shown):
         EstimatorOptions(**{name: value})
     assert str(info.value).startswith(f"{name} must be "), str(info.value)
     assert shown in str(info.value)
-    est = OneFaultShotEstimator(**{**FAST, "options": {name: value}})
-    with pytest.raises(GearshotError) as info:
-        _fit(est, data, tfs)
-    message = str(info.value)
-    assert message.startswith(f"options: {name} must be "), message
-    assert shown in message, message
-    assert not hasattr(est, "model_")
+    _assert_refused_at_fit(OneFaultShotEstimator(**{**FAST, "options": {name: value}}),
+                           data, tfs, f"options: {name} must be ", shown)
 
 
 def test_unknown_option_is_named():
