@@ -433,6 +433,31 @@ def test_simulated_suppression_subtracts_each_twin():
         steps.suppress_harmonics_simulated(sa, np.ones(4, bool), twins[:3])
 
 
+def test_twin_path_equals_propagating_signals_and_twins_apart(tf_pair):
+    """Steps 4-6 with twins run on SA - twin (one propagation): the same differences as
+    propagating SAs and twins apart, each scaled by the propagated healthy SAs' mean RMS;
+    step 5's scale is one function for both domains."""
+    rng = np.random.default_rng(7)
+    sa = rng.normal(size=(6, N))
+    twins = sa + 0.1 * rng.normal(size=(6, N))
+    healthy = np.array([True, True, False, False, False, False])
+    twins[healthy] = sa[healthy]
+    noise = 0.01 * rng.normal(size=(6, N))
+    tf = tf_pair[0]
+    got = steps.simulated_features(sa, healthy, tf, mesh_order=38, names=["rms_diff"],
+                                   twins=twins, noise=noise)
+    p_sa, p_tw = steps.propagate_simulated(sa, tf), steps.propagate_simulated(twins, tf)
+    scale = steps.rms_scale(p_sa[healthy])
+    assert scale == pytest.approx(np.mean(np.sqrt(np.mean(p_sa[healthy] ** 2, axis=1))))
+    want, _ = steps.centred_features(p_sa / scale - p_tw / scale + noise, mesh_order=38,
+                                     names=["rms_diff"], healthy_mask=healthy)
+    assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    assert_allclose(steps.normalize_rms(p_sa, p_sa[healthy]), p_sa / scale)
+    assert_allclose(steps.normalize_rms(p_sa, scale=scale), p_sa / scale)
+    with pytest.raises(GearshotError, match="target_healthy has zero RMS"):
+        steps.rms_scale(np.zeros((2, N)), name="target_healthy")
+
+
 def test_residue_noise_has_the_measured_power_spectrum():
     rng = np.random.default_rng(4)
     shaped = np.fft.irfft(np.fft.rfft(rng.normal(size=(400, 256)), axis=-1)
