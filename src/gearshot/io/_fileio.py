@@ -28,6 +28,7 @@ __all__ = [
     "write_json_atomic",
     "select_channels",
     "reconcile_fs",
+    "machine_channels",
     "time_column_fs",
     "METADATA_KEYS",
     "ACCEL_NAMES",
@@ -230,3 +231,19 @@ def time_column_fs(path: Path, t: np.ndarray) -> float:
         raise GearshotError(f"{str(path)!r}: the time column is not uniformly spaced "
                             f"(steps {dt.min()!r} .. {dt.max()!r} s)")
     return float(f"{1.0 / step:.9g}")  # time columns carry rounding noise
+
+
+def machine_channels(raw: RawFile, machine: Any
+                     ) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
+    """Sensor channels (scaled to physical units) and the tacho of a file, by the machine."""
+    rows = []
+    for s in machine.sensors:
+        name = _resolve(raw, f"sensor {s.name!r} channel", s.channel, {})
+        row = np.asarray(raw.channels[name], dtype=np.float64).ravel() / s.sensitivity
+        rows.append(row - row.mean() if s.ac_coupled else row)
+    tac = None
+    if machine.tacho is not None:  # no [tacho]: the speed comes from the vibration
+        tname = _resolve(raw, "tacho.channel", machine.tacho.channel, {})
+        tac = np.asarray(raw.channels[tname], dtype=np.float64).ravel()
+    acc = rows[0] if len(rows) == 1 else np.stack(rows)
+    return acc, tac, tuple(s.name for s in machine.sensors)
