@@ -213,11 +213,11 @@ def reconcile_fs(raw: RawFile, fs: Any) -> float:
     if isinstance(fs, bool) or not isinstance(fs, (int, float, np.number)) or not (
             math.isfinite(fs) and fs > 0):
         raise GearshotError(f"fs must be a finite positive number (Hz); got {describe(fs)}")
-    fs = float(fs)
-    if file_fs is not None and abs(fs - file_fs) > 1e-9 * file_fs:
-        raise GearshotError(f"fs={fs!r} conflicts with the sampling rate {file_fs!r} Hz stated "
-                            f"in {str(raw.path)!r}")
-    return fs
+    rate = float(fs)
+    if file_fs is not None and abs(rate - file_fs) > 1e-9 * file_fs:
+        raise GearshotError(f"fs={rate!r} conflicts with the sampling rate {file_fs!r} Hz "
+                            f"stated in {str(raw.path)!r}")
+    return rate
 
 
 def time_column_fs(path: Path, t: np.ndarray) -> float:

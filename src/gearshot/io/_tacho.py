@@ -5,13 +5,16 @@ revolutions of one SA cycle of a shaft or a gear pair."""
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_int
 from ..signal.angle import check_pulse_train
+
+if TYPE_CHECKING:
+    from ..machine import Machine
 
 __all__ = ["TachoRecording", "SPEED_TOLERANCE"]
 
@@ -32,12 +35,13 @@ class TachoRecording:
     tacho_shaft: str
     origin: str | None
     channel_names: tuple[str, ...]
-    machine: Any
+    machine: Machine | None
 
     @property
     def duration(self) -> float:
         """Length in s."""
-        return self.acceleration.shape[-1] / self.fs
+        n: int = self.acceleration.shape[-1]
+        return n / self.fs
 
     def _label(self) -> str:
         return f"recording {self.origin!r}" if self.origin else "recording"
@@ -61,9 +65,9 @@ class TachoRecording:
             raise GearshotError(f"{self._label()} has no tacho; SA segments need one")
         if float(np.ptp(self.tacho)) == 0.0:
             raise GearshotError(f"{self._label()}: the tacho is flat (no pulses)")
-        if threshold is None and self.machine is not None:
+        if threshold is None and self.machine is not None and self.machine.tacho is not None:
             threshold = self.machine.tacho.threshold
-        cache = self.__dict__.setdefault("_pulse_cache", {})
+        cache: dict[float | None, np.ndarray] = self.__dict__.setdefault("_pulse_cache", {})
         if threshold not in cache:
             try:
                 cache[threshold] = np.asarray(pulse_times(self.tacho, self.fs,

@@ -118,6 +118,7 @@ class VibrationRecording(TachoRecording):
 
         Without a tacho: from the vibration (:meth:`vibration_angle`; the tracked shaft
         stands for the tacho shaft)."""
+        tacho_rate: float
         if self.tacho is None:
             tacho_rate = self.vibration_angle().mean_speed
         else:

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,6 +29,9 @@ from ._format_text import TEXT_SUFFIXES, read_text
 from ._format_wav import read_wav, write_wav
 from ._tacho import SPEED_TOLERANCE as SPEED_TOLERANCE  # its old home
 
+if TYPE_CHECKING:
+    from ..machine import FileLayout, Machine
+
 __all__ = ["Recording", "FORMATS"]
 
 #: file suffix -> format name understood by :meth:`Recording.read` / :meth:`Recording.write`.
@@ -42,10 +45,10 @@ def _opt_float(value: Any, name: str) -> float | None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
         raise GearshotError(f"{name} must be a real number or None; got {describe(value)}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise GearshotError(f"{name} must be finite; got {value}")
-    return value
+    number = float(value)
+    if not math.isfinite(number):
+        raise GearshotError(f"{name} must be finite; got {number}")
+    return number
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,7 +106,7 @@ class Recording(AngleDomainRecording):
     extras: Mapping[str, Any] = field(default_factory=dict)
     origin: str | None = field(default=None, compare=False)
     channel_names: tuple[str, ...] = ()
-    machine: Any = field(default=None, compare=False, repr=False)
+    machine: Machine | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -234,15 +237,8 @@ class Recording(AngleDomainRecording):
             if not isinstance(machine, Machine):
                 machine = Machine.from_toml(machine)
         layout = None if machine is None else machine.layout
-        if layout is not None and fmt in ("text", "csv"):
-            def reader(p):
-                return read_text(p, delimiter=layout.delimiter, header=layout.header,
-                                 columns=layout.columns, skip_rows=layout.skip_rows)
-        else:
-            reader = {"hdf5": read_hdf5, "mat": read_mat, "wav": read_wav, "csv": read_csv,
-                      "text": read_text, "tdms": read_tdms}[fmt]
         try:
-            raw: RawFile = _bounded_read(reader, path)
+            raw = _bounded_read(_reader(fmt, layout), path)
         except GearshotError:
             raise
         except Exception as exc:  # corrupt / truncated / not this format
@@ -347,7 +343,21 @@ class Recording(AngleDomainRecording):
 READ_BUDGET_S = 20.0
 
 
-def _bounded_read(reader: Any, path: Path) -> RawFile:
+def _reader(fmt: str, layout: FileLayout | None) -> Callable[[Path], RawFile]:
+    """The reader of format ``fmt``; text and CSV files laid out by a machine's ``[file]``
+    table when ``layout`` is given."""
+    if layout is not None and fmt in ("text", "csv"):
+        def read_laid_out(p: Path) -> RawFile:
+            return read_text(p, delimiter=layout.delimiter, header=layout.header,
+                             columns=layout.columns, skip_rows=layout.skip_rows)
+        return read_laid_out
+    readers: dict[str, Callable[[Path], RawFile]] = {
+        "hdf5": read_hdf5, "mat": read_mat, "wav": read_wav, "csv": read_csv,
+        "text": read_text, "tdms": read_tdms}
+    return readers[fmt]
+
+
+def _bounded_read(reader: Callable[[Path], RawFile], path: Path) -> RawFile:
     """Run ``reader(path)`` in a worker thread; the caller waits in short, interruptible
     steps (Ctrl-C is honoured at once) and gives up with a :class:`GearshotError` after
     :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file)."""
@@ -373,4 +383,5 @@ def _bounded_read(reader: Any, path: Path) -> RawFile:
                             f"a damaged file (or a stalled disk)")
     if "exc" in box:
         raise box["exc"]
-    return box["raw"]
+    raw: RawFile = box["raw"]
+    return raw

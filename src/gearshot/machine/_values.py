@@ -36,12 +36,12 @@ def float_key(value: Any, key: str, *, positive: bool = True, allow_zero: bool =
     ``positive``), else an error naming ``key``."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise GearshotError(f"{key} must be a number; got {describe(value)}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise GearshotError(f"{key} must be finite; got {value}")
-    if positive and (value < 0 or (value == 0 and not allow_zero)):
-        raise GearshotError(f"{key} must be {'>= 0' if allow_zero else '> 0'}; got {value}")
-    return value
+    number = float(value)
+    if not math.isfinite(number):
+        raise GearshotError(f"{key} must be finite; got {number}")
+    if positive and (number < 0 or (number == 0 and not allow_zero)):
+        raise GearshotError(f"{key} must be {'>= 0' if allow_zero else '> 0'}; got {number}")
+    return number
 
 
 def name_key(value: Any, key: str) -> str:

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .._errors import GearshotError
 from .._validation import describe
@@ -28,6 +28,9 @@ from ._consistency import (
 )
 from ._tables import machine_fields
 from .parts import FileLayout, GearStage, MonitoredGear, Sensor, Tacho, VibrationSpeed
+
+if TYPE_CHECKING:
+    from ..sim import GearPair
 
 __all__ = ["Machine"]
 
@@ -183,7 +186,7 @@ class Machine:
             return st.driven, st.driven_teeth
         return st.driver, st.driver_teeth
 
-    def gear_pair(self, **overrides: Any):
+    def gear_pair(self, **overrides: Any) -> GearPair:
         """The monitored pair as a :class:`gearshot.sim.GearPair` for the simulator.
 
         The simulator puts the fault on its driven gear (``z_gear``), so ``z_gear`` is the
