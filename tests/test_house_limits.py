@@ -32,8 +32,6 @@ _PENDING: frozenset[str] = frozenset(
         "estimator/_model.py",
         "estimator/steps.py",
         "experiments/family.py",
-        "io/recording.py",
-        "machine.py",
         "signal/ridge.py",
         "signal/tracking.py",
         "sim/database.py",
