@@ -40,10 +40,10 @@ import pandas as pd
 from .._atomic import atomic_path, check_writable, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
+from ..fault_registry import check_fault_type
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
 from ..paper import GEAR_TEETH, PINION_TEETH, TABLE1_SIZES
 from ..signal.level import rms
-from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
 from .motion import load_torque, motor_angle, ramp_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
@@ -88,7 +88,7 @@ class VirtualRig:
         :meth:`with_reality`).
     fault_type : str
         The fault this rig grows (``"ftff"``, default; ``"partial_face"``, ``"breakage"``,
-        ``"destruction"``: :data:`gearshot.sim.FAULT_TYPES`); ``fault_size`` of
+        ``"destruction"``: :data:`gearshot.fault_registry.FAULT_TYPE_NAMES`); ``fault_size`` of
         :meth:`record` is its size label. The hidden reality makes each type irregular
         (:mod:`gearshot.rig.irregular`). The ``"sim"`` engine grows every type, the
         surrogate only the FTFF; a callable engine gets ``fault_type=`` as a keyword when

@@ -16,7 +16,7 @@ against it (a missing or overwritten chunk is named, never read as NaN), and a b
 rebuilds exactly the blocks found damaged, reusing the rest; a lost ``manifest.json`` is
 restored from the blocks' copies. Each block's random stream derives from
 ``SeedSequence(seed, spawn_key=(i, j, k))`` (``(i, j, k, code)`` for a fault type other
-than the FTFF, ``code`` its position in :data:`~gearshot.sim.FAULT_TYPES`) and each
+than the FTFF, ``code`` the type's fixed code in :mod:`gearshot.fault_registry`) and each
 signal's from the block's, so contents do not depend on order or interruption. A build of
 FTFFs only keeps the layout and manifest of stores built before fault types existed.
 """
@@ -37,6 +37,7 @@ from .._atomic import atomic_dir, check_writable, remove_tree, write_json_atomic
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, check_load, check_speed, describe
+from ..fault_registry import check_fault_type, fault_type_record
 from ._block_read import read_block, resume_problem
 from ._integrity import (
     block_content_problem,
@@ -46,7 +47,7 @@ from ._integrity import (
     store_lock,
 )
 from .dynamics import simulate_sa
-from .fault_types import FAULT_MODEL_VERSIONS, FAULT_TYPES, check_fault_type
+from .fault_types import FAULT_MODEL_VERSIONS
 from .geometry import GearPair
 
 __all__ = ["build_database", "load_database", "default_database_path"]
@@ -265,7 +266,7 @@ def _ownership_problem(path: Path, manifest: dict, i: int, j: int, k: int,
     try:
         ds = xr.open_zarr(path, consolidated=False)
         problem = block_content_problem(ds, manifest, i, j, k, fault_type,
-                                        list(FAULT_TYPES).index(fault_type))
+                                        fault_type_record(fault_type).code)
     except Exception as exc:  # a decoder's error on a damaged block
         return f"it cannot be decoded ({type(exc).__name__}: {exc})"
     if problem is None:
@@ -321,7 +322,7 @@ def _check_against_manifest(store: Path, path: Path, part, man: dict, where: str
                    f"{manifest_diff(_block_manifest(path) or {}, man)})")
     else:
         problem = block_content_problem(part, man, i, j, k, fault_type,
-                                        list(FAULT_TYPES).index(fault_type))
+                                        fault_type_record(fault_type).code)
     if problem is None:
         return
     theirs = _block_manifest(path)
@@ -362,7 +363,7 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
         return final.name
     if manifest is None:   # the builder's manifest, never one found on disk
         raise GearshotError("_build_block needs the build's manifest")
-    code = list(FAULT_TYPES).index(fault_type)
+    code = fault_type_record(fault_type).code
     n = n_healthy + n_faulty
     sizes, sig_seeds = block_draws(seed, i, j, k, code, n_healthy, n_faulty)
     sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
