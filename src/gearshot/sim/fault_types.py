@@ -222,8 +222,14 @@ class ToothBreakage(SizedToothFault):
         """Lost height (m, from the tip) at face positions ``zeta`` (0 ... 1)."""
         zeta = np.asarray(zeta, dtype=float)
         chip = (1 + self.corner) * np.clip(1 - zeta / self.corner_width, 0.0, None)
-        h = self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip), 0.0, 1.0)
+        h = self.active_height(pair) * np.clip(
+            self.size * np.maximum(1.0, chip) * self.line_shape(zeta), 0.0, 1.0)
         return np.where(zeta <= self.share + 1e-12, h, 0.0)
+
+    def line_shape(self, zeta) -> np.ndarray | float:
+        """Factor on the lost height along the break line at face positions ``zeta``
+        (1: a straight break line; a rig's irregular break overrides it)."""
+        return 1.0
 
     @staticmethod
     def active_height(pair: GearPair) -> float:
