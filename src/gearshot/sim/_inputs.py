@@ -96,7 +96,7 @@ def resolve_faults(fault_sizes, faults, center, depth, fault_type="ftff"
                    ) -> list[ToothFault]:
     """One fault object per signal, from sizes of ``fault_type`` (its class, with the
     shared options ``center``/``depth`` its record takes) or from fault objects."""
-    fault_type_record(fault_type)         # names the known types
+    record = fault_type_record(fault_type)      # refuses an unknown type, naming the known
     if faults is not None:
         if fault_sizes is not None:
             raise GearshotError("give fault_sizes or faults, not both")
@@ -112,7 +112,7 @@ def resolve_faults(fault_sizes, faults, center, depth, fault_type="ftff"
         raise GearshotError("give fault_sizes (FTFF sizes) or faults (fault objects)")
     sizes = check_sizes(fault_sizes)
     shared = {"center": center, "depth": depth}
-    options = {k: shared[k] for k in fault_type_record(fault_type).options}
+    options = {k: shared[k] for k in record.options}
     cls = fault_class(fault_type)     # sizes as given: an FTFF off the profile is an error
     return [cls(size=float(y), **options) for y in sizes]
 
