@@ -34,7 +34,6 @@ _PENDING: frozenset[str] = frozenset(
         "experiments/family.py",
         "signal/ridge.py",
         "signal/tracking.py",
-        "sim/database.py",
         "sim/dynamics.py",
     }
 )

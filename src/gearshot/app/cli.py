@@ -15,6 +15,7 @@ from .. import __version__
 from .._atomic import atomic_path, check_writable, os_error_text, write_json_atomic
 from .._errors import GearshotError
 from .._validation import check_load, check_speed
+from ..fault_registry import FAULT_TYPE_NAMES
 from ..paper import (
     CYCLES_PER_SEGMENT,
     GEAR_TEETH,
@@ -231,7 +232,7 @@ def simulate(
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
                                 "--scheduler is given."),
     fault_type: list[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
-                                         "ftff, partial_face, breakage, destruction."),
+                                         f"{', '.join(FAULT_TYPE_NAMES)}."),
     machine: Path | None = typer.Option(None, "--machine", help="Machine description "
                                            "(TOML): simulate its monitored pair; --speed is "
                                            "then the tacho shaft's speed."),
