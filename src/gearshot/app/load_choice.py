@@ -171,17 +171,18 @@ def load_distances(database: str | Path, speed: float, healthy_sa: ArrayLike,
 
 def choose_load(database: str | Path, speed: float, healthy_sa: ArrayLike,
                 healthy_long: ArrayLike, *, mesh_order: int,
-                min_clarity: float = MIN_CLARITY) -> LoadChoice:
+                min_clarity: float | None = None) -> LoadChoice:
     """The database load whose simulated healthy signals best match the recordings.
 
     Parameters are those of :func:`load_distances`; ``min_clarity`` sets
-    :attr:`LoadChoice.ambiguous` (:data:`MIN_CLARITY` by default).
+    :attr:`LoadChoice.ambiguous` (default :data:`MIN_CLARITY`, read at the call).
 
     Returns
     -------
     LoadChoice
     """
-    min_clarity = check_positive(min_clarity, "min_clarity")
+    min_clarity = check_positive(MIN_CLARITY if min_clarity is None else min_clarity,
+                                 "min_clarity")
     loads, dist, grades = load_distances(database, speed, healthy_sa, healthy_long,
                                          mesh_order=mesh_order)
     order = np.argsort(dist, kind="stable")
