@@ -259,6 +259,7 @@ def _condition(database, machine, seg: _Segments, *, speed, load,
                  tolerance=speed_tolerance)
     choice, source = None, "given" if load is not None else "only"
     if several:
+        assert seg.long is not None  # at least one healthy recording was cut
         choice = choose_load(database, machine.sim_speed(cond_speed), np.vstack(seg.train),
                              seg.long, mesh_order=machine.monitored.teeth)
         if choice.ambiguous:
