@@ -31,6 +31,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_speed import fft_ref  # the reference FFT workload, beside this script
+
 ROOT = Path(__file__).resolve().parents[1]
 MACHINE = ROOT / "examples" / "machines" / "phm09_spur.toml"
 FILE = ROOT.parent / "shared" / "data" / "phm09" / "spur2_30hz_High_1.zip"
@@ -53,21 +55,6 @@ t1 = time.perf_counter()
 shaft_indicators(rec, m, shaft="idler", sensors=["acc_input"])
 print(t1 - t, time.perf_counter() - t1)
 """
-
-
-def fft_ref() -> tuple[float, float]:
-    """(wall, CPU) seconds of the fixed FFT workload, best of 3 (as bench_speed.py)."""
-    import numpy as np
-
-    x = np.random.default_rng(0).standard_normal((64, 8192))
-    best_w = best_c = float("inf")
-    for _ in range(3):
-        t0, c0 = time.perf_counter(), time.process_time()
-        for _ in range(10):
-            np.fft.rfft(x, axis=-1)
-        best_w = min(best_w, time.perf_counter() - t0)
-        best_c = min(best_c, time.process_time() - c0)
-    return best_w, best_c
 
 
 def parse_time(path: Path, repeats: int) -> float:

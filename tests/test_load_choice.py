@@ -6,11 +6,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from test_cli_journey import crop  # cropped copies of the shared PHM09 records
 
 from gearshot import GearshotError, Machine
 from gearshot.app import load_choice
@@ -19,7 +19,6 @@ from gearshot.sim import GearPair, build_database, load_database
 
 ROOT = Path(__file__).resolve().parents[1]
 SPUR = ROOT / "examples" / "machines" / "phm09_spur.toml"
-PHM = ROOT.parent / "shared" / "data" / "phm09"
 LOADS = (5.0, 320.0)
 
 
@@ -89,19 +88,6 @@ def test_clarity_and_ambiguity():
 
 
 # ---------------------------------------------------------------- predict --machine
-def _crop(name: str, folder: Path, rows: int = 100_000) -> Path:
-    src = PHM / name
-    if not src.is_file():
-        pytest.skip(f"{src} is absent; real-data checks need ../shared/data/phm09")
-    with zipfile.ZipFile(src) as zf:
-        member = zf.namelist()[0]
-        lines = zf.read(member).splitlines(keepends=True)[:rows]
-    out = folder / name
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(member, b"".join(lines))
-    return out
-
-
 @pytest.fixture(scope="module")
 def phm(tmp_path_factory):
     """Cropped PHM09 30 Hz High records and a machine database over two loads."""
@@ -109,7 +95,7 @@ def phm(tmp_path_factory):
     machine = Machine.from_toml(SPUR)
     store = build_database(folder / "db", machine.gear_pair(), speeds=[machine.sim_speed(30)],
                            loads=[5, 80], grades=[6, 7], n_healthy=6, n_faulty=24)
-    files = {n: _crop(f"{n}_30hz_High_1.zip", folder) for n in ("spur1", "spur2", "spur3")}
+    files = {n: crop(f"{n}_30hz_High_1.zip", folder) for n in ("spur1", "spur2", "spur3")}
     return machine, store, files
 
 
