@@ -28,7 +28,6 @@ _PENDING: frozenset[str] = frozenset(
     {
         "app/cli.py",
         "app/demo.py",
-        "app/predict_machine.py",
         "estimator/_model.py",
         "estimator/steps.py",
         "experiments/family.py",

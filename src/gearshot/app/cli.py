@@ -647,9 +647,9 @@ def predict(
                                           "healthy recordings' tacho); without: the "
                                           "database's speed in rps (required)."),
     load: float | None = typer.Option(None, "--load", help="Database load, N m (default: "
-                                         "the database's only load; an unquantified load: "
-                                         "build the database at one load and leave this "
-                                         "out)."),
+                                         "the database's only load; with --machine and a "
+                                         "database over several loads, the one the healthy "
+                                         "recordings pick, refused when ambiguous)."),
     out: Path = typer.Option(Path("predictions.csv"), "--out", help="Output table, CSV "
                              "or (by suffix .json) JSON; one row per SA segment with its "
                              "role, estimate and interval."),
@@ -702,7 +702,7 @@ def predict(
                                      holdout=holdout, coverage=coverage, seed=seed,
                                      speed_tolerance=speed_tolerance)
         where = (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, load "
-                 f"{frame.attrs['load']:g} N m")
+                 f"{frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}")
     else:
         from .predict import predict_from_files
 
