@@ -22,7 +22,6 @@ _EXCUSED: set[tuple[str, str]] = {
     ("gearshot.sim._block_read", "gearshot.sim.database"),  # database <-> _block_read
     ("gearshot.sim.faults", "gearshot.sim._ftff_batch"),  # faults <-> _ftff_batch
     ("gearshot.sim._ftff_batch", "gearshot.sim.stiffness"),  # stiffness <-> _ftff_batch
-    ("gearshot.app.figures", "gearshot.app.report"),  # report <-> figures
 }
 
 

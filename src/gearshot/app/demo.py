@@ -146,7 +146,7 @@ def _print_tables(console, stats, first, full_pred, draws):
 
 def _write_outputs(out, summary, figures, results, full_pred):
     """results.json, ablations.csv, predictions.csv and report.md; returns the report."""
-    from .report import write_report
+    from .markdown import write_report
 
     write_json_atomic(summary, out / "results.json", indent=2, sort_keys=False)
     with atomic_path(out / "ablations.csv") as tmp:

@@ -120,10 +120,10 @@ def experiment_rig(
     n_faulty: NFaulty = 700,
     json_out: ResultsJson = None,
     out: FiguresOut = None,
-    scheduler: Scheduler = None,
-    workers: Workers = 2,
     param: list[str] = typer.Option([], "--param", help=HELP_PARAM),
     paired: bool = typer.Option(True, "--paired/--no-paired", help=HELP_RIG_PAIRED),
+    scheduler: Scheduler = None,
+    workers: Workers = 2,
 ) -> None:
     """Sec. 4.2: virtual-rig recordings; the five variants of Fig. 14."""
     from ..campaigns import check_rig_grade
