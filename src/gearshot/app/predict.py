@@ -181,7 +181,7 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
                                      holdout=holdout, coverage=coverage, seed=seed,
                                      speed_tolerance=speed_tolerance)
         return frame, (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, "
-                       f"load {frame.attrs['load']:g} N m")
+                       f"load {frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}")
     if speed is None:
         raise GearshotError("--speed is required without --machine (the database's "
                             "speed, rps)")
