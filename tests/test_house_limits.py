@@ -29,8 +29,6 @@ _PENDING: frozenset[str] = frozenset(
         "app/predict_machine.py",
         "estimator/_model.py",
         "estimator/steps.py",
-        "io/recording.py",
-        "machine.py",
         "signal/ridge.py",
         "signal/tracking.py",
         "sim/database.py",
