@@ -21,7 +21,6 @@ ROOT = Path(__file__).resolve().parents[1] / "src" / "gearshot"
 _EXCUSED: set[tuple[str, str]] = {
     ("gearshot.sim.faults", "gearshot.sim._ftff_batch"),  # faults <-> _ftff_batch
     ("gearshot.sim._ftff_batch", "gearshot.sim.stiffness"),  # stiffness <-> _ftff_batch
-    ("gearshot.app.figures", "gearshot.app.report"),  # report <-> figures
 }
 
 
