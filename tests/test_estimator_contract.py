@@ -328,8 +328,12 @@ def test_failed_refit_keeps_the_previous_model(data, tfs, fitted):
     assert_array_equal(est.predict(data[3]), before)
 
 
-def test_fault_type_names_follow_the_simulator():
-    from gearshot.estimator._model import FAULT_TYPE_NAMES
-    from gearshot.sim import FAULT_TYPES
+def test_fault_type_choices_are_the_registry():
+    """The estimator's fault_type choices are the one fault-type record's names."""
+    from gearshot.estimator import OneFaultShotEstimator, check_estimator_params
+    from gearshot.fault_registry import FAULT_TYPE_NAMES
 
-    assert FAULT_TYPE_NAMES == tuple(FAULT_TYPES)
+    for name in FAULT_TYPE_NAMES:
+        check_estimator_params(OneFaultShotEstimator(fault_type=name))
+    with pytest.raises(GearshotError, match="fault_type"):
+        check_estimator_params(OneFaultShotEstimator(fault_type="rust"))

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from sklearn.base import BaseEstimator, RegressorMixin
 
+from ..fault_registry import FAULT_TYPE_NAMES
 from ..features import PAPER_FEATURES, available_features
 from ._database import _database_by_grade, _database_twins, _has_twins, _select_fault_type
 from ._grade_choice import _GradeChoosing
@@ -65,9 +66,6 @@ __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
 FloatArray = NDArray[np.float64]
 
-#: Fault types a database may hold (:data:`gearshot.sim.FAULT_TYPES`; named here so that the
-#: estimator does not import the simulator).
-FAULT_TYPE_NAMES = ("ftff", "partial_face", "breakage", "destruction")
 
 
 # scikit-learn ships no type information: its classes are Any to mypy
