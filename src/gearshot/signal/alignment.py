@@ -267,7 +267,8 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch,
     delay-aligned reference that leaves the least energy, that reference's index and its
     delay in samples."""
     n, n_refs = sx.shape[-1], spec_r.shape[0]
-    cross = (sx[:, None, :] * np.conj(spec_r)[None]).reshape(-1, n)
+    m = n // 2 + 1  # the lag search reads the non-negative frequencies only
+    cross = (sx[:, None, :m] * np.conj(spec_r[:, :m])[None]).reshape(-1, m)
     steps = search.best(cross).reshape(-1, n_refs)  # delays, 1/upsample samples
     tau = steps / upsample  # delays, samples
     advance = _grid_shift_factors(n, steps, upsample)  # (c, n_refs, n)
