@@ -64,14 +64,14 @@ class _Parts:
 
     @cached_property
     def spectrum(self) -> ComplexArray:
-        return cast(ComplexArray, np.fft.rfft(self.sa, axis=-1))
+        return np.fft.rfft(self.sa, axis=-1)
 
     def _keep(self, orders: IntArray, *, invert: bool = False) -> FloatArray:
         mask = np.zeros(self.n // 2 + 1, dtype=bool)
         mask[orders] = True
         if invert:
             mask = ~mask
-        return cast(FloatArray, np.fft.irfft(self.spectrum * mask, n=self.n, axis=-1))
+        return np.fft.irfft(self.spectrum * mask, n=self.n, axis=-1)
 
     def _mesh(self, n_sidebands: int) -> IntArray:
         return mesh_band_orders(self.n, self.mesh_order, n_sidebands)
@@ -84,7 +84,7 @@ class _Parts:
 
     @cached_property
     def diff(self) -> FloatArray:
-        return cast(FloatArray, np.fft.irfft(self.diff_spectrum, n=self.n, axis=-1))
+        return np.fft.irfft(self.diff_spectrum, n=self.n, axis=-1)
 
     @cached_property
     def rms_diff(self) -> FloatArray:

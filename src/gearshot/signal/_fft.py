@@ -10,8 +10,6 @@ the smallest 5-smooth number (2^a 3^b 5^c) not below ``n``.
 
 from __future__ import annotations
 
-from typing import cast
-
 import numpy as np
 
 from .._typing import ComplexArray
@@ -54,17 +52,17 @@ def _real_to_full(half: ComplexArray, n: int) -> ComplexArray:
 def fft(x: np.ndarray, axis: int = -1) -> ComplexArray:
     """Discrete Fourier transform along ``axis`` (as :func:`scipy.fft.fft`, bit for bit)."""
     if np.iscomplexobj(x):
-        return cast(ComplexArray, np.fft.fft(x, axis=axis))
+        return np.fft.fft(x, axis=axis)
     x = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
     full = _real_to_full(np.fft.rfft(x, axis=-1), x.shape[-1])
-    return cast(ComplexArray, np.moveaxis(full, -1, axis))
+    return np.moveaxis(full, -1, axis)
 
 
 def ifft(x: np.ndarray, axis: int = -1) -> ComplexArray:
     """Inverse discrete Fourier transform along ``axis`` (as :func:`scipy.fft.ifft`)."""
     if np.iscomplexobj(x):
-        return cast(ComplexArray, np.fft.ifft(x, axis=axis))
+        return np.fft.ifft(x, axis=axis)
     x = np.moveaxis(np.asarray(x, dtype=np.float64), axis, -1)
     n = x.shape[-1]
     full = _real_to_full(np.conj(np.fft.rfft(x, axis=-1)) / n, n)
-    return cast(ComplexArray, np.moveaxis(full, -1, axis))
+    return np.moveaxis(full, -1, axis)

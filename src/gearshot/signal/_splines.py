@@ -36,7 +36,8 @@ _INV141 = _Z ** np.abs(np.arange(-_K, _K + 1)) / (2.0 * math.sqrt(3.0))
 def _solve141(r: FloatArray, mode: str) -> FloatArray:
     """``[1, 4, 1]``-inverse filter of ``r`` with its ends extended by ``mode``
     (``"reflect"``: mirror without repeating the end sample; ``"constant"``: zeros)."""
-    return np.convolve(np.pad(r, _K, mode=mode), _INV141, mode="valid")  # type: ignore[call-overload]
+    padded: FloatArray = np.pad(r, _K, mode=mode)  # type: ignore[call-overload]
+    return np.convolve(padded, _INV141, mode="valid")
 
 
 def _mirror(index: IntArray, n: int) -> IntArray:

@@ -77,7 +77,7 @@ def fractional_shift(x: ArrayLike, delay: ArrayLike) -> FloatArray:
                             f"shape {x.shape[:-1]} of x (shape {x.shape})")
     n = x.shape[-1]
     spectrum = _fft.fft(x, axis=-1) * _shift_factors(n, -tau)
-    return cast(FloatArray, _fft.ifft(spectrum, axis=-1).real)
+    return _fft.ifft(spectrum, axis=-1).real
 
 
 class _LagSearch:

@@ -124,7 +124,7 @@ def bandlimited_resynthesis(x: ArrayLike, fs: float, *, cutoff: float, passband:
         if n_out < n_fft:
             spec[..., -1] = spec[..., -1].real  # the new Nyquist bin of a real signal
     y = np.fft.irfft(spec, n=n_out, axis=-1) * (n_out / n_fft)
-    return cast(FloatArray, y), fs * n_out / n_fft, -pad / fs
+    return y, fs * n_out / n_fft, -pad / fs
 
 
 @finite_result
@@ -188,4 +188,4 @@ def antialias_filter(x: ArrayLike, fs: float, *, cutoff: float, passband: float 
     y = np.fft.irfft(spec, n=n_fft * up, axis=-1)
     if up > 1:
         y *= up
-    return cast(FloatArray, y[..., pad * up: (pad + n) * up])
+    return y[..., pad * up: (pad + n) * up]

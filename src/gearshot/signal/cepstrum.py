@@ -32,7 +32,7 @@ def real_cepstrum(magnitude: ArrayLike) -> FloatArray:
     [ 0.      0.25   -0.0625  0.0208]
     """
     checked = _checked_magnitude(magnitude)
-    return cast(FloatArray, _fft.ifft(np.log(checked), axis=-1).real)
+    return _fft.ifft(np.log(checked), axis=-1).real
 
 
 def _checked_magnitude(magnitude: ArrayLike) -> FloatArray:

@@ -203,7 +203,7 @@ def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int, keep_mesh: b
         mask[[0, *_shaft_orders(shaft_orders, n)]] = True
     spectrum = np.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
-    return cast(FloatArray, np.fft.irfft(spectrum, n=n, axis=-1))
+    return np.fft.irfft(spectrum, n=n, axis=-1)
 
 
 @finite_result
