@@ -24,7 +24,7 @@ def next_fast_len(n: int) -> int:
     --------
     >>> from gearshot.signal._fft import next_fast_len
     >>> [next_fast_len(n) for n in (1, 7, 97, 1001, 266656)]
-    [1, 8, 100, 1024, 268800]
+    [1, 8, 100, 1024, 270000]
     """
     best = 1 << max(0, (n - 1).bit_length())
     p5 = 1
