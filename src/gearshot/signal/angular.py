@@ -109,9 +109,10 @@ def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
     """Time at which the shaft reaches given angles, from its tacho pulses.
 
     The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
-    revolutions from the first) is a cubic spline, so speed varies smoothly rather than
-    piecewise-constantly; where a spline would not be monotone (extreme speed jumps) a
-    monotone PCHIP is used instead.
+    revolutions from the first) is a cubic spline (not-a-knot ends, as
+    :class:`scipy.interpolate.CubicSpline`, computed in NumPy), so speed varies smoothly
+    rather than piecewise-constantly; where a spline would not be monotone (extreme speed
+    jumps) or with fewer than 4 pulses a monotone PCHIP is used instead.
 
     Parameters
     ----------
