@@ -1,4 +1,5 @@
-"""SAs of the shared PHM09 records (every shaft, acc_input) and of virtual-rig recordings,
+"""SAs of the shared PHM09 records (every shaft, acc_input; two without the tacho) and of
+virtual-rig recordings,
 saved as arrays, so two runs (before/after a numerical change) can be compared by their
 largest relative difference (``--compare A.npz B.npz``).
 
@@ -37,6 +38,14 @@ def phm09(out: dict[str, np.ndarray]) -> None:
                                                                  cycles_per_segment=None)
             out[f"{path.stem}/{shaft}/seg"] = rec.to_sa_segments(
                 shaft=shaft, cycles_per_segment=10, samples_per_cycle=512)
+
+
+def notacho(out: dict[str, np.ndarray]) -> None:
+    for name, kind in (("spur2_30hz_High_1.zip", "spur"), ("helical2_40hz_Low_1.zip", "helical")):
+        m = Machine.from_toml(MACHINES / f"phm09_{kind}_notacho.toml")
+        rec = Recording.read(DATA / name, machine=m)
+        out[f"{name}/notacho"] = rec.to_sa_segments(shaft=m.monitored.shaft,
+                                                    cycles_per_segment=None)
 
 
 def rig(out: dict[str, np.ndarray], folder: Path) -> None:
@@ -80,6 +89,7 @@ def main() -> None:
         return
     out: dict[str, np.ndarray] = {}
     phm09(out)
+    notacho(out)
     rig(out, Path(args.rig_dir))
     np.savez(args.out, **out)
     print(f"{len(out)} arrays written to {args.out}")
