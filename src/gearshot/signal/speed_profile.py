@@ -38,6 +38,7 @@ __all__ = ["SpeedProfile", "fit_speed_profile"]
 _FLOOR_DB = 10.0  # a comb line scores only above this level over the local floor
 _CAP_DB = 30.0  # one line counts at most this much
 _LINE_DB = 15.0  # a line "stands out" in the whole-record order spectrum (noise: < 14)
+_SHAFT_WEIGHT = 0.5  # a whole order that is no mesh line counts half (f / j fits any line)
 _KEEP = 6  # rate candidates carried from one stage to the next
 _PEAKS = 16  # mesh-comb peaks rescored with every whole order
 _MEDIAN_BINS = 129  # local floor: running median over this many spectrum bins
@@ -57,7 +58,8 @@ class SpeedProfile:
         Every comb line (order, level in dB over the local floor of the whole-record order
         spectrum), strongest first.
     n_lines : int
-        Lines at least 15 dB over the floor (white noise: none in 20 trials).
+        Whole orders of the shaft up to the top mesh line (mesh lines, the shafts'
+        harmonics and sidebands) at least 15 dB over the floor; 0 where no mesh line is.
     """
 
     mid: float
@@ -117,8 +119,10 @@ def _levels(power: np.ndarray) -> np.ndarray:
 def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
           top_hz: float) -> np.ndarray:
     """Comb score of every candidate speed: the levels above the floor summed over the
-    mesh ``lines`` and every whole order below ``top_hz`` (Hz, the same for every
-    candidate, so that twice the speed, which meets only the even orders, loses)."""
+    mesh ``lines`` and, at half weight, every other whole order below ``top_hz`` (Hz, the
+    same for every candidate, so that twice the speed, which meets only the even orders,
+    loses; half weight, since some whole order ``j`` meets any line at the speed
+    ``f / j``)."""
     gain = np.clip(level - _FLOOR_DB, 0.0, _CAP_DB).astype(np.float32)
     gain = np.maximum(gain[:-1], gain[1:])  # the line between two bins: the larger
     orders = np.arange(1.0, max(float(lines.max()), top_hz / float(speeds.min())) + 1.0)
@@ -131,7 +135,8 @@ def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
                             .astype(np.int32), gain.size - 1)]
         shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
         kept = shaft[np.arange(chunk.size), np.maximum(n_kept[chunk] - 1, 0)]
-        score[chunk] = g[:, mesh].sum(axis=1) + np.where(n_kept[chunk] > 0, kept, 0.0)
+        score[chunk] = g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept[chunk] > 0,
+                                                                          kept, 0.0)
     return score
 
 
@@ -180,13 +185,14 @@ def _search(y: np.ndarray, fs: float, lines: np.ndarray, lo: float, hi: float,
 
 
 def _line_levels(y: np.ndarray, fs: float, coef: tuple[float, float, float],
-                 lines: np.ndarray) -> np.ndarray:
+                 orders: np.ndarray) -> np.ndarray:
+    """Level (dB over the local floor) of every order in the whole record's order
+    spectrum along the profile ``coef``."""
     u = np.arange(y.size) / fs - 0.5 * (y.size - 1) / fs
     c = coef[0]
     power, df = _spectrum(y, 1.0 / fs, u, (coef[1] / c, coef[2] / c))
     level = _levels(power)
-    pos = lines * c / df
-    i0 = np.clip(np.rint(pos).astype(np.int64), 1, level.size - 2)
+    i0 = np.clip(np.rint(orders * c / df).astype(np.int64), 1, level.size - 2)
     return np.asarray(np.max(np.stack([level[i0 + d] for d in (-1, 0, 1)]), axis=0))
 
 
@@ -257,8 +263,9 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     >>> x = np.cos(2 * np.pi * 17 * revs) + np.cos(2 * np.pi * 34 * revs)
     >>> x += 2.0 * rng.standard_normal(t.size)
     >>> p = fit_speed_profile(x, fs, orders=[17], speed_range=(10, 19))
-    >>> print(np.round(p.coef, 3), p.n_lines)
-    [14.  1.  0.] 2
+    >>> c, a, q = p.coef
+    >>> print(f"{c:.2f} rev/s at mid-record, {a:.2f} rev/s per s;", p.n_lines, "lines")
+    14.00 rev/s at mid-record, 1.00 rev/s per s; 2 lines
     """
     x = as_signal_array(x, "x", max_ndim=1, min_length=64)
     fs = check_positive(fs, "fs")
@@ -278,14 +285,19 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     top_hz = float(lines.max()) * (hi + max_rate * duration / 2)
     y, fs_d = _decimated(x, fs, top_hz)
     c, a = _search(y, fs_d, lines, lo, hi, max_rate)
+    level = _line_levels(y, fs_d, (c, a, 0.0), lines)
+    strong = lines[np.argsort(-level)[:3]]
     coef = (c, a, 0.0)
+    for frac in (0.25, 0.5, 1.0):  # continuation: a curvature is local on a short span
+        m0 = int(0.5 * (1.0 - frac) * y.size)
+        coef = _refine(y[m0: y.size - m0], fs_d, coef, strong)
     level = _line_levels(y, fs_d, coef, lines)
-    strong = lines[np.argsort(-level)[:3]]  # the three strongest lines
-    if strong.size:
-        coef = _refine(y, fs_d, coef, strong)
-        level = _line_levels(y, fs_d, coef, lines)
+    whole = np.arange(1.0, float(lines.max()) + 1.0)
+    n_lines = int(np.sum(_line_levels(y, fs_d, coef, whole) >= _LINE_DB))
+    if level.max() < _LINE_DB:
+        n_lines = 0  # the whole orders alone: no mesh line stands out
     rank = np.argsort(-level)
     mid = 0.5 * (y.size - 1) / fs_d
     return SpeedProfile(mid=mid, coef=coef,
                         lines=tuple((int(lines[i]), float(level[i])) for i in rank),
-                        n_lines=int(np.sum(level >= _LINE_DB)))
+                        n_lines=n_lines)
