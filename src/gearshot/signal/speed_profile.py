@@ -39,6 +39,8 @@ _FLOOR_DB = 10.0  # a comb line scores only above this level over the local floo
 _CAP_DB = 30.0  # one line counts at most this much
 _LINE_DB = 15.0  # a line "stands out" in the whole-record order spectrum (noise: < 14)
 _SHAFT_WEIGHT = 0.5  # a whole order that is no mesh line counts half (f / j fits any line)
+_RATIOS = (1 / 2, 2 / 3, 3 / 2, 2)  # speed ratios a comb of whole orders cannot tell
+_RATES = 160  # rates searched on the first span at most
 _KEEP = 6  # rate candidates carried from one stage to the next
 _PEAKS = 16  # mesh-comb peaks rescored with every whole order
 _MEDIAN_BINS = 129  # local floor: running median over this many spectrum bins
@@ -66,6 +68,19 @@ class SpeedProfile:
     coef: tuple[float, float, float]
     lines: tuple[tuple[int, float], ...]
     n_lines: int
+
+    def ambiguous(self, speed_range: tuple[float, float], duration: float) -> float | None:
+        """A ratio ``r`` (1/2, 2/3, 3/2, 2) for which ``r`` times this profile over the
+        record (0 to ``duration`` s) also lies inside ``speed_range``, else None: there
+        the whole orders of a multi-shaft train (other shafts' harmonics at fractional
+        orders) may fit ``r`` times the true speed as well, and the fit cannot tell."""
+        t = np.linspace(0.0, duration, 65)
+        s = self.speed(t)
+        lo, hi = speed_range
+        for r in _RATIOS:
+            if lo <= r * float(s.min()) and r * float(s.max()) <= hi:
+                return float(r)
+        return None
 
     def speed(self, t: np.ndarray) -> np.ndarray:
         """Shaft speed at times ``t`` (s from the first sample), rev/s."""
@@ -167,19 +182,22 @@ def _search(y: np.ndarray, fs: float, lines: np.ndarray, lo: float, hi: float,
     t = np.arange(n) / fs
     mid = 0.5 * t[-1]
     top = float(lines.max())
-    rates = np.zeros(1)
     best: list[tuple[float, float, float]] = []
+    prev = 0.0
     for frac in (0.25, 0.5, 1.0):
         half = 0.5 * frac * t[-1]
         sel = np.abs(t - mid) <= half
         step = 0.5 / (top * half * half)
-        if not best:
+        if not best:  # at most _RATES rates on the first span (the later ones refine)
+            step = max(step, 2.0 * max_rate / _RATES)
             rates = np.arange(-max_rate, max_rate + 0.5 * step, step)
         else:
-            rates = np.unique(np.concatenate([a + step * np.arange(-4, 5)
+            k = max(1, int(math.ceil(prev / step)))
+            rates = np.unique(np.concatenate([a + step * np.arange(-k, k + 1)
                                               for _, _, a in best]))
         found = _stage(y[sel], 1.0 / fs, t[sel] - mid, lines, lo, hi, rates)
         best = sorted(found, reverse=True)[:_KEEP]
+        prev = step
     c = best[0][1]
     return c, best[0][2] * c / (0.5 * (lo + hi))  # the grid's rate is for the shape a / c_mid
 
@@ -243,7 +261,7 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
         Harmonics of every order in the comb (those below 0.4 ``fs``).
     max_rate : float, optional
         Largest speed change searched, rev/s per second. Default: the rate that takes the
-        speed across the whole range in half the record.
+        speed across the whole range in the record.
 
     Returns
     -------
@@ -274,7 +292,7 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     n_harmonics = check_int(n_harmonics, "n_harmonics", minimum=1, maximum=100)
     duration = x.size / fs
     if max_rate is None:
-        max_rate = 2.0 * (hi - lo) / duration
+        max_rate = (hi - lo) / duration
     max_rate = check_positive(max_rate, "max_rate")
     lines = np.array(sorted({h * o for o in order_list for h in range(1, n_harmonics + 1)
                              if h * o * hi * (1.0 + max_rate * duration / (2 * lo))
@@ -287,10 +305,12 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     c, a = _search(y, fs_d, lines, lo, hi, max_rate)
     level = _line_levels(y, fs_d, (c, a, 0.0), lines)
     strong = lines[np.argsort(-level)[:3]]
-    coef = (c, a, 0.0)
+    chain = (c, a, 0.0)
     for frac in (0.25, 0.5, 1.0):  # continuation: a curvature is local on a short span
         m0 = int(0.5 * (1.0 - frac) * y.size)
-        coef = _refine(y[m0: y.size - m0], fs_d, coef, strong)
+        chain = _refine(y[m0: y.size - m0], fs_d, chain, strong)
+    direct = _refine(y, fs_d, (c, a, 0.0), strong)  # a short span may mislead the chain
+    coef = max((direct, chain), key=lambda k: float(_line_levels(y, fs_d, k, strong).sum()))
     level = _line_levels(y, fs_d, coef, lines)
     whole = np.arange(1.0, float(lines.max()) + 1.0)
     n_lines = int(np.sum(_line_levels(y, fs_d, coef, whole) >= _LINE_DB))

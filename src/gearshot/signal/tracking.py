@@ -55,7 +55,7 @@ import numpy as np
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
-from .ridge import SpeedRidge, speed_ridge
+from .ridge import SpeedRidge, _speed_range, speed_ridge
 from .speed_profile import SpeedProfile, fit_speed_profile
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
@@ -141,7 +141,9 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     refused, a speed profile fitted to the whole record
     (:func:`gearshot.signal.speed_profile.fit_speed_profile`) is tried before refusing:
     it is taken when at least ``min_lines`` whole orders of the shaft (mesh lines
-    included) stand 15 dB over the floor of the record's order spectrum; the phase step
+    included) stand 15 dB over the floor of the record's order spectrum and no speed
+    ratio 1/2, 2/3, 3/2 or 2 of the profile also lies in ``speed_range`` (the whole
+    orders of a multi-shaft train may fit such a ratio as well); the phase step
     then runs around it, and the profile's own angle is kept where that phase wanders
     more than ``max_wander`` or its SNR is below ``min_snr_db``.
 
@@ -229,7 +231,8 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
         return _shaft_angle(result, ppr)
     profile = fit_speed_profile(x, fs, orders=orders, speed_range=speed_range,
                                 max_rate=max_rate)
-    if profile.n_lines >= max(min_lines, 1):
+    ratio = profile.ambiguous(_speed_range(speed_range), x.size / fs)
+    if profile.n_lines >= max(min_lines, 1) and ratio is None:
         fine = _profile_pass(x, fs, profile, bandwidth, track)
         if not (_db(fine.snr) >= min_snr_db and fine.wander <= max_wander):
             fine = fine._replace(angle=profile.angle(fine.times),
@@ -244,8 +247,8 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
         f"{ridge.n_lines} of {ridge.n_comb} comb lines stand out (min_lines={min_lines}); "
         f"over the whole record the best speed profile's strongest mesh line is "
         f"{profile.lines[0][1]:.1f} dB over the floor ({profile.n_lines} whole orders at "
-        f"15 dB or more); the speed cannot be estimated from the vibration (give a tacho, "
-        f"another sensor or a narrower speed range)")
+        f"15 dB or more{_ambiguity(ratio, profile)}); the speed cannot be estimated from "
+        f"the vibration (give a tacho, another sensor or a narrower speed range)")
 
 
 class _Pass(NamedTuple):
@@ -258,6 +261,13 @@ class _Pass(NamedTuple):
     speed: np.ndarray
     wander: float
     band: float
+
+
+def _ambiguity(ratio: float | None, profile: SpeedProfile) -> str:
+    if ratio is None:
+        return ""
+    return (f", at {profile.coef[0]:.4g} rev/s mid-record, but {ratio:.3g} times that is "
+            f"in the speed range too")
 
 
 def _db(snr: float) -> float:
