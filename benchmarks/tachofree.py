@@ -220,8 +220,6 @@ def runup_row(label, acc, tacho, fs, *, orders, speed_range, revs_per_cycle, tru
     b = sa_from_pulses(acc, fs, est.pulse_times, ppr=est.pulses_per_rev,
                        revs_per_cycle=revs_per_cycle)
     row["sa_err_vs_tacho"] = aligned_rms_diff(a, b)
-    row["mean_speed_err_pct"] = 100 * (est.mean_speed / float(np.polyfit(
-        pulses - est.times.mean(), np.arange(pulses.size), 1)[0]) - 1)
     return row
 
 
