@@ -28,8 +28,6 @@ _PENDING: frozenset[str] = frozenset(
     {
         "estimator/_model.py",
         "estimator/steps.py",
-        "signal/ridge.py",
-        "signal/tracking.py",
         "sim/dynamics.py",
     }
 )

@@ -250,9 +250,9 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     Parameters
     ----------
     x : array_like, shape (n,)
-        Vibration sampled at ``fs``.
+        One sensor's vibration.
     fs : float
-        Sampling rate, Hz.
+        Its sampling rate, Hz.
     orders : int or sequence of int
         Mesh orders synchronous with the shaft (its own gear first).
     speed_range : (float, float)
