@@ -22,6 +22,15 @@ import math
 import numba as nb
 import numpy as np
 
+from ._compliance import (
+    _N_SEGMENT,
+    _contact_frame,
+    _fillet_compliance,
+    _hertz_stiffness,
+    _materials,
+    _segments,
+    _simpson_nodes,
+)
 from .geometry import GearPair, contact_angles, involute_half_angle
 
 __all__ = ["bridge_batch", "ftff_gear_compliance"]
@@ -170,7 +179,6 @@ def ftff_gear_compliance(pair: GearPair, roll, arcs):
     point with its fault's cut ``arcs`` (n_points, 5): xa, xb, cx, ch, radius of
     :meth:`FullToothFaceFault._arc`. As ``_tooth_compliance(pair, z_gear, roll,
     fault.section_loss)``."""
-    from .stiffness import _contact_frame, _fillet_compliance, _materials, _simpson_nodes
 
     z = pair.z_gear
     E, G, L = _materials(pair)
@@ -251,7 +259,7 @@ def ftff_tables(pair: GearPair, faults):
     """Tables over the spur contact position u (``_N_TABLE`` points) of non-healthy
     FTFFs: pair stiffness k (N/m) and displacement excitation e_f (m), arrays (n, n_u);
     as ``_pair_table(pair, fault)`` and ``fault.displacement(pair, 1 - u)``."""
-    from .stiffness import _N_SEGMENT, _N_TABLE, _healthy_compliances
+    from .stiffness import _N_TABLE, _healthy_compliances
 
     n = len(faults)
     s0s, s1s, arcs_all = _arcs(pair, faults)
@@ -272,14 +280,7 @@ def ftff_tables(pair: GearPair, faults):
         s0, s1 = s0s[i], s1s[i]
         edges = np.unique(np.clip(np.concatenate([[s0, 1.0], [s0, sw, s1]]), s0, 1.0))
         k_hi, k_lo = kn > sw, kn <= sw
-        for a, b in zip(edges[:-1], edges[1:]):
-            if b - a <= 0:
-                continue
-            sel = (s >= a) & (s <= b) if b == 1.0 else (s >= a) & (s < b)
-            if not sel.any():
-                continue
-            eta = 1e-9 * (b - a)
-            kts = np.linspace(a + eta, b - eta, _N_SEGMENT)
+        for sel, kts in _segments(s, edges):
             cr = kts.copy()                               # FullToothFaceFault.contact_roll
             hi = (kts > sw) & (kts < s1)
             lo = (kts > s0) & (kts <= sw)
@@ -294,7 +295,7 @@ def ftff_tables(pair: GearPair, faults):
     inv = np.tile(inv_g, (n, 1))
     for m, (i, sel, kts) in enumerate(segs):
         inv[i, sel] = np.interp(s[sel], kts, vals[m * _N_SEGMENT:(m + 1) * _N_SEGMENT])
-    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+    k_h = _hertz_stiffness(pair)
     k = 1.0 / (1.0 / k_h + inv_p + inv)
     ef = np.zeros((n, _N_TABLE))
     for i, f in enumerate(faults):                        # FullToothFaceFault.displacement

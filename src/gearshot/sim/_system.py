@@ -37,7 +37,7 @@ from ._kernel import (
 )
 from .faults import ToothFault
 from .geometry import GearPair
-from .profile_errors import ToothProfileErrors
+from .profile_errors import ToothProfileErrors, wave_amplitudes
 from .stiffness import _N_TABLE, _pair_table, fault_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
@@ -186,9 +186,9 @@ def prefetch_ftff(pair: GearPair, faults) -> None:
 def _stack_errors(errs: list[ToothProfileErrors]):
     """Slope, the waviness as sine/cosine amplitudes (half the waviness times cos/sin of
     each tooth's phase) and noise knots of every signal; the waves per profile."""
-    half = 0.5 * np.stack([e.waviness for e in errs])
-    phase = np.stack([e.phase for e in errs])
-    return ((np.stack([e.slope for e in errs]), half * np.cos(phase), half * np.sin(phase),
+    wa, wb = wave_amplitudes(np.stack([e.waviness for e in errs]),
+                             np.stack([e.phase for e in errs]))
+    return ((np.stack([e.slope for e in errs]), wa, wb,
              np.ascontiguousarray(np.stack([e.noise for e in errs]))),
             float(errs[0].n_waves))
 
