@@ -38,7 +38,7 @@ from ._kernel import (
 from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors, wave_amplitudes
-from .stiffness import _N_TABLE, _pair_table, fault_tables
+from .stiffness import _N_TABLE, _pair_table, face_bands, fault_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
            "make_batch", "warmup_time"]
@@ -178,7 +178,7 @@ def prefetch_ftff(pair: GearPair, faults) -> None:
     """Compute the tables of every FTFF among ``faults`` (and their face bands) in one
     batch (:func:`._ftff_batch.ftff_cached`)."""
     todo = [band for f in faults if f is not None and not f.is_healthy
-            for _, _, band in f.face_bands(pair) if is_ftff(band)]
+            for _, _, band in face_bands(pair, f) if is_ftff(band)]
     if todo:
         ftff_cached(pair, todo)
 

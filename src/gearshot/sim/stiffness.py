@@ -96,11 +96,20 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 def _whole_face(fault: ToothFault, pair: GearPair) -> bool:
     """True when ``fault`` is its own transverse fault over the whole face width."""
-    bands = fault.face_bands(pair)
+    bands = face_bands(pair, fault)
     return len(bands) == 1 and bands[0][0] == 0.0 and bands[0][1] == 1.0 and bands[0][2] is fault
 
 
 _N_TABLE = 1025
+_U_TABLE = np.linspace(0.0, 1.0, _N_TABLE)      # the tables' contact positions u
+_U_TABLE.setflags(write=False)
+
+
+@functools.lru_cache(maxsize=256)
+def face_bands(pair: GearPair, fault: ToothFault) -> tuple:
+    """``fault.face_bands(pair)``, computed once per (pair, fault) (a batch asks twice:
+    for its FTFF bands and for its tables)."""
+    return fault.face_bands(pair)
 
 
 @functools.lru_cache(maxsize=32)
@@ -117,12 +126,13 @@ def _faulty_gear_compliance(pair: GearPair, fault: ToothFault) -> np.ndarray:
     """Gear-tooth compliance over the u table for a faulty tooth: exact on a few points
     of each smooth segment (between the fault's breakpoints) and interpolated, healthy
     outside the affected range."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    s = 1.0 - u
     _, inv_g = _healthy_compliances(pair)
+    s_min, breaks = fault.affected_range(pair)
+    if s_min >= 1.0 and len(breaks) == 0:       # a surface or tip fault: section unchanged
+        return inv_g.copy()
+    s = 1.0 - _U_TABLE
     out = inv_g.copy()
     (_, _), (g_lo, g_hi) = pair.roll_limits
-    s_min, breaks = fault.affected_range(pair)
     edges = np.unique(np.clip(np.concatenate([[s_min, 1.0], breaks]), s_min, 1.0))
     sec = functools.partial(fault.section_loss, pair)
     for sel, knots in _segments(s, edges):
@@ -142,7 +152,7 @@ def _pair_table(pair: GearPair, fault: ToothFault | None) -> np.ndarray:
     k_h = _hertz_stiffness(pair)
     tab = 1.0 / (1.0 / k_h + inv_p + inv_g)
     if fault is not None and not fault.is_healthy and fault.scales_contact:
-        tab = tab * fault.stiffness_scale(pair, 1.0 - np.linspace(0.0, 1.0, _N_TABLE))
+        tab = tab * fault.stiffness_scale(pair, 1.0 - _U_TABLE)
     tab.setflags(write=False)
     return tab
 
@@ -152,9 +162,9 @@ def _band_tables(pair: GearPair, fault: ToothFault):
     """The fault's face bands as ``((z0, z1, k, d), ...)``: face fractions, the band's
     transverse pair stiffness (N/m, full-width scale) and displacement excitation (m)
     over the spur contact position u."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
+    u = _U_TABLE
     out = []
-    for z0, z1, f in fault.face_bands(pair):
+    for z0, z1, f in face_bands(pair, fault):
         if z1 <= z0 or f is None or f.is_healthy:
             continue
         if is_ftff(f):
