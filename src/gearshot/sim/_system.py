@@ -193,7 +193,8 @@ def _stack_errors(errs: list[ToothProfileErrors]):
             float(errs[0].n_waves))
 
 
-LANES = 8      # signals integrated side by side by one thread (_kernel._modal_step)
+LANES = 32     # signals integrated side by side by one thread (_kernel._modal_step); 8 -> 32
+#                halves the kernel time per SA (benchmarks/RESULTS.md, session 7)
 
 
 def _lanes(n: int) -> tuple[int, int]:
