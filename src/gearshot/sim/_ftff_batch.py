@@ -110,7 +110,7 @@ def _retreat(pair: GearPair, u, r, ang):
                     pair.center_distance, rb1, ra1)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot.
 
@@ -130,29 +130,32 @@ def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     # the pinion flank's ends count (rounding of the rotated points must not drop the
     # point at the pinion tip, where the contact at u = 1 lies)
     lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
-    for f in range(n):
-        for m in range(n_u):
-            best = np.inf
-            kb = 0
-            cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
-            for k in range(n_pts):
-                cth = cm * ca[f, k] - sm * sa[f, k]
-                sth = sm * ca[f, k] + cm * sa[f, k]
-                px = o2x + r[f, k] * cth
-                py = r[f, k] * sth
-                rp = math.hypot(px, py)
-                if rp < lo_r or rp > hi_r:
-                    continue
-                c = rb1 / rp
-                s = math.sqrt(max(1.0 - c * c, 0.0))
-                theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
-                gap = rb1 * (theta - pp)
-                gap = (gap + half) % circ - half
-                if gap < best:
-                    best = gap
-                    kb = k
-            ret[f, m] = max(best, 0.0)
-            rad[f, m] = r[f, kb]
+    for fm in nb.prange(n * n_u):          # every knot of every fault on its own
+        f, m = fm // n_u, fm % n_u
+        best = np.inf
+        kb = 0
+        cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
+        for k in range(n_pts):
+            cth = cm * ca[f, k] - sm * sa[f, k]
+            sth = sm * ca[f, k] + cm * sa[f, k]
+            px = o2x + r[f, k] * cth
+            py = r[f, k] * sth
+            rp = math.hypot(px, py)
+            if rp < lo_r or rp > hi_r:
+                continue
+            c = rb1 / rp
+            s = math.sqrt(max(1.0 - c * c, 0.0))
+            theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
+            gap = rb1 * (theta - pp)
+            t = gap + half                   # (gap + half) % circ - half, the modulo
+            if t < 0.0 or t >= circ:         # only where it changes t
+                t = t % circ
+            gap = t - half
+            if gap < best:
+                best = gap
+                kb = k
+        ret[f, m] = max(best, 0.0)
+        rad[f, m] = r[f, kb]
     return ret, rad
 
 
@@ -207,7 +210,7 @@ def _interp_walk(x, xp, fp, j):
     return slope * (x - xp[j]) + fp[j], j
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab,
                E, G, L):
     """Bending + shear + axial compliance: the Simpson sums of ``_tooth_compliance``
@@ -215,7 +218,7 @@ def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs
     n = xc.shape[0]
     out = np.empty(n)
     n_nodes = xi.shape[0]
-    for p in range(n):
+    for p in nb.prange(n):
         xa, xe, cx, ch, rad = arcs[p, 0], arcs[p, 1], arcs[p, 2], arcs[p, 3], arcs[p, 4]
         span = xc[p] - x0
         cbp, sbp = cb[p], sb[p]
