@@ -28,7 +28,6 @@ from ._compliance import (
     _fillet_compliance,
     _hertz_stiffness,
     _materials,
-    _segments,
     _simpson_nodes,
 )
 from .geometry import GearPair, contact_angles, involute_half_angle
@@ -262,7 +261,7 @@ def ftff_tables(pair: GearPair, faults):
     """Tables over the spur contact position u (``_N_TABLE`` points) of non-healthy
     FTFFs: pair stiffness k (N/m) and displacement excitation e_f (m), arrays (n, n_u);
     as ``_pair_table(pair, fault)`` and ``fault.displacement(pair, 1 - u)``."""
-    from .stiffness import _N_TABLE, _healthy_compliances
+    from .stiffness import _U_TABLE, _healthy_compliances
 
     n = len(faults)
     s0s, s1s, arcs_all = _arcs(pair, faults)
@@ -271,42 +270,111 @@ def ftff_tables(pair: GearPair, faults):
                            arcs_all[i:i + _RETREAT_CHUNK]))
              for i in range(0, n, _RETREAT_CHUNK)]
     knots, ret, contact = (np.concatenate([p[m] for p in parts]) for m in range(3))
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    s = 1.0 - u
+    s = 1.0 - _U_TABLE
     inv_p, inv_g = _healthy_compliances(pair)
     _, (g_lo, g_hi) = pair.roll_limits
-    rolls, arcs, segs = [], [], []
-    for i in range(n):
-        kn, ct = knots[i], contact[i]
-        j = int(np.argmax(np.abs(np.diff(ct))))          # FullToothFaceFault._switch
-        sw = 0.5 * (kn[j] + kn[j + 1])
-        s0, s1 = s0s[i], s1s[i]
-        edges = np.unique(np.clip(np.concatenate([[s0, 1.0], [s0, sw, s1]]), s0, 1.0))
-        k_hi, k_lo = kn > sw, kn <= sw
-        for sel, kts in _segments(s, edges):
-            cr = kts.copy()                               # FullToothFaceFault.contact_roll
-            hi = (kts > sw) & (kts < s1)
-            lo = (kts > s0) & (kts <= sw)
-            if hi.any():
-                cr[hi] = np.interp(kts[hi], kn[k_hi], ct[k_hi])
-            if lo.any():
-                cr[lo] = np.interp(kts[lo], kn[k_lo], ct[k_lo])
-            rolls.append(g_lo + cr * (g_hi - g_lo))
-            arcs.append(np.broadcast_to(arcs_all[i], (_N_SEGMENT, 5)))
-            segs.append((i, sel, kts))
-    vals = ftff_gear_compliance(pair, np.concatenate(rolls), np.concatenate(arcs))
+    seg_fault, seg_ab, kts, rolls = _segment_points(knots, contact, s0s, s1s, s, g_lo,
+                                                    g_hi, _N_SEGMENT)
+    vals = ftff_gear_compliance(pair, rolls, arcs_all[np.repeat(seg_fault, _N_SEGMENT)])
     inv = np.tile(inv_g, (n, 1))
-    for m, (i, sel, kts) in enumerate(segs):
-        inv[i, sel] = np.interp(s[sel], kts, vals[m * _N_SEGMENT:(m + 1) * _N_SEGMENT])
-    k_h = _hertz_stiffness(pair)
-    k = 1.0 / (1.0 / k_h + inv_p + inv)
-    ef = np.zeros((n, _N_TABLE))
-    for i, f in enumerate(faults):                        # FullToothFaceFault.displacement
-        s0, s1 = s0s[i], s1s[i]
-        inside = (s > s0) & (s < s1)
-        if inside.any():
-            ef[i, inside] = -f.transmission * np.interp(s[inside], knots[i], ret[i])
+    ef = np.zeros((n, s.size))
+    trans = np.array([f.transmission for f in faults], dtype=float)
+    _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals.reshape(kts.shape), knots, ret,
+                 s0s, s1s, trans)
+    k = 1.0 / (1.0 / _hertz_stiffness(pair) + inv_p + inv)
     return k, ef
+
+
+@nb.njit(cache=True, inline="always")
+def _interp_point(x, xp, fp, lo, hi):
+    """``np.interp(x, xp[lo:hi], fp[lo:hi])`` of one point (numpy's formula: the
+    slope of the cell times the distance from its left node plus that node's value)."""
+    if x < xp[lo]:
+        return fp[lo]
+    if x >= xp[hi - 1]:
+        return fp[hi - 1]
+    j = lo
+    while xp[j + 1] <= x:
+        j += 1
+    if xp[j] == x:
+        return fp[j]
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
+
+
+@nb.njit(cache=True)
+def _segment_points(knots, contact, s0s, s1s, s, g_lo, g_hi, n_seg):
+    """The smooth segments of every fault's compliance (``stiffness._segments`` between
+    the cut's start, load switch, end and the tip) and the gear roll (m) at their
+    evaluation points (``FullToothFaceFault.contact_roll``): segment's fault (n_segs,),
+    ends (n_segs, 2), points (n_segs, n_seg), rolls (n_segs * n_seg,)."""
+    n, n_k = knots.shape
+    seg_fault = np.empty(4 * n, np.int64)
+    seg_ab = np.empty((4 * n, 2))
+    kts = np.empty((4 * n, n_seg))
+    rolls = np.empty(4 * n * n_seg)
+    m = 0
+    for i in range(n):
+        s0, s1 = s0s[i], s1s[i]
+        j = 0                                          # FullToothFaceFault._switch
+        for q in range(1, n_k - 1):
+            if abs(contact[i, q + 1] - contact[i, q]) > abs(contact[i, j + 1] - contact[i, j]):
+                j = q
+        sw = 0.5 * (knots[i, j] + knots[i, j + 1])
+        n_lo = 0                                       # knots <= sw: a prefix
+        while n_lo < n_k and knots[i, n_lo] <= sw:
+            n_lo += 1
+        edges = np.unique(np.minimum(np.maximum(np.array([s0, 1.0, s0, sw, s1]), s0), 1.0))
+        for e in range(edges.size - 1):
+            a, b = edges[e], edges[e + 1]
+            if b - a <= 0 or not _holds_point(s, a, b):
+                continue
+            eta = 1e-9 * (b - a)
+            start, step = a + eta, ((b - eta) - (a + eta)) / (n_seg - 1)
+            for q in range(n_seg):
+                x = q * step + start if q < n_seg - 1 else b - eta
+                cr = x
+                if x > sw and x < s1:
+                    cr = _interp_point(x, knots[i], contact[i], n_lo, n_k)
+                elif x > s0 and x <= sw:
+                    cr = _interp_point(x, knots[i], contact[i], 0, n_lo)
+                kts[m, q] = x
+                rolls[m * n_seg + q] = g_lo + cr * (g_hi - g_lo)
+            seg_fault[m] = i
+            seg_ab[m, 0], seg_ab[m, 1] = a, b
+            m += 1
+    return seg_fault[:m], seg_ab[:m], kts[:m], rolls[:m * n_seg]
+
+
+@nb.njit(cache=True, inline="always")
+def _in_segment(x, a, b):
+    return x >= a and (x <= b if b == 1.0 else x < b)
+
+
+@nb.njit(cache=True)
+def _holds_point(s, a, b):
+    for x in s:
+        if _in_segment(x, a, b):
+            return True
+    return False
+
+
+@nb.njit(cache=True)
+def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s, trans):
+    """The faulty gear tooth's compliance ``inv`` (interpolated from each segment's
+    points, healthy elsewhere) and the displacement excitation ``ef``
+    (``FullToothFaceFault.displacement``), in place."""
+    n_seg = kts.shape[1]
+    for m in range(seg_fault.shape[0]):
+        i = seg_fault[m]
+        a, b = seg_ab[m, 0], seg_ab[m, 1]
+        for p in range(s.shape[0]):
+            if _in_segment(s[p], a, b):
+                inv[i, p] = _interp_point(s[p], kts[m], vals[m], 0, n_seg)
+    for i in range(ef.shape[0]):
+        for p in range(s.shape[0]):
+            if s[p] > s0s[i] and s[p] < s1s[i]:
+                ef[i, p] = -trans[i] * _interp_point(s[p], knots[i], ret[i], 0,
+                                                     knots.shape[1])
 
 
 def ftff_cached(pair: GearPair, faults):
