@@ -11,9 +11,12 @@ import pytest
 import gearshot.signal
 import gearshot.transfer
 
+# private modules (``_uff58``, ...) hold helpers of the public ones, not public functions
 MODULES = sorted(
-    [f"gearshot.signal.{m.name}" for m in pkgutil.iter_modules(gearshot.signal.__path__)]
-    + [f"gearshot.transfer.{m.name}" for m in pkgutil.iter_modules(gearshot.transfer.__path__)]
+    [f"gearshot.signal.{m.name}" for m in pkgutil.iter_modules(gearshot.signal.__path__)
+     if not m.name.startswith("_")]
+    + [f"gearshot.transfer.{m.name}" for m in pkgutil.iter_modules(gearshot.transfer.__path__)
+       if not m.name.startswith("_")]
     + ["gearshot.features", "gearshot.paper"])
 
 

@@ -7,35 +7,10 @@ application's choice (the ``gearshot`` command line uses the non-interactive Agg
 
 from __future__ import annotations
 
-from .fault_types import plot_fault_signatures
-from .paper import (
-    VARIANT_LABELS,
-    plot_ablation,
-    plot_calibration,
-    plot_error_vs,
-    plot_feature_invariance,
-    plot_predicted_vs_true,
-    plot_sa_and_difference,
-    plot_spectrum_background,
-    plot_tf_estimate,
-    plot_tuning_curve,
-    save_figure,
-)
-from .transfer import plot_transfer_function, plot_transfer_functions
+from . import fault_types, paper, transfer
+from .fault_types import *  # noqa: F403
+from .paper import *  # noqa: F403
+from .transfer import *  # noqa: F403
 
-__all__ = [
-    "VARIANT_LABELS",
-    "save_figure",
-    "plot_sa_and_difference",
-    "plot_spectrum_background",
-    "plot_tf_estimate",
-    "plot_tuning_curve",
-    "plot_calibration",
-    "plot_feature_invariance",
-    "plot_predicted_vs_true",
-    "plot_ablation",
-    "plot_error_vs",
-    "plot_transfer_function",
-    "plot_transfer_functions",
-    "plot_fault_signatures",
-]
+# The public names, said once: each submodule's own ``__all__``.
+__all__ = [*paper.__all__, *transfer.__all__, *fault_types.__all__]

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = [
+    "VARIANT_LABELS",
     "save_figure",
     "plot_sa_and_difference",
     "plot_spectrum_background",

@@ -208,26 +208,33 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
     spec_x = scipy.fft.fft(flat, axis=-1)
     spec_r = scipy.fft.fft(refs, axis=-1)
     search = _LagSearch(n, upsample)
-    n_refs = refs.shape[0]
 
     residual = np.empty_like(flat)
     ref_index = np.empty(flat.shape[0], dtype=int)
     delays = np.empty(flat.shape[0])
-    chunk = max(1, 256 // n_refs)
+    chunk = max(1, 256 // refs.shape[0])
     for start in range(0, flat.shape[0], chunk):
-        sx = spec_x[start:start + chunk]  # (c, n)
-        cross = (sx[:, None, :] * np.conj(spec_r)[None]).reshape(-1, n)
-        tau = (search.best(cross) / upsample).reshape(-1, n_refs)  # delays, samples
-        advance = _shift_factors(n, tau)  # (c, n_refs, n)
-        res_spec = sx[:, None, :] * advance - spec_r[None]
-        energy = np.sum(res_spec.real ** 2 + res_spec.imag ** 2, axis=-1)
-        best = np.argmin(energy, axis=-1)
-        rows = np.arange(len(sx))
-        back = res_spec[rows, best] * np.conj(advance[rows, best])
-        residual[start:start + chunk] = scipy.fft.ifft(back, axis=-1).real
-        ref_index[start:start + chunk] = best
-        delays[start:start + chunk] = tau[rows, best]
+        part = slice(start, start + chunk)
+        residual[part], ref_index[part], delays[part] = _best_residuals(
+            spec_x[part], spec_r, search, upsample)
     residual = residual.reshape(signals.shape)
     if return_details:
         return residual, ref_index.reshape(batch_shape), delays.reshape(batch_shape)
     return residual
+
+
+def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch,
+                    upsample: int) -> tuple[FloatArray, IntArray, FloatArray]:
+    """For each signal spectrum in ``sx`` (c, n): the residual after subtracting the
+    delay-aligned reference that leaves the least energy, that reference's index and its
+    delay in samples."""
+    n, n_refs = sx.shape[-1], spec_r.shape[0]
+    cross = (sx[:, None, :] * np.conj(spec_r)[None]).reshape(-1, n)
+    tau = (search.best(cross) / upsample).reshape(-1, n_refs)  # delays, samples
+    advance = _shift_factors(n, tau)  # (c, n_refs, n)
+    res_spec = sx[:, None, :] * advance - spec_r[None]
+    energy = np.sum(res_spec.real ** 2 + res_spec.imag ** 2, axis=-1)
+    best = np.argmin(energy, axis=-1)
+    rows = np.arange(len(sx))
+    back = res_spec[rows, best] * np.conj(advance[rows, best])
+    return scipy.fft.ifft(back, axis=-1).real, best, tau[rows, best]

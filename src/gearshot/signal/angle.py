@@ -96,26 +96,32 @@ def check_pulse_train(pulses: np.ndarray, *, pulses_per_rev: int, label: str) ->
         raise GearshotError(
             f"{label}: extra tacho pulse at t={pulses[i + 1]:.4g} s ({gaps[i] / med:.2f} "
             f"median intervals after the previous one); {short.size} such glitch(es)")
-    long = np.flatnonzero(gaps > DROPOUT_FACTOR * med)
-    if long.size:
-        spans = np.rint(gaps[long] / med).astype(np.int64)  # intervals the gap covers
-        bad = np.flatnonzero(spans > pulses_per_rev)
-        if bad.size:
-            i = int(long[bad[0]])
-            raise GearshotError(
-                f"{label}: tacho dropout of {gaps[i]:.4g} s ({gaps[i] / med:.2f} pulse "
-                f"intervals, more than one revolution at tacho_pulses_per_rev="
-                f"{pulses_per_rev}) after the pulse at t={pulses[i]:.4g} s; {bad.size} such "
-                f"gap(s)")
-        pieces = [pulses[: long[0] + 1]]
-        for j, (at, k) in enumerate(zip(long, spans)):
-            a, b = pulses[at], pulses[at + 1]
-            pieces.append(a + (b - a) * np.arange(1, k) / k)
-            stop = long[j + 1] + 1 if j + 1 < long.size else pulses.size
-            pieces.append(pulses[at + 1: stop])
-        pulses = np.concatenate(pieces)
-    return pulses
+    return _bridge_dropouts(pulses, gaps, med, pulses_per_rev=pulses_per_rev, label=label)
 
+
+def _bridge_dropouts(pulses: FloatArray, gaps: FloatArray, med: float, *, pulses_per_rev: int,
+                     label: str) -> FloatArray:
+    """``pulses`` with each dropout (a gap over ``DROPOUT_FACTOR`` median intervals) of at
+    most one revolution filled with evenly spaced pulses; a longer dropout raises."""
+    long = np.flatnonzero(gaps > DROPOUT_FACTOR * med)
+    if not long.size:
+        return pulses
+    spans = np.rint(gaps[long] / med).astype(np.int64)  # intervals the gap covers
+    bad = np.flatnonzero(spans > pulses_per_rev)
+    if bad.size:
+        i = int(long[bad[0]])
+        raise GearshotError(
+            f"{label}: tacho dropout of {gaps[i]:.4g} s ({gaps[i] / med:.2f} pulse "
+            f"intervals, more than one revolution at tacho_pulses_per_rev="
+            f"{pulses_per_rev}) after the pulse at t={pulses[i]:.4g} s; {bad.size} such "
+            f"gap(s)")
+    pieces = [pulses[: long[0] + 1]]
+    for j, (at, k) in enumerate(zip(long, spans)):
+        a, b = pulses[at], pulses[at + 1]
+        pieces.append(a + (b - a) * np.arange(1, k) / k)
+        stop = long[j + 1] + 1 if j + 1 < long.size else pulses.size
+        pieces.append(pulses[at + 1: stop])
+    return np.concatenate(pieces)
 
 def uniform_cycle_times(cycle_times: ArrayLike) -> FloatArray:
     """Equally spaced cycle times with the same first and last value (constant speed).

@@ -222,6 +222,24 @@ def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples
     spr = check_int(samples_per_rev, "samples_per_rev", minimum=1, maximum=MAX_POINTS)
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=MAX_POINTS)
     upsample = check_int(upsample, "upsample", minimum=1, maximum=64)
+    n_revs = _whole_revolutions(x, fs, pulses, spr=spr, ppr=ppr, upsample=upsample)
+    angles = np.arange(n_revs * spr) / spr
+    times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
+    if antialias:
+        x_fine, position = _bandlimited_fine(x, fs, pulses, times, spr=spr, ppr=ppr,
+                                             upsample=upsample, passband=passband)
+    else:
+        import scipy.signal  # imported here: a 0.5-1 s import the default path never needs
+
+        x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1) if upsample > 1 else x
+        position = times * fs * upsample  # fractional sample index in x_fine
+    return _spline_read(x_fine, position).reshape(*x.shape[:-1], position.size)
+
+
+def _whole_revolutions(x: FloatArray, fs: float, pulses: FloatArray, *, spr: int, ppr: int,
+                       upsample: int) -> int:
+    """Whole revolutions from the first pulse, after checking that the pulses lie inside
+    the signal and that the work stays within the size limits."""
     if x.size * upsample > 16 * MAX_POINTS:
         raise GearshotError(f"x ({x.size} samples) × upsample={upsample} exceeds "
                             f"{16 * MAX_POINTS} samples; resample shorter pieces")
@@ -238,21 +256,25 @@ def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples
     if n_revs * spr * max(1, x.size // x.shape[-1]) > 16 * MAX_POINTS:
         raise GearshotError(f"the output would hold {n_revs} revolutions × samples_per_rev="
                             f"{spr} points per signal, more than {16 * MAX_POINTS} in all")
-    angles = np.arange(n_revs * spr) / spr
-    times = angle_to_time(pulses, angles, pulses_per_rev=ppr)
-    if antialias:
-        # band-limit below the angular Nyquist and re-synthesize at upsample x the Nyquist
-        # rate of what is left (coarser than fs for slow shafts: cheaper, equally exact)
-        cutoff = 0.5 * spr * min_shaft_rate(pulses, pulses_per_rev=ppr)
-        rate = 2.0 * upsample * min(cutoff, fs / 2)
-        x_fine, fs_fine, t0 = bandlimited_resynthesis(x, fs, cutoff=cutoff, passband=passband,
-                                                      rate=rate)
-        position = (times - t0) * fs_fine
-    else:
-        import scipy.signal  # imported here: a 0.5-1 s import the default path never needs
+    return n_revs
 
-        x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1) if upsample > 1 else x
-        position = times * fs * upsample  # fractional sample index in x_fine
+
+def _bandlimited_fine(x: FloatArray, fs: float, pulses: FloatArray, times: FloatArray, *,
+                      spr: int, ppr: int, upsample: int,
+                      passband: float) -> tuple[FloatArray, FloatArray]:
+    """The signal band-limited below the angular Nyquist at the slowest shaft speed, re-
+    synthesized at ``upsample`` × the Nyquist rate of what is left (coarser than ``fs`` for
+    slow shafts: cheaper, equally exact), and the fractional sample index of ``times`` in it."""
+    cutoff = 0.5 * spr * min_shaft_rate(pulses, pulses_per_rev=ppr)
+    rate = 2.0 * upsample * min(cutoff, fs / 2)
+    x_fine, fs_fine, t0 = bandlimited_resynthesis(x, fs, cutoff=cutoff, passband=passband,
+                                                  rate=rate)
+    return x_fine, (times - t0) * fs_fine
+
+
+def _spline_read(x_fine: FloatArray, position: FloatArray) -> FloatArray:
+    """Cubic-spline values of each signal (last axis) at fractional sample ``position``;
+    shape (n_signals, position.size)."""
     import scipy.ndimage
 
     flat = x_fine.reshape(-1, x_fine.shape[-1])
@@ -261,4 +283,4 @@ def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples
         coeffs = scipy.ndimage.spline_filter1d(row, order=3, mode="mirror")
         out[i] = scipy.ndimage.map_coordinates(coeffs, position[None, :], order=3,
                                                mode="mirror", prefilter=False)
-    return out.reshape(*x.shape[:-1], position.size)
+    return out

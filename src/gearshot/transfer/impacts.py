@@ -129,9 +129,23 @@ def frf_from_impacts(force, response, fs: float, *, estimator: str = "H1",
     x = as_signal_array(response, "response", min_ndim=1, max_ndim=2, min_length=4)
     if f.shape != x.shape:
         raise GearshotError(f"response must have the shape of force {f.shape}; got {x.shape}")
-    f = np.atleast_2d(f)
-    x = np.atleast_2d(x)
-    n = f.shape[-1]
+    f, x, force_window, exp_window = _windowed(np.atleast_2d(f), np.atleast_2d(x), fs,
+                                               force_window, exp_window)
+    freqs = np.fft.rfftfreq(f.shape[-1], 1.0 / fs)
+    h, coh = _h_and_coherence(np.fft.rfft(f, axis=-1), np.fft.rfft(x, axis=-1), freqs,
+                              estimator)
+    tf = TransferFunction(freqs=freqs, values=h, name=f"{estimator} from {f.shape[0]} impact(s)",
+                          metadata={"estimator": estimator, "n_impacts": int(f.shape[0]),
+                                    "force_window_s": force_window,
+                                    "exp_window_end": exp_window, "fs_hz": fs})
+    return ImpactFRF(tf, coh)
+
+
+def _windowed(f: np.ndarray, x: np.ndarray, fs: float, force_window: float | None,
+              exp_window: float | None
+              ) -> tuple[np.ndarray, np.ndarray, float | None, float | None]:
+    """Force (and, with ``exp_window``, response) records windowed per impact; the checked
+    window parameters."""
     if force_window is not None:
         force_window = check_positive(force_window, "force_window")
         f = f * _force_window(f, fs, force_window)
@@ -140,12 +154,16 @@ def frf_from_impacts(force, response, fs: float, *, estimator: str = "H1",
         e = _exp_window(f, exp_window)
         f = f * e
         x = x * e
-    F = np.fft.rfft(f, axis=-1)
-    X = np.fft.rfft(x, axis=-1)
+    return f, x, force_window, exp_window
+
+
+def _h_and_coherence(F: np.ndarray, X: np.ndarray, freqs: np.ndarray,
+                     estimator: str) -> tuple[np.ndarray, np.ndarray]:
+    """H1 or H2 from the impacts' spectra (averaged over the first axis), and the ordinary
+    coherence; refuses lines where the estimator is undefined."""
     g_ff = np.mean(np.abs(F) ** 2, axis=0)
     g_xx = np.mean(np.abs(X) ** 2, axis=0)
     g_fx = np.mean(np.conj(F) * X, axis=0)
-    freqs = np.fft.rfftfreq(n, 1.0 / fs)
     tiny = np.finfo(float).tiny
     if np.any(g_ff <= tiny):
         k = int(np.flatnonzero(g_ff <= tiny)[0])
@@ -161,12 +179,7 @@ def frf_from_impacts(force, response, fs: float, *, estimator: str = "H1",
         h = g_xx / np.conj(g_fx)
     with np.errstate(divide="ignore", invalid="ignore"):
         coh = np.where(g_xx > tiny, np.abs(g_fx) ** 2 / (g_ff * g_xx), 0.0)
-    coh = np.clip(coh, 0.0, 1.0)
-    tf = TransferFunction(freqs=freqs, values=h, name=f"{estimator} from {f.shape[0]} impact(s)",
-                          metadata={"estimator": estimator, "n_impacts": int(f.shape[0]),
-                                    "force_window_s": force_window,
-                                    "exp_window_end": exp_window, "fs_hz": fs})
-    return ImpactFRF(tf, coh)
+    return h, np.clip(coh, 0.0, 1.0)
 
 
 def impact_arrays(records: Sequence[UffRecord], *, response_quantity: str | None = None

@@ -115,7 +115,21 @@ def modal_frf(freqs, modes: Sequence[Mode], *, quantity: str = "accelerance",
     if rigid_body != 0.0 and quantity != "accelerance" and np.any(f == 0):
         raise GearshotError(f"rigid_body={rigid_body} makes the {quantity} infinite at 0 Hz")
     w = 2 * np.pi * f
-    receptance = np.zeros(f.shape, dtype=np.complex128)
+    h, pairs = _with_allpass(_modal_response(w, modes, quantity, rigid_body), w, allpass)
+    if delay:
+        h = h * np.exp(-1j * w * delay)
+    meta = {"modes": tuple((m.frequency, m.damping, m.residue) for m in modes),
+            "rigid_body": rigid_body, "delay_s": delay, "allpass": tuple(pairs),
+            "model": f"modal {quantity}"}
+    return TransferFunction(freqs=f, values=h, name=name, response_quantity=_QUANTITIES[quantity],
+                            reference_quantity="force", metadata=meta)
+
+
+def _modal_response(w: np.ndarray, modes: Sequence[Mode], quantity: str,
+                    rigid_body: float) -> np.ndarray:
+    """Sum of the modes' receptances at angular frequencies ``w``, as ``quantity``, with the
+    rigid-body term."""
+    receptance = np.zeros(w.shape, dtype=np.complex128)
     for m in modes:
         wr = 2 * np.pi * m.frequency
         receptance += m.residue / (wr**2 - w**2 + 2j * m.damping * wr * w)
@@ -127,6 +141,13 @@ def modal_frf(freqs, modes: Sequence[Mode], *, quantity: str = "accelerance",
     else:
         with np.errstate(divide="ignore", invalid="ignore"):
             h = receptance - (rigid_body / w**2 if rigid_body else 0.0)
+    return h
+
+
+def _with_allpass(h: np.ndarray, w: np.ndarray, allpass: Sequence[tuple[float, float]]
+                  ) -> tuple[np.ndarray, list[tuple[float, float]]]:
+    """``h`` times each all-pass section (a right-half-plane zero pair over its mirrored
+    stable pole pair), and the checked ``(frequency_hz, damping)`` pairs."""
     pairs = []
     for item in allpass:
         try:
@@ -140,13 +161,7 @@ def modal_frf(freqs, modes: Sequence[Mode], *, quantity: str = "accelerance",
         w0 = 2 * np.pi * f0
         h = h * (w0**2 - w**2 - 2j * z0 * w0 * w) / (w0**2 - w**2 + 2j * z0 * w0 * w)
         pairs.append((f0, z0))
-    if delay:
-        h = h * np.exp(-1j * w * delay)
-    meta = {"modes": tuple((m.frequency, m.damping, m.residue) for m in modes),
-            "rigid_body": rigid_body, "delay_s": delay, "allpass": tuple(pairs),
-            "model": f"modal {quantity}"}
-    return TransferFunction(freqs=f, values=h, name=name, response_quantity=_QUANTITIES[quantity],
-                            reference_quantity="force", metadata=meta)
+    return h, pairs
 
 
 def attenuation_db(tf: TransferFunction) -> float:
@@ -283,34 +298,45 @@ def synthetic_tfs(n: int, *, band: tuple[float, float] = (0.0, 1000.0), n_lines:
     n_nmp = int(round(nonminimum_fraction * n))
     nmp_flags = np.zeros(n, bool)
     nmp_flags[rng.permutation(n)[:n_nmp]] = True
-    tfs = []
-    for i in range(n):
-        k = int(rng.integers(m_lo, m_hi + 1))
-        zeta = rng.uniform(min(z_lo, z_hi), max(z_lo, z_hi), size=k)
-        fr = _spread_modes(rng, k, lo + 0.03 * (hi - lo), lo + 0.97 * (hi - lo))
-        mags = rng.lognormal(0.0, 0.6, size=k)
-        flips = rng.random(k - 1) < 0.35
-        if k > 1 and flips.all():
-            flips[rng.integers(k - 1)] = False  # keep one same-sign pair -> antiresonance
-        signs = np.concatenate([[1.0], np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)])
-        modes = [Mode(float(a), float(b), float(c)) for a, b, c in zip(fr, zeta, signs * mags)]
-        rigid = float(rng.uniform(0.2, 1.0) * mags.mean())
-        delay = 0.0
-        allp: tuple[tuple[float, float], ...] = ()
-        if nmp_flags[i]:
-            delay = float(rng.uniform(0.2e-3, 2e-3))
-            if rng.random() < 0.5:
-                allp = ((float(rng.uniform(lo + 0.2 * (hi - lo), lo + 0.8 * (hi - lo))),
-                         float(rng.uniform(0.05, 0.3))),)
-        tf = modal_frf(freqs, modes, rigid_body=rigid, delay=delay, allpass=allp,
-                       name=f"synthetic_{i:03d}")
-        target = rng.uniform(min(a_lo, a_hi), max(a_lo, a_hi))
-        gain = 10 ** (-target / 20) / np.sqrt(np.mean(tf.magnitude**2))
-        meta = dict(tf.metadata, scale=float(gain), attenuation_db=float(target),
-                    nonminimum_phase_added=bool(nmp_flags[i]))
-        tfs.append(TransferFunction(freqs=freqs, values=tf.values * gain, name=tf.name,
-                                    response_quantity="acceleration", metadata=meta))
-    return tfs
+    return [_random_accelerance(rng, freqs, f"synthetic_{i:03d}", band=(lo, hi),
+                                n_modes=(m_lo, m_hi),
+                                damping=(min(z_lo, z_hi), max(z_lo, z_hi)),
+                                attenuation=(min(a_lo, a_hi), max(a_lo, a_hi)),
+                                nonminimum=bool(nmp_flags[i]))
+            for i in range(n)]
+
+
+def _random_accelerance(rng: np.random.Generator, freqs: np.ndarray, name: str, *,
+                        band: tuple[float, float], n_modes: tuple[int, int],
+                        damping: tuple[float, float], attenuation: tuple[float, float],
+                        nonminimum: bool) -> TransferFunction:
+    """One FRF of :func:`synthetic_tfs`' random model, its draws taken from ``rng`` in a
+    fixed order (modes, damping, frequencies, residues, rigid body, delay/all-pass, level)."""
+    lo, hi = band
+    k = int(rng.integers(n_modes[0], n_modes[1] + 1))
+    zeta = rng.uniform(damping[0], damping[1], size=k)
+    fr = _spread_modes(rng, k, lo + 0.03 * (hi - lo), lo + 0.97 * (hi - lo))
+    mags = rng.lognormal(0.0, 0.6, size=k)
+    flips = rng.random(k - 1) < 0.35
+    if k > 1 and flips.all():
+        flips[rng.integers(k - 1)] = False  # keep one same-sign pair -> antiresonance
+    signs = np.concatenate([[1.0], np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)])
+    modes = [Mode(float(a), float(b), float(c)) for a, b, c in zip(fr, zeta, signs * mags)]
+    rigid = float(rng.uniform(0.2, 1.0) * mags.mean())
+    delay = 0.0
+    allp: tuple[tuple[float, float], ...] = ()
+    if nonminimum:
+        delay = float(rng.uniform(0.2e-3, 2e-3))
+        if rng.random() < 0.5:
+            allp = ((float(rng.uniform(lo + 0.2 * (hi - lo), lo + 0.8 * (hi - lo))),
+                     float(rng.uniform(0.05, 0.3))),)
+    tf = modal_frf(freqs, modes, rigid_body=rigid, delay=delay, allpass=allp, name=name)
+    target = rng.uniform(attenuation[0], attenuation[1])
+    gain = 10 ** (-target / 20) / np.sqrt(np.mean(tf.magnitude**2))
+    meta = dict(tf.metadata, scale=float(gain), attenuation_db=float(target),
+                nonminimum_phase_added=nonminimum)
+    return TransferFunction(freqs=freqs, values=tf.values * gain, name=tf.name,
+                            response_quantity="acceleration", metadata=meta)
 
 
 def _spread_modes(rng: np.random.Generator, k: int, lo: float, hi: float) -> np.ndarray:
