@@ -37,7 +37,6 @@ _PENDING: frozenset[str] = frozenset(
         "signal/ridge.py",
         "signal/tracking.py",
         "sim/database.py",
-        "sim/dynamics.py",
     }
 )
 
