@@ -260,7 +260,7 @@ def bench_sweep(args):
     """The paper sweep's two parts on a measured fraction: the paired grade-7 database of
     ``--conditions`` conditions and the Sec. 4.1 datasets of those conditions, on a
     LocalCluster of 2 single-threaded workers; extrapolated to 26 x 4 conditions."""
-    from gearshot.app.cli import PAPER_LOADS, PAPER_SPEEDS
+    from gearshot.paper import PAPER_LOADS, PAPER_SPEEDS
     from gearshot.experiments import simulated_experiment
     from gearshot.sim import GearPair, build_database
 
