@@ -250,14 +250,23 @@ class Batch:
         self.V = np.zeros((n_pad, x0.size))
         self.A = np.zeros((n_pad, x0.size))
 
-    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+    def shared(self, mesh_pos):
+        """What every signal shares at the steps' mesh positions ``mesh_pos``
+        (:func:`._kernel.contact_slots`, :func:`._kernel.table_shared`,
+        :func:`._kernel.spur_shared`); the same for every batch of a pair, so batches
+        run over the same steps compute it once (:meth:`run`'s ``shared``)."""
+        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, self.pair.contact_ratio,
+                                                        _pair_table(self.pair, None))
+        return (pair_id, wgt, pos, count, k_h,
+                *spur_shared(pos, count, self.g[3].shape[1], self.g_nw, self.p_nw))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec, shared=None):
         """Advance over the given steps; return the vertical acceleration (g) of steps
-        ``rec_start ... rec_start + n_rec - 1``."""
-        pair, integ = self.pair, self.integ
-        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, pair.contact_ratio,
-                                                        _pair_table(pair, None))
-        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[1], self.g_nw,
-                                           self.p_nw)
+        ``rec_start ... rec_start + n_rec - 1`` (``shared``: :meth:`shared` of
+        ``mesh_pos``, computed here when not given)."""
+        integ = self.integ
+        pair_id, wgt, pos, count, k_h, n_cell, n_frac, trig = (
+            self.shared(mesh_pos) if shared is None else shared)
         out = np.empty((self.X.shape[0], n_rec))
         newmark_spur(np.ascontiguousarray(load, dtype=float),
                      np.ascontiguousarray(motor_acc, dtype=float), count, wgt, pos,
@@ -283,9 +292,13 @@ class HelicalBatch(Batch):
         self.kf, self.fpf = _pad(self.kf, n_pad), _pad(self.fpf, n_pad)
         self._init_state(n)
 
-    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+    def shared(self, mesh_pos):
+        return _contacts(mesh_pos, self.span, self.k)
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec, shared=None):
         integ = self.integ
-        pair_id, wgt, _, count, cell, frac, k_h = _contacts(mesh_pos, self.span, self.k)
+        pair_id, wgt, _, count, cell, frac, k_h = (
+            self.shared(mesh_pos) if shared is None else shared)
         out = np.empty((self.X.shape[0], n_rec))
         newmark_tables(
             np.ascontiguousarray(load, dtype=float),

@@ -106,10 +106,13 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     loads = np.full(n_steps, load)
     ge, pe = draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=True)
     out = np.empty((n_sig, n_points))
+    shared = None                        # the same steps for every batch: computed once
     for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        acc = make_batch(pair, integ, faults[sl], ge[sl], pe[sl]).run(
-            mesh_pos, zeros, loads, n_warm - 1, n_rev)
+        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        if shared is None:
+            shared = batch.shared(mesh_pos)
+        acc = batch.run(mesh_pos, zeros, loads, n_warm - 1, n_rev, shared)
         out[sl] = _fft_resample(acc, n_points)
     return out
 
