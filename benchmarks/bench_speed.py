@@ -165,6 +165,7 @@ def bench_condition(args):
                   f"{'+ twins' if paired else '(unpaired)'}, in-process (2 numba threads): "
                   f"{wall:.1f} s wall, {cpu:.1f} s CPU; load avg before {l0}, after "
                   f"{load_avg()}; {peak_mb()}")
+        k0 = children_cpu()
         client, cluster = _local_client()
         try:
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), client,
@@ -172,8 +173,11 @@ def bench_condition(args):
         finally:
             client.close()
             cluster.close()
+        workers_cpu = children_cpu() - k0
         print(f"  + twins on a LocalCluster (2 x 1 thread, started before timing): "
-              f"{wall:.1f} s wall; load avg before {l0}, after {load_avg()}; {peak_mb()}")
+              f"{wall:.1f} s wall, workers' CPU {workers_cpu:.1f} s (/2 = "
+              f"{workers_cpu / 2:.1f} s on 2 free cores); load avg before {l0}, after "
+              f"{load_avg()}; {peak_mb()}")
 
 
 def bench_scheduler(args):
