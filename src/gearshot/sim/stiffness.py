@@ -96,7 +96,7 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 def _whole_face(fault: ToothFault, pair: GearPair) -> bool:
     """True when ``fault`` is its own transverse fault over the whole face width."""
-    bands = face_bands(pair, fault)
+    bands = fault.face_bands(pair)        # not the cache: its band may be an equal copy
     return len(bands) == 1 and bands[0][0] == 0.0 and bands[0][1] == 1.0 and bands[0][2] is fault
 
 
