@@ -80,7 +80,7 @@ def concurrency(work: Path, trials: int) -> dict:
 def tampering(work: Path) -> dict:
     import gearshot.sim.database as d
     from gearshot.sim import build_database, load_database
-    from gearshot.sim.database import _write_checksums
+    from gearshot.sim._db_checksums import write_checksums as _write_checksums
 
     d.simulate_sa = integ._fake_simulate_sa
     kw = integ.KW

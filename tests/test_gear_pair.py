@@ -104,7 +104,7 @@ def test_a_database_without_pair_attributes_falls_back(db40, target):
 
 
 def test_an_unreadable_manifest_pair_loads_without_pair_attributes():
-    from gearshot.sim.database import _pair_from_manifest
+    from gearshot.sim._db_manifest import pair_from_manifest as _pair_from_manifest
 
     assert _pair_from_manifest({"pair": "GearPair(z_pinion=17, z_gear=40)"}).z_gear == 40
     numpy2 = "GearPair(z_pinion=17, z_gear=np.int64(40), module=np.float64(0.004))"

@@ -218,7 +218,7 @@ def test_foreign_block_with_a_rewritten_record_is_refused_and_rebuilt(tmp_path, 
     import shutil
 
     from gearshot.sim import build_database, load_database
-    from gearshot.sim.database import _write_checksums
+    from gearshot.sim._db_checksums import write_checksums as _write_checksums
 
     other = build_database(tmp_path / "other", **dict(KW, seed=9))
     ref = load_database(store, speed=15, load=10).sa.values

@@ -263,3 +263,24 @@ def test_jittered_tacho_has_one_clean_pulse_per_revolution():
         steps = np.diff(pulse_times(x, fs)) * 15.0  # revolutions between pulses
         assert steps.size in (448, 449, 450)
         assert steps.min() > 0.95 and steps.max() < 1.05
+
+
+def test_a_tacho_recording_with_a_machine_without_tacho_uses_its_own_tacho():
+    """A machine without [tacho] (speed from the vibration) and a recording that does
+    carry a tacho: the tacho is used with the default trigger level (it once raised
+    AttributeError looking up the machine's tacho threshold)."""
+    from pathlib import Path
+
+    from gearshot import Machine
+
+    toml = Path(__file__).resolve().parents[1] / "examples/machines/phm09_spur_notacho.toml"
+    m = Machine.from_toml(toml)
+    assert m.tacho is None
+    rec = make_recording(tacho_pulses_per_rev=1)
+    plain = rec.pulse_times()
+    with_machine = Recording(np.stack([rec.acceleration, rec.acceleration]), rec.tacho,
+                             FS, speed=15.0, tacho_pulses_per_rev=1, machine=m,
+                             tacho_shaft=m.reference_shaft)
+    np.testing.assert_array_equal(with_machine.pulse_times(), plain)
+    assert with_machine.speed_source == "tacho"
+    assert abs(with_machine.shaft_speed() - 15.0) < 0.01

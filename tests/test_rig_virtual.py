@@ -234,6 +234,46 @@ def test_failed_campaign_leaves_no_partial_file(tmp_path):
     assert after == before  # nothing new, index untouched, no staging folder
 
 
+def test_campaign_files_go_into_place_through_the_atomic_writer(tmp_path, monkeypatch):
+    """The recordings, then the index last, are moved by ``_atomic.commit_staged``."""
+    from gearshot import _atomic
+
+    calls = []
+
+    def spy(staging, folder, names):
+        calls.append((Path(folder), list(names), sorted(p.name for p in Path(staging).iterdir())))
+        _atomic.commit_staged(staging, folder, names)
+
+    monkeypatch.setattr("gearshot.rig.virtual.commit_staged", spy)
+    df = VirtualRig(seed=0, engine="surrogate").campaign(
+        tmp_path, speed=15.0, load=5.0, duration=0.2, healthy=1, sizes=(0.5,),
+        repetitions=1, progress=False)
+    names = [Path(p).name for p in df["path"]]
+    assert calls == [(tmp_path, [*names, "index.csv"], sorted([*names, "index.csv"]))]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*names, "index.csv"])
+
+
+def test_commit_staged_moves_in_order_and_names_a_failed_destination(tmp_path):
+    from gearshot._atomic import commit_staged, staging_dir
+
+    folder = tmp_path / "camp"
+    with staging_dir(folder) as stage:
+        for name in ("a.h5", "index.csv"):
+            (stage / name).write_text(name)
+        commit_staged(stage, folder, ["a.h5", "index.csv"])
+        assert not list(stage.iterdir())
+    assert {p.name: p.read_text() for p in folder.iterdir()} == {"a.h5": "a.h5",
+                                                                 "index.csv": "index.csv"}
+    (folder / "b.h5").mkdir()                      # a folder where a file must go
+    with pytest.raises(GearshotError, match=r"cannot write .*b\.h5"):
+        with staging_dir(folder) as stage:
+            (stage / "b.h5").write_text("b")
+            (stage / "index.csv").write_text("new")
+            commit_staged(stage, folder, ["b.h5", "index.csv"])
+    assert (folder / "index.csv").read_text() == "index.csv"   # the index is not replaced
+    assert sorted(p.name for p in folder.iterdir()) == ["a.h5", "b.h5", "index.csv"]
+
+
 def test_bad_engine_and_bad_arguments(tmp_path):
     rig = VirtualRig(seed=0, engine=lambda **kw: np.zeros(10))
     with pytest.raises(GearshotError, match="engine returned shape"):

@@ -169,7 +169,8 @@ def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
         build_database(tmp_path / "plain", client=False, progress=False, **PAIR_KW)
     build_database(tmp_path / "plain", client=False, progress=False, paired=False, **PAIR_KW)
     # the repair command of a damaged store rebuilds the same layout
-    from gearshot.sim.database import _read_manifest, _rebuild_hint
+    from gearshot.sim._db_manifest import read_manifest as _read_manifest
+    from gearshot.sim._db_manifest import rebuild_hint as _rebuild_hint
     assert "--no-paired" in _rebuild_hint(tmp_path / "plain", _read_manifest(tmp_path / "plain"))
     assert "--no-paired" not in _rebuild_hint(tmp_path / "paired",
                                               _read_manifest(tmp_path / "paired"))

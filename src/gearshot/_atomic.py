@@ -26,7 +26,7 @@ import shutil
 import socket
 import tempfile
 import zlib
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +36,7 @@ __all__ = [
     "atomic_path",
     "atomic_dir",
     "staging_dir",
+    "commit_staged",
     "write_text_atomic",
     "write_json_atomic",
     "check_writable",
@@ -291,7 +292,7 @@ def staging_dir(folder: str | os.PathLike) -> Iterator[Path]:
     """A hidden temporary folder inside ``folder`` (created), always removed afterwards.
 
     For outputs made of several files: write them all into the staging folder (each with
-    :func:`atomic_path`), then move each into place with ``os.replace``.
+    :func:`atomic_path`), then move them into place with :func:`commit_staged`.
     """
     folder = Path(folder)
     _make_folder(folder, folder)
@@ -307,6 +308,24 @@ def staging_dir(folder: str | os.PathLike) -> Iterator[Path]:
         raise _fail(folder, exc) from exc
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def commit_staged(staging: str | os.PathLike, folder: str | os.PathLike,
+                  names: Sequence[str]) -> None:
+    """Move the finished files ``names`` of a :func:`staging_dir` into ``folder``.
+
+    Each file is moved by one rename (same file system: a reader sees the old file or the
+    new one), in the order given -- put a file that names the others (an index) last, so
+    that it never names a file not yet in place -- and ``folder`` is synced afterwards. An
+    OS error becomes a :class:`~gearshot.GearshotError` naming the destination.
+    """
+    staging, folder = Path(staging), Path(folder)
+    for name in names:
+        try:
+            os.replace(staging / name, folder / name)
+        except OSError as exc:
+            raise _fail(folder / name, exc) from None
+    _fsync_dir(folder)
 
 
 def remove_tree(path: str | os.PathLike) -> None:

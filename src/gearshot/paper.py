@@ -21,6 +21,8 @@ __all__ = [
     "PINION_TEETH", "GEAR_TEETH", "MODULE", "FACE_WIDTH", "PRESSURE_ANGLE_DEG",
     "TABLE1_SIZES", "PAPER_SPEEDS", "PAPER_LOADS", "SAMPLES_PER_CYCLE",
     "CYCLES_PER_SEGMENT",
+    "RIG_CONDITIONS", "RIG_SPEED", "RIG_LOAD", "RIG_HEALTHY_RECORDINGS", "RIG_REPETITIONS",
+    "RIG_DURATION",
 ]
 
 #: Teeth of the driving pinion (input shaft, where the tacho sits).
@@ -46,3 +48,14 @@ PAPER_LOADS: tuple[float, ...] = (5.0, 10.0, 15.0, 20.0)
 SAMPLES_PER_CYCLE: int = 2048
 #: Cycles averaged into one experimental SA segment.
 CYCLES_PER_SEGMENT: int = 50
+
+#: Operating conditions of the rig experiments (Sec. 4.2): (input speed rev/s, load N m).
+RIG_CONDITIONS: tuple[tuple[float, float], ...] = ((15.0, 10.0), (15.0, 5.0), (30.0, 5.0),
+                                                   (30.0, 10.0))
+#: The condition a one-condition run (the demo, ``gearshot rig``, ``simulate``,
+#: ``experiment``) defaults to: the first of :data:`RIG_CONDITIONS`.
+RIG_SPEED, RIG_LOAD = RIG_CONDITIONS[0]
+#: Table 1 per condition: healthy recordings, recordings per fault size, seconds each.
+RIG_HEALTHY_RECORDINGS: int = 6
+RIG_REPETITIONS: int = 6
+RIG_DURATION: float = 60.0

@@ -20,8 +20,10 @@ Load
 ----
 A database slice is one (speed, load) condition. When the load is not quantified (the PHM
 2009 records say only High / Low), build the database at one nominal load and leave
-``--load`` out: the database's only load is used and reported; a database over several
-loads needs ``--load``, and the error lists them.
+``--load`` out: the database's only load is used and reported. With ``--machine``, a
+database over several loads lets the healthy recordings choose
+(:mod:`gearshot.app.load_choice`, refused when ambiguous); elsewhere it needs ``--load``,
+and the error lists them.
 """
 
 from __future__ import annotations

@@ -16,10 +16,10 @@ from rich.console import Console
 from rich.table import Table
 
 from .._atomic import atomic_path, write_json_atomic
+from ..paper import RIG_LOAD as LOAD
+from ..paper import RIG_SPEED as SPEED
 
 __all__ = ["run_demo"]
-
-SPEED, LOAD = 15.0, 10.0
 
 
 def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duration=30.0,
@@ -42,61 +42,24 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
         Draws of the faulty example (and of the training/test split); the error table
         gives the mean and spread over them, the figures show the first draw.
     """
-    from .. import data_home
     from .._validation import check_int
-    from ..experiments import RIG_VARIANTS, rig_experiment
-    from ..rig import VirtualRig
-    from ..sim import GearPair, build_database, load_database
-    from ..transfer import TransferFunctionBank
 
     draws = check_int(draws, "draws", minimum=1, maximum=100)
     console = console or Console()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
-    home = data_home()
-    store = home / f"demo-db-h{n_healthy}-f{n_faulty}-s{seed}-paired"
-    console.rule("1. simulated database (15 rps, 10 Nm, DIN grades 1–12)")
-    build_database(store, GearPair.paper(), speeds=[SPEED], loads=[LOAD], grades=range(1, 13),
-                   n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, paired=True)
-    database = load_database(store, speed=SPEED, load=LOAD)
-    console.print(f"{database.sizes['signal']} simulated SAs in {store}")
-
-    console.rule("2. virtual-rig campaign")
-    campaign = home / f"demo-campaign-s{seed}-d{duration:g}-r{repetitions}"
-    rig = VirtualRig(seed=seed)
-    if not (campaign / "index.csv").is_file():
-        rig.campaign(campaign, speed=SPEED, load=LOAD, duration=duration,
-                     repetitions=repetitions)
-    console.print(f"recordings in {campaign}")
-
+    database = _demo_database(console, seed=seed, n_healthy=n_healthy, n_faulty=n_faulty)
+    campaign, rig = _demo_campaign(console, seed=seed, duration=duration,
+                                   repetitions=repetitions)
     console.rule("3. one-fault-shot estimation and ablations")
-    selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
-    results, predictions = rig_experiment(campaign, database, speed=SPEED, load=LOAD,
-                                          selection_tf=selection_tf, variants=RIG_VARIANTS,
-                                          n_repeats=draws, seed=seed, keep_estimators="first")
+    results, predictions = _demo_fit(campaign, database, seed=seed, draws=draws)
+    stats = _mae_stats(results)
     first = results[results["repeat"] == 0]
     full = first[first["variant"] == "full"].iloc[0]
     est = full["estimator"]
-    stats = _mae_stats(results)
-    table = Table(title=f"MAE of the fault-size estimate on the rig's test segments, over "
-                        f"{draws} draws of the faulty example")
-    for col in ("variant", "MAE mean ± std [%]", "min–max [%]", "grade (draw 1)",
-                "features (draw 1)"):
-        table.add_column(col)
-    for variant, row in stats.iterrows():
-        one = first[first["variant"] == variant].iloc[0]
-        table.add_row(variant, f"{row['mean']:.1f} ± {row['std']:.1f}",
-                      f"{row['min']:.1f}–{row['max']:.1f}", str(one["grade"]), one["selected"])
-    console.print(table)
     full_pred = predictions[(predictions["variant"] == "full") & (predictions["repeat"] == 0)]
-    sizes = Table(title="full algorithm, draw 1: predicted vs true size")
-    for col in ("true size", "n segments", "mean predicted", "std"):
-        sizes.add_column(col)
-    for size, part in full_pred.groupby("true"):
-        sizes.add_row(f"{size:.2f}", str(len(part)), f"{part['predicted'].mean():.3f}",
-                      f"{part['predicted'].std():.3f}")
-    console.print(sizes)
+    _print_tables(console, stats, first, full_pred, draws)
     console.print(f"example: size {full['example_size']:.2f}; chosen grade {est.grade_} "
                   f"(hidden rig grade {rig.reveal().grade})")
 
@@ -113,17 +76,84 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
         "feature_errors": est.feature_errors_, "n_neighbors": int(est.n_neighbors_),
         "seconds": time.perf_counter() - t_start,
     }
+    report = _write_outputs(out, summary, figures, results, full_pred)
+    console.print(f"report: {report.resolve()}")
+    console.print(f"done in {summary['seconds']:.0f} s; outputs in {out.resolve()}")
+    return out
+
+
+def _demo_database(console, *, seed, n_healthy, n_faulty):
+    """Step 1: the cached demo database (grades 1–12 at the demo's condition, paired)."""
+    from .. import data_home
+    from ..sim import GearPair, build_database, load_database
+
+    store = data_home() / f"demo-db-h{n_healthy}-f{n_faulty}-s{seed}-paired"
+    console.rule(f"1. simulated database ({SPEED:g} rps, {LOAD:g} Nm, DIN grades 1–12)")
+    build_database(store, GearPair.paper(), speeds=[SPEED], loads=[LOAD], grades=range(1, 13),
+                   n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, paired=True)
+    database = load_database(store, speed=SPEED, load=LOAD)
+    console.print(f"{database.sizes['signal']} simulated SAs in {store}")
+    return database
+
+
+def _demo_campaign(console, *, seed, duration, repetitions):
+    """Step 2: the cached campaign of the rig ``seed``; returns (folder, rig)."""
+    from .. import data_home
+    from ..rig import VirtualRig
+
+    console.rule("2. virtual-rig campaign")
+    campaign = data_home() / f"demo-campaign-s{seed}-d{duration:g}-r{repetitions}"
+    rig = VirtualRig(seed=seed)
+    if not (campaign / "index.csv").is_file():
+        rig.campaign(campaign, speed=SPEED, load=LOAD, duration=duration,
+                     repetitions=repetitions)
+    console.print(f"recordings in {campaign}")
+    return campaign, rig
+
+
+def _demo_fit(campaign, database, *, seed, draws):
+    """Step 3: the full algorithm and its ablations over ``draws`` draws of the example
+    (the first draw's estimators kept)."""
+    from ..experiments import RIG_VARIANTS, rig_experiment
+    from ..transfer import TransferFunctionBank
+
+    selection_tf = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([seed, 99]))[0]
+    return rig_experiment(campaign, database, speed=SPEED, load=LOAD,
+                          selection_tf=selection_tf, variants=RIG_VARIANTS,
+                          n_repeats=draws, seed=seed, keep_estimators="first")
+
+
+def _print_tables(console, stats, first, full_pred, draws):
+    """The MAE table over draws and the first draw's predicted-vs-true table."""
+    table = Table(title=f"MAE of the fault-size estimate on the rig's test segments, over "
+                        f"{draws} draws of the faulty example")
+    for col in ("variant", "MAE mean ± std [%]", "min–max [%]", "grade (draw 1)",
+                "features (draw 1)"):
+        table.add_column(col)
+    for variant, row in stats.iterrows():
+        one = first[first["variant"] == variant].iloc[0]
+        table.add_row(variant, f"{row['mean']:.1f} ± {row['std']:.1f}",
+                      f"{row['min']:.1f}–{row['max']:.1f}", str(one["grade"]), one["selected"])
+    console.print(table)
+    sizes = Table(title="full algorithm, draw 1: predicted vs true size")
+    for col in ("true size", "n segments", "mean predicted", "std"):
+        sizes.add_column(col)
+    for size, part in full_pred.groupby("true"):
+        sizes.add_row(f"{size:.2f}", str(len(part)), f"{part['predicted'].mean():.3f}",
+                      f"{part['predicted'].std():.3f}")
+    console.print(sizes)
+
+
+def _write_outputs(out, summary, figures, results, full_pred):
+    """results.json, ablations.csv, predictions.csv and report.md; returns the report."""
+    from .markdown import write_report
+
     write_json_atomic(summary, out / "results.json", indent=2, sort_keys=False)
     with atomic_path(out / "ablations.csv") as tmp:
         results.drop(columns=["estimator"]).to_csv(tmp, index=False)
     with atomic_path(out / "predictions.csv") as tmp:
         full_pred.to_csv(tmp, index=False)
-    from .report import write_report
-
-    report = write_report(out, summary, figures)
-    console.print(f"report: {report.resolve()}")
-    console.print(f"done in {summary['seconds']:.0f} s; outputs in {out.resolve()}")
-    return out
+    return write_report(out, summary, figures)
 
 
 def _mae_stats(results):

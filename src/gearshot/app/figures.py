@@ -50,7 +50,7 @@ def simulated_figures(results: pd.DataFrame, out) -> dict:
         fig, ax = plt.subplots(figsize=(7, 3.5))
         plotting.plot_error_vs(results, by, ax=ax)
         figs[f"MAE vs {by}"] = plotting.save_figure(fig, out / name)[0]
-    from .report import write_report
+    from .markdown import write_report
 
     table = results.groupby("variant")["mae"].mean() * 100
     write_report(out, {"mae": float(table.get("full", np.nan)),
@@ -83,7 +83,7 @@ def rig_figures(results: pd.DataFrame, predictions: pd.DataFrame, out, *,
                                                    draws=n_draws, name="fig14b")
     if estimator is not None:
         figs.update(estimator_figures(estimator, out))
-    from .report import write_report
+    from .markdown import write_report
 
     write_report(out, {"mae": float(mae.get("full", np.nan)) * 100,
                        "ablations": (mae * 100).to_dict()}, figs)
@@ -153,7 +153,7 @@ def report_from_json(path, out) -> Path:
     if payload.get("experiment") == "simulated":
         simulated_figures(rows, out)
     else:
-        from .report import write_report
+        from .markdown import write_report
 
         grouped = rows.groupby("variant", sort=False)["mae"]
         mae = grouped.mean()

@@ -150,36 +150,51 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
         the gear train).
     """
-    from ..io import Recording
-
     machine.check_shaft(shaft, "--shaft")
     if isinstance(sensors, str):
         sensors = [sensors]
     names = [machine.sensor(s).name for s in
              (sensors or ([sensor] if sensor else [s.name for s in machine.sensors]))]
     ratio = float(machine.speed_ratio(shaft))
-    baselines: dict[str, float | None] = {n: None for n in names}
-    if baseline_paths:
-        recs = [Recording.read(p, machine=machine) for p in baseline_paths]
-        baselines = {n: baseline_variance(recs, machine, shaft=shaft, sensor=n) for n in names}
-    records = []
-    for path in paths:
-        rec = Recording.read(path, machine=machine)
-        tacho = float(rec.shaft_speed())
-        for name in names:
-            res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
-                                   baseline=baselines[name])[name]
-            records.append({"file": Path(path).name, "sensor": name,
-                            "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
-                            "speed_source": rec.speed_source,
-                            "speed_uncertainty_hz": rec.speed_uncertainty,
-                            "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
+    baselines = _baselines(baseline_paths, machine, shaft, names)
+    records = [row for path in paths
+               for row in _record_rows(path, machine, shaft, names, baselines, ratio)]
     units = {n: indicator_units(machine, n) for n in names}
     return {"kind": "indicators", "machine": machine.name,
             "machine_file": None if machine_file is None else str(machine_file),
             "shaft": shaft, "tacho_shaft": machine.reference_shaft, "shaft_speed_ratio": ratio,
             "units": {"speeds": "Hz (revolutions per second)", "indicators": units},
             "records": records}
+
+
+def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
+               names: Sequence[str]) -> dict[str, float | None]:
+    """NA4's baseline variance per sensor from healthy recordings (None without any)."""
+    from ..io import Recording
+
+    if not baseline_paths:
+        return {n: None for n in names}
+    recs = [Recording.read(p, machine=machine) for p in baseline_paths]
+    return {n: baseline_variance(recs, machine, shaft=shaft, sensor=n) for n in names}
+
+
+def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
+                 baselines: dict[str, float | None], ratio: float) -> list[dict[str, Any]]:
+    """The payload records of one file: one per sensor."""
+    from ..io import Recording
+
+    rec = Recording.read(path, machine=machine)
+    tacho = float(rec.shaft_speed())
+    rows = []
+    for name in names:
+        res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
+                               baseline=baselines[name])[name]
+        rows.append({"file": Path(path).name, "sensor": name,
+                     "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
+                     "speed_source": rec.speed_source,
+                     "speed_uncertainty_hz": rec.speed_uncertainty,
+                     "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
+    return rows
 
 
 def _case_of(file_name: str) -> tuple[str, str]:

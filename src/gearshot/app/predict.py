@@ -12,7 +12,8 @@ from .._errors import GearshotError
 from .._validation import check_in_range
 from ..paper import GEAR_TEETH, PINION_TEETH
 
-__all__ = ["predict_from_files", "ROLES"]
+__all__ = ["predict_from_files", "predict_recordings", "write_predictions",
+           "format_predictions", "comparable_summary", "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
 #: the fit. ``healthy_fitted``: a healthy segment the estimator was fitted on (an
@@ -58,7 +59,6 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
-    from ..io import recording_segments
     from ..sim import load_database
     from .conditions import choose_condition
     from .files import expand_recordings
@@ -79,22 +79,11 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    # every recording is read and segmented before the fit: a file too short for one SA
-    # segment (or unreadable) fails now, not after minutes of fitting
-    targets = [(path, recording_segments(path, **kw)) for path in files]
-    healthy_sa, long = [], None
-    for i, p in enumerate(healthy):
-        if i == 0:
-            sa, long = recording_segments(p, long=True, **kw)
-        else:
-            sa = recording_segments(p, **kw)
-        healthy_sa.append(sa)
-    example = recording_segments(faulty, **kw)[0]
+    targets, healthy_sa, long, example = _segments(files, healthy, faulty, kw)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, np.vstack(healthy_sa), example, faulty_size, long, selection_tf=selection_tf,
-            **kw)
+    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
     fitted = {_key(p) for p in healthy}
     frames = []
     for path, sa in targets:
@@ -109,6 +98,27 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load
     return frame
+
+
+def _segments(files, healthy, faulty, kw):
+    """SA segments of the targets, the healthy recordings (stacked; the first one's long
+    angle-domain signal too) and the faulty example (the faulty recording's first segment).
+
+    Every recording is read and segmented before the fit: a file too short for one SA
+    segment (or unreadable) fails now, not after minutes of fitting.
+    """
+    from ..io import recording_segments
+
+    targets = [(path, recording_segments(path, **kw)) for path in files]
+    healthy_sa, long = [], None
+    for i, p in enumerate(healthy):
+        if i == 0:
+            sa, long = recording_segments(p, long=True, **kw)
+        else:
+            sa = recording_segments(p, **kw)
+        healthy_sa.append(sa)
+    example = recording_segments(faulty, **kw)[0]
+    return targets, np.vstack(healthy_sa), long, example
 
 
 def _key(path) -> Path:
@@ -138,3 +148,81 @@ def summary_table(frame: pd.DataFrame, roles: Sequence[str] = ROLES) -> pd.DataF
     table["recording"] = [Path(r).name for r in table["recording"]]
     return table.rename(columns={"estimated_size": "mean estimated size",
                                  "low": "mean low", "high": "mean high"})
+
+
+def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, machine=None,
+                       speed=None, load=None, coverage=0.9, gear_teeth=None, pinion_teeth=None,
+                       seed=0, cycles_per_segment=None, sensor=None, holdout=0.25,
+                       speed_tolerance=0.05) -> tuple[pd.DataFrame, str]:
+    """``gearshot predict``: fit and estimate, through a machine file or without one.
+
+    With ``machine`` (a TOML path): :func:`gearshot.app.predict_machine.predict_from_machine`
+    (speeds in tacho-shaft Hz, ``speed`` None: from the healthy recordings' tacho).
+    Without: :func:`predict_from_files` (``speed`` required, in rps; at least one
+    recording).
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        One row per SA segment (see the two functions).
+    where : str
+        One line naming the database condition the estimates were made at.
+    """
+    from .files import expand_recordings
+
+    if machine is not None:
+        from ..machine import Machine
+        from .predict_machine import predict_from_machine
+
+        frame = predict_from_machine(Machine.from_toml(machine), database, healthy, faulty,
+                                     faulty_size, expand_recordings(recordings, "--recordings"),
+                                     speed=speed, load=load,
+                                     cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                     holdout=holdout, coverage=coverage, seed=seed,
+                                     speed_tolerance=speed_tolerance)
+        return frame, (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, "
+                       f"load {frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}")
+    if speed is None:
+        raise GearshotError("--speed is required without --machine (the database's "
+                            "speed, rps)")
+    if not recordings:
+        raise GearshotError("--recordings: give at least one file or folder to estimate")
+    frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
+                               speed=speed, load=load, coverage=coverage,
+                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed)
+    return frame, (f"database condition: {frame.attrs['speed']:g} rps, load "
+                   f"{frame.attrs['load']:g} N m")
+
+
+def write_predictions(frame: pd.DataFrame, out: str | Path) -> Path:
+    """Write a predict table to ``out``: JSON records when it ends in ``.json``, else CSV
+    (through :func:`gearshot._atomic.atomic_path`)."""
+    from .._atomic import atomic_path
+
+    out = Path(out)
+    with atomic_path(out, make_parents=True) as tmp:
+        if out.suffix.lower() == ".json":
+            tmp.write_text(frame.to_json(orient="records", indent=2))
+        else:
+            frame.to_csv(tmp, index=False)
+    return out
+
+
+def comparable_summary(frame: pd.DataFrame) -> str:
+    """One line counting the comparable segments of a predict table (issue #19)."""
+    if "comparable" not in frame or not len(frame):
+        return "comparable: no segment estimated"
+    n_yes = int(frame["comparable"].sum())
+    n_no = len(frame) - n_yes
+    line = f"comparable: {n_yes} segment(s), not comparable: {n_no}"
+    if n_no:
+        line += (" (they do not look like the fitted machine — another build, speed, load "
+                 "or sensor? — do not act on their estimates)")
+    return line
+
+
+def format_predictions(frame: pd.DataFrame, where: str) -> str:
+    """What ``gearshot predict`` prints: the condition, the summary per recording and
+    role (:func:`summary_table`) and the comparability count."""
+    table = summary_table(frame).to_string(index=False, float_format=lambda v: f"{v:.3f}")
+    return "\n".join([where, table, comparable_summary(frame)])

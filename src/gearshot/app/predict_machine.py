@@ -4,6 +4,7 @@ machine description (gear train, tacho, sensors, file layout)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,7 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
+from .load_choice import LoadChoice, choose_load
 
 __all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
 
@@ -100,9 +102,11 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         Tacho-shaft speed of the database condition, Hz (rev/s). Default: the database
         speed nearest to the healthy recordings' tacho speed (their median).
     load : float, optional
-        Load of the database slice, N m. Default: the database's only load (an
-        unquantified load: build the database at one load, see
-        :mod:`gearshot.app.conditions`).
+        Load of the database slice, N m. Default: the database's only load; with a
+        database over several loads, the load whose simulated healthy signals best match
+        the healthy recordings (:func:`gearshot.app.load_choice.choose_load`), refused with
+        one line when the choice is ambiguous (clarity below
+        :data:`~gearshot.app.load_choice.MIN_CLARITY`).
     speed_tolerance : float
         Every recording's tacho speed must lie within this relative distance of the
         condition, else a :class:`~gearshot.GearshotError` names the file, its speed and
@@ -124,91 +128,169 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, speed_hz, database_speed_hz, predicted, low, high,
-        comparability, comparable, speed_source, speed_uncertainty_hz`` (``speed_hz``: the
+        ``recording, role, segment, speed_hz, database_speed_hz, database_load,
+        load_source, load_clarity, predicted, low, high, comparability, comparable,
+        speed_source, speed_uncertainty_hz`` (``database_load``: the load estimated at,
+        N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
+        (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
         ``comparability``/``comparable``: the score of
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
         segment looks like the fitted machine; ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
-        ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``), the grade and
-        the simulated reference.
+        ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
+        ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
+        reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
-    from ..sim import load_database
 
-    cps = machine.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
-    if cps is None:
-        raise GearshotError("the machine file says cycles_per_segment = 'all'; predict needs "
-                            "several segments per record: pass --cycles-per-segment")
-    cps = check_int(cps, "cycles_per_segment", minimum=1)
-    holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
-    spc = machine.samples_per_cycle
-    if not healthy:
-        raise GearshotError("--healthy needs at least one recording")
-    for p in [*healthy, faulty, *recordings]:
-        if not Path(p).is_file():
-            raise GearshotError(f"recording {str(p)!r} does not exist")
-    db_speeds, _ = database_conditions(database, machine)   # a bad --database fails now
-    rows = []
-    sources: dict[str, dict] = {}
-    train, long = [], None
-    speeds: dict[str, float] = {}
-    for p in healthy:
-        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
-                                     info=sources.setdefault(str(p), {}))
-        speeds[str(p)] = sp
-        n_hold = int(np.floor(holdout * sa.shape[0]))
-        n_fit = sa.shape[0] - n_hold
-        if n_fit < 1:
-            raise GearshotError(f"{str(p)!r}: no segment left for the fit after holdout="
-                                f"{holdout}")
-        train.append(sa[:n_fit])
-        if long is None:
-            long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
-        for k in range(n_fit, sa.shape[0]):
-            rows.append((str(p), "healthy_holdout", k, sp, sa[k]))
-    fsa, _, fsp = machine_segments(faulty, machine, cycles_per_segment=cps, sensor=sensor,
-                                   info=sources.setdefault(str(faulty), {}))
-    speeds.setdefault(str(faulty), fsp)
-    example_segment = check_int(example_segment, "example_segment", minimum=0,
-                                maximum=fsa.shape[0] - 1)
-    for k in range(fsa.shape[0]):
-        if k != example_segment:
-            rows.append((str(faulty), "faulty_rest", k, fsp, fsa[k]))
-    for p in recordings:
-        sa, _, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
-                                     info=sources.setdefault(str(p), {}))
-        speeds.setdefault(str(p), sp)
-        rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
-    cond_speed, cond_load = choose_condition(database, machine, speed=speed, load=load,
-                                             measured=[speeds[str(p)] for p in healthy])
-    check_speeds(list(speeds.items()), cond_speed, conditions=db_speeds,
-                 tolerance=speed_tolerance)
-    db = load_database(database, speed=machine.sim_speed(cond_speed), load=cond_load)
+    cps = _check_options(machine, healthy, [faulty, *recordings], cycles_per_segment,
+                         holdout)
+    database_conditions(database, machine)   # a bad --database fails now
+    seg = _segment_recordings(machine, healthy, faulty, recordings, cps=cps, sensor=sensor,
+                              holdout=holdout, example_segment=example_segment)
+    cond = _condition(database, machine, seg, speed=speed, load=load,
+                      speed_tolerance=speed_tolerance)
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
     # too), on the simulated side as on the recorded one
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
                                    "mesh_order": meshes})
     # the database must be of the machine's monitored pair (refused otherwise)
-    est.fit(db, np.vstack(train), fsa[example_segment], faulty_size, long,
+    est.fit(cond.slice, np.vstack(seg.train), seg.example, faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1])
-    frame = pd.DataFrame([r[:4] for r in rows],
+    frame = _estimates(est, seg, cond, coverage)
+    frame.attrs["grade"] = getattr(est, "grade_", None)
+    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
+    return frame
+
+
+def _check_options(machine, healthy, others, cycles_per_segment, holdout) -> int:
+    """The SA segment length in cycles, after checking the options and the files."""
+    cps = machine.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
+    if cps is None:
+        raise GearshotError("the machine file says cycles_per_segment = 'all'; predict needs "
+                            "several segments per record: pass --cycles-per-segment")
+    cps = check_int(cps, "cycles_per_segment", minimum=1)
+    check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
+    if not healthy:
+        raise GearshotError("--healthy needs at least one recording")
+    for p in [*healthy, *others]:
+        if not Path(p).is_file():
+            raise GearshotError(f"recording {str(p)!r} does not exist")
+    return cps
+
+
+@dataclass
+class _Segments:
+    """The SA segments of every recording, by role."""
+
+    rows: list = field(default_factory=list)    # (file, role, segment, speed, sa)
+    train: list = field(default_factory=list)   # healthy segments of the fit
+    long: np.ndarray | None = None              # angle-domain signal for the TF estimate
+    example: np.ndarray | None = None           # the faulty example's SA
+    speeds: dict = field(default_factory=dict)  # file -> tacho speed, Hz
+    healthy_speeds: list = field(default_factory=list)
+    sources: dict = field(default_factory=dict)  # file -> speed_source, uncertainty
+
+
+def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, holdout,
+                        example_segment) -> _Segments:
+    """Cut every recording into SA segments; healthy hold-outs, the example, the rest."""
+    spc = machine.samples_per_cycle
+    seg = _Segments()
+
+    def cut(p):
+        sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
+                                     info=seg.sources.setdefault(str(p), {}))
+        seg.speeds.setdefault(str(p), sp)
+        return sa, x, sp
+
+    for p in healthy:
+        sa, x, sp = cut(p)
+        seg.healthy_speeds.append(sp)
+        n_fit = sa.shape[0] - int(np.floor(holdout * sa.shape[0]))
+        if n_fit < 1:
+            raise GearshotError(f"{str(p)!r}: no segment left for the fit after holdout="
+                                f"{holdout}")
+        seg.train.append(sa[:n_fit])
+        if seg.long is None:
+            seg.long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
+        seg.rows.extend((str(p), "healthy_holdout", k, sp, sa[k])
+                        for k in range(n_fit, sa.shape[0]))
+    fsa, _, fsp = cut(faulty)
+    example_segment = check_int(example_segment, "example_segment", minimum=0,
+                                maximum=fsa.shape[0] - 1)
+    seg.example = fsa[example_segment]
+    seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
+                    for k in range(fsa.shape[0]) if k != example_segment)
+    for p in recordings:
+        sa, _, sp = cut(p)
+        seg.rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))
+    return seg
+
+
+@dataclass
+class _Condition:
+    """The database condition estimated at, and how its load was found."""
+
+    speed: float                 # tacho-shaft Hz
+    load: float                  # N m
+    load_source: str             # "given", "only" (the database's one load) or "chosen"
+    slice: object = None         # the database slice (xarray.Dataset)
+    choice: LoadChoice | None = None
+
+
+def _condition(database, machine, seg: _Segments, *, speed, load,
+               speed_tolerance) -> _Condition:
+    """The (speed, load) condition, every recording's speed checked against it: the load
+    given, the database's only load, or the load the healthy recordings pick from a
+    database over several (refused when the choice is ambiguous)."""
+    from ..sim import load_database
+
+    db_speeds, loads = database_conditions(database, machine)
+    several = load is None and len(loads) > 1
+    cond_speed, cond_load = choose_condition(database, machine, speed=speed,
+                                             load=loads[0] if several else load,
+                                             measured=seg.healthy_speeds)
+    check_speeds(list(seg.speeds.items()), cond_speed, conditions=db_speeds,
+                 tolerance=speed_tolerance)
+    choice, source = None, "given" if load is not None else "only"
+    if several:
+        assert seg.long is not None  # at least one healthy recording was cut
+        choice = choose_load(database, machine.sim_speed(cond_speed), np.vstack(seg.train),
+                             seg.long, mesh_order=machine.monitored.teeth)
+        if choice.ambiguous:
+            raise GearshotError(
+                f"--load is needed: the healthy recordings do not tell the loads of database "
+                f"{str(database)!r} apart ({choice.describe()}); give --load, or build the "
+                f"database at one nominal load and leave --load out")
+        cond_load, source = choice.load, "chosen"
+    db = load_database(database, speed=machine.sim_speed(cond_speed), load=cond_load)
+    return _Condition(cond_speed, cond_load, source, db, choice)
+
+
+def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.DataFrame:
+    """One row per estimated segment, with the condition and how it was found."""
+    frame = pd.DataFrame([r[:4] for r in seg.rows],
                          columns=["recording", "role", "segment", "speed_hz"])
-    frame["database_speed_hz"] = cond_speed
-    if rows:
-        sas = np.stack([r[4] for r in rows])
+    frame["database_speed_hz"] = cond.speed
+    frame["database_load"] = cond.load
+    frame["load_source"] = cond.load_source
+    frame["load_clarity"] = None if cond.choice is None else cond.choice.clarity
+    if seg.rows:
+        sas = np.stack([r[4] for r in seg.rows])
         low, high = est.predict_interval(sas, coverage=coverage)
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
         frame["comparability"], frame["comparable"] = _comparability_columns(est, sas)
-    frame.attrs["speed_hz"], frame.attrs["load"] = cond_speed, cond_load
-    frame["speed_source"] = [sources[r]["speed_source"] for r in frame["recording"]]
-    frame["speed_uncertainty_hz"] = [sources[r]["speed_uncertainty_hz"]
+    frame.attrs["speed_hz"], frame.attrs["load"] = cond.speed, cond.load
+    frame.attrs["load_source"] = cond.load_source
+    frame.attrs["load_choice"] = None if cond.choice is None else cond.choice.as_dict()
+    frame.attrs["load_note"] = "" if cond.choice is None else f" ({cond.choice.describe()})"
+    frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
+    frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
-    frame.attrs["grade"] = getattr(est, "grade_", None)
-    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame

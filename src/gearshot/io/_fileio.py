@@ -28,6 +28,7 @@ __all__ = [
     "write_json_atomic",
     "select_channels",
     "reconcile_fs",
+    "machine_channels",
     "time_column_fs",
     "METADATA_KEYS",
     "ACCEL_NAMES",
@@ -212,11 +213,11 @@ def reconcile_fs(raw: RawFile, fs: Any) -> float:
     if isinstance(fs, bool) or not isinstance(fs, (int, float, np.number)) or not (
             math.isfinite(fs) and fs > 0):
         raise GearshotError(f"fs must be a finite positive number (Hz); got {describe(fs)}")
-    fs = float(fs)
-    if file_fs is not None and abs(fs - file_fs) > 1e-9 * file_fs:
-        raise GearshotError(f"fs={fs!r} conflicts with the sampling rate {file_fs!r} Hz stated "
-                            f"in {str(raw.path)!r}")
-    return fs
+    rate = float(fs)
+    if file_fs is not None and abs(rate - file_fs) > 1e-9 * file_fs:
+        raise GearshotError(f"fs={rate!r} conflicts with the sampling rate {file_fs!r} Hz "
+                            f"stated in {str(raw.path)!r}")
+    return rate
 
 
 def time_column_fs(path: Path, t: np.ndarray) -> float:
@@ -230,3 +231,19 @@ def time_column_fs(path: Path, t: np.ndarray) -> float:
         raise GearshotError(f"{str(path)!r}: the time column is not uniformly spaced "
                             f"(steps {dt.min()!r} .. {dt.max()!r} s)")
     return float(f"{1.0 / step:.9g}")  # time columns carry rounding noise
+
+
+def machine_channels(raw: RawFile, machine: Any
+                     ) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
+    """Sensor channels (scaled to physical units) and the tacho of a file, by the machine."""
+    rows = []
+    for s in machine.sensors:
+        name = _resolve(raw, f"sensor {s.name!r} channel", s.channel, {})
+        row = np.asarray(raw.channels[name], dtype=np.float64).ravel() / s.sensitivity
+        rows.append(row - row.mean() if s.ac_coupled else row)
+    tac = None
+    if machine.tacho is not None:  # no [tacho]: the speed comes from the vibration
+        tname = _resolve(raw, "tacho.channel", machine.tacho.channel, {})
+        tac = np.asarray(raw.channels[tname], dtype=np.float64).ravel()
+    acc = rows[0] if len(rows) == 1 else np.stack(rows)
+    return acc, tac, tuple(s.name for s in machine.sensors)

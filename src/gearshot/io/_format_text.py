@@ -21,6 +21,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from ._fileio import TIME_NAMES, RawFile, read_sidecar, time_column_fs
+from ._fixed_width import read_fixed_width
 
 __all__ = ["read_text", "TEXT_SUFFIXES", "read_text_bytes"]
 
@@ -141,6 +142,12 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
     """
     path = Path(path)
     data = read_text_bytes(path)
+    table = None
+    if skip_rows == 0 and header is not True and delimiter in (..., None):
+        table = read_fixed_width(data)  # the PHM09 layout: no tokenizing, exact
+    if table is not None:
+        return _raw_file(path, [str(i) for i in range(table.shape[1])],
+                         [table[:, i] for i in range(table.shape[1])], columns, header=False)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
@@ -169,6 +176,14 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
     if n_read != n_cols and not header:
         raise GearshotError(f"{str(path)!r}: rows have {n_cols} values but {n_read} "
                             f"columns were read (ragged file?)")
+    return _raw_file(path, names, cols, columns, header=bool(header))
+
+
+def _raw_file(path: Path, names: list[str], cols: list[np.ndarray],
+              columns: Sequence[str] | None, *, header: bool) -> RawFile:
+    """The channels read, renamed by ``columns``, checked for missing values, with the
+    sampling rate of a sidecar or a time column."""
+    n_read = len(cols)
     if columns is not None:
         columns = [str(c) for c in columns]
         if len(columns) != n_read:
@@ -192,5 +207,5 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
                 fs = time_column_fs(path, chans[name])
             break
     return RawFile(path, chans, fs, dict(side.get("metadata", {})),
-                   positional_defaults=bool(header) and columns is None,
+                   positional_defaults=header and columns is None,
                    time_channel=time_name)

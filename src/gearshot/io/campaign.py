@@ -17,7 +17,7 @@ INDEX_NAME = "index.csv"
 INDEX_COLUMNS = ["path", "speed", "load", "fault_size", "repetition"]
 
 
-def read_campaign(folder: str | os.PathLike) -> pd.DataFrame:
+def read_campaign(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """The index of a campaign folder, with absolute paths."""
     import pandas as pd  # imported on use: reading one recording never needs it
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
@@ -10,10 +12,11 @@ from .recording import Recording
 __all__ = ["recording_segments"]
 
 
-def recording_segments(path, *, gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
-                       cycles_per_segment=CYCLES_PER_SEGMENT,
-                       samples_per_cycle=SAMPLES_PER_CYCLE,
-                       long=False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
+                       pinion_teeth: int = PINION_TEETH,
+                       cycles_per_segment: int | None = CYCLES_PER_SEGMENT,
+                       samples_per_cycle: int = SAMPLES_PER_CYCLE,
+                       long: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """SA segments (and optionally the angle-domain signal) of one recording file."""
     rec = Recording.read(path)
     sa = rec.to_sa_segments(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,

@@ -68,23 +68,16 @@ class IrregularFaceFault(FullToothFaceFault):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        rough = tuple(float(r) for r in self.roughness)
-        if not all(np.isfinite(rough)) or sum(abs(r) for r in rough) >= 1.0:
-            raise GearshotError(f"roughness must be finite with absolute sum < 1; got "
-                                f"{self.roughness!r}")
-        object.__setattr__(self, "roughness", rough)
+        object.__setattr__(self, "roughness", check_roughness(self.roughness))
 
     def depth_profile(self, s: np.ndarray) -> np.ndarray:
-        """Depth factor at roll fractions ``s`` (1 outside the cut)."""
+        """Depth factor at roll fractions ``s`` (:func:`shape_factor` across the cut; its
+        edge values beyond it)."""
         s = np.asarray(s, dtype=float)
         s0, s1 = self.window
         if s1 <= s0:
             return np.ones_like(s)
-        x = np.clip((s - s0) / (s1 - s0), 0.0, 1.0)
-        profile = np.ones_like(x)
-        for k, r in enumerate(self.roughness):
-            profile = profile + r * np.cos((k + 1) * np.pi * x)
-        return profile
+        return shape_factor((s - s0) / (s1 - s0), self.roughness)
 
     def section_loss(self, pair, x: np.ndarray) -> np.ndarray:
         base = super().section_loss(pair, x)
@@ -97,7 +90,6 @@ class IrregularFaceFault(FullToothFaceFault):
 
     def displacement(self, pair, s: np.ndarray) -> np.ndarray:
         return super().displacement(pair, s) * self.depth_profile(s)
-
 
 
 def check_roughness(roughness) -> tuple[float, ...]:
@@ -153,14 +145,10 @@ class IrregularBreakage(ToothBreakage):
         object.__setattr__(self, "roughness", check_roughness(self.roughness))
         super().__post_init__()
 
-    def lost_height(self, pair, zeta) -> np.ndarray:
+    def line_shape(self, zeta) -> np.ndarray:
         zeta = np.asarray(zeta, dtype=float)
         share = self.share
-        chip = (1 + self.corner) * np.clip(1 - zeta / self.corner_width, 0.0, None)
-        factor = shape_factor(zeta / share if share > 0 else zeta, self.roughness)
-        h = self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip) * factor,
-                                               0.0, 1.0)
-        return np.where(zeta <= share + 1e-12, h, 0.0)
+        return shape_factor(zeta / share if share > 0 else zeta, self.roughness)
 
 
 @dataclass(frozen=True)

@@ -6,16 +6,18 @@ tests and benchmarks may :meth:`VirtualRig.reveal` it to check the gap is real.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import check_int
+from .._validation import check_in_range, check_int
 from ..paper import GEAR_TEETH, PINION_TEETH
 
-__all__ = ["RigReality", "draw_reality"]
+__all__ = ["RigReality", "draw_reality", "override_reality"]
 
 
 @dataclass(frozen=True)
@@ -171,3 +173,41 @@ def draw_reality(rng: np.random.Generator, *, n_tfs: int = 1,
         tf_index=int(rng.integers(n_tfs)),
         tacho_jitter=float(rng.uniform(1e-4, 5e-4)),
     )
+
+
+_RANGES = {  # field -> (low, high) accepted by with_reality / reality_overrides
+    "snr_db": (0.0, 200.0), "attenuation_db": (-60.0, 200.0), "speed_drift": (0.0, 0.05),
+    "speed_ripple": (0.0, 0.05), "load_ripple": (0.0, 0.5), "motor_level": (0.0, 10.0),
+    "extra_level": (0.0, 10.0), "impact_level": (0.0, 10.0), "tacho_jitter": (0.0, 0.01),
+    "fault_center": (0.0, 1.0), "fault_depth": (0.01, 1.0), "damping_factor": (0.1, 10.0),
+    "bearing_stiffness_factor": (0.1, 10.0), "shaft_stiffness_factor": (0.1, 10.0),
+    "mesh_stiffness_factor": (0.1, 10.0), "motor_slip": (0.0, 0.5),
+    "impact_frequency": (1.0, 1e6), "extra_order": (0.01, 1000.0),
+    "impact_order": (0.01, 1000.0),
+}
+
+
+def override_reality(reality: RigReality, changes: Mapping[str, Any], *,
+                     n_tfs: int) -> RigReality:
+    """``reality`` with validated field changes (``VirtualRig.with_reality``,
+    ``reality_overrides``); ``n_tfs``: the size of the rig's TF bank."""
+    fields = set(reality.as_dict())
+    out: dict[str, Any] = {}
+    for key, value in changes.items():
+        if key not in fields:
+            raise GearshotError(f"reality has no field {key!r}; fields: {sorted(fields)}")
+        if key == "grade":
+            out[key] = check_int(value, "grade", minimum=1, maximum=12)
+        elif key == "tf_index":
+            out[key] = check_int(value, "tf_index", minimum=0, maximum=n_tfs - 1)
+        elif key in ("profile_seed", "motor_pole_pairs"):
+            out[key] = check_int(value, key, minimum=0 if key == "profile_seed" else 1)
+        elif key in _RANGES:
+            out[key] = check_in_range(value, key, *_RANGES[key])
+        else:  # tuples: mass/inertia factors, fault edges/roughness
+            arr = tuple(float(v) for v in value)
+            if len(arr) != len(getattr(reality, key)):
+                raise GearshotError(f"{key} must hold {len(getattr(reality, key))} numbers; "
+                                    f"got {value!r}")
+            out[key] = arr
+    return dataclasses.replace(reality, **out)

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import check_int
+from ..fault_registry import check_fault_type
 from .irregular import IrregularFaceFault, physical_fault_of_type
 from .reality import RigReality
 
@@ -72,7 +73,8 @@ class SimulatorEngine:
     nominal_grade : int
         DIN grade used when ``reality`` is None (the nominal model).
     fault_type : str
-        The fault the rig grows (:data:`gearshot.sim.FAULT_TYPES`; default ``"ftff"``).
+        The fault the rig grows (:data:`gearshot.fault_registry.FAULT_TYPE_NAMES`;
+        default ``"ftff"``).
     """
 
     pair: object = field(default=None)
@@ -80,8 +82,6 @@ class SimulatorEngine:
     fault_type: str = "ftff"
 
     def __post_init__(self) -> None:
-        from ..sim.fault_types import check_fault_type
-
         check_int(self.nominal_grade, "nominal_grade", minimum=1, maximum=12)
         check_fault_type(self.fault_type)
 

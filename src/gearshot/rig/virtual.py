@@ -27,7 +27,6 @@ whole run); :class:`~gearshot.rig.surrogate.SurrogateEngine` is a fast stand-in.
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -37,17 +36,17 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._atomic import atomic_path, check_writable, staging_dir
+from .._atomic import atomic_path, check_writable, commit_staged, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
+from ..fault_registry import check_fault_type
 from ..io import INDEX_COLUMNS, INDEX_NAME, Recording
 from ..paper import GEAR_TEETH, PINION_TEETH, TABLE1_SIZES
 from ..signal.level import rms
-from ..sim.fault_types import check_fault_type
 from .interference import add_noise, bearing_impacts, extra_shaft, motor_harmonics
 from .motion import load_torque, motor_angle, ramp_angle
 from .path import apply_path, as_tf_list, path_fir, synthetic_path_tfs
-from .reality import RigReality, draw_reality
+from .reality import RigReality, draw_reality, override_reality
 from .sim_engine import SimulatorEngine
 from .surrogate import SurrogateEngine
 from .tacho import tacho_signal
@@ -88,7 +87,7 @@ class VirtualRig:
         :meth:`with_reality`).
     fault_type : str
         The fault this rig grows (``"ftff"``, default; ``"partial_face"``, ``"breakage"``,
-        ``"destruction"``: :data:`gearshot.sim.FAULT_TYPES`); ``fault_size`` of
+        ``"destruction"``: :data:`gearshot.fault_registry.FAULT_TYPE_NAMES`); ``fault_size`` of
         :meth:`record` is its size label. The hidden reality makes each type irregular
         (:mod:`gearshot.rig.irregular`). The ``"sim"`` engine grows every type, the
         surrogate only the FTFF; a callable engine gets ``fault_type=`` as a keyword when
@@ -149,7 +148,7 @@ class VirtualRig:
             overrides = dict(self.reality_overrides or {})
             if self.grade is not None:
                 overrides["grade"] = self.grade
-            reality = _override(reality, overrides, n_tfs=len(tfs))
+            reality = override_reality(reality, overrides, n_tfs=len(tfs))
             tf = tfs[reality.tf_index]
             fir = path_fir(tf, fs, attenuation_db=reality.attenuation_db,
                            n_taps=min(2 * (tf.freqs.size - 1), 16384))
@@ -215,41 +214,19 @@ class VirtualRig:
         fault_size = check_in_range(fault_size, "fault_size", 0.0, 1.0)
         duration = check_positive(duration, "duration")
         repetition = check_int(repetition, "repetition", minimum=0)
+        if end_speed is not None:
+            end_speed = check_positive(end_speed, "end_speed")
         fs = float(self.fs)
         rng = np.random.default_rng([int(self.seed), 2, _key(speed), _key(load),
                                      _key(fault_size), repetition])
         n_settle = int(round(self.settle * fs))
-        n = int(round(duration * fs))
-        t = np.arange(n_settle + n) / fs
-        # relative position of the wheels at the start: a whole number of pinion turns
-        # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
-        start = float(rng.integers(0, self.gear_teeth))
-        if end_speed is None:
-            motor = motor_angle(t, speed=speed, drift=reality.speed_drift,
-                                ripple=reality.speed_ripple, rng=rng, start=start)
-        else:
-            end_speed = check_positive(end_speed, "end_speed")
-            motor = ramp_angle(t, speed=speed, end_speed=end_speed, t_start=self.settle,
-                               t_end=float(t[-1]), ripple=reality.speed_ripple, rng=rng,
-                               start=start)
+        t = np.arange(n_settle + int(round(duration * fs))) / fs
+        motor = self._motor(t, speed, end_speed, reality, rng)
         torque = load_torque(motor * self.pinion_teeth / self.gear_teeth, load=load,
                              ripple=reality.load_ripple, rng=rng)
         engine = self._engine()
-        vib = np.asarray(engine(motor_revs=motor, load_torque=torque, fs=fs,
-                            fault_size=fault_size, reality=reality, rng=rng),
-                     dtype=np.float64)
-        if vib.shape != motor.shape or not np.all(np.isfinite(vib)):
-            raise GearshotError(f"the physics engine returned shape {vib.shape} or non-finite "
-                                f"values; expected {motor.shape} finite")
-        level = rms(vib[n_settle:])
-        vib = vib + level * (
-            reality.motor_level * motor_harmonics(t, speed=speed,
-                                                  pole_pairs=reality.motor_pole_pairs,
-                                                  slip=reality.motor_slip, rng=rng)
-            + reality.extra_level * extra_shaft(motor, order=reality.extra_order, rng=rng)
-            + reality.impact_level * bearing_impacts(motor, fs, order=reality.impact_order,
-                                                     frequency=reality.impact_frequency,
-                                                     rng=rng))
+        vib = _engine_vibration(engine, motor, torque, fs, fault_size, reality, rng)
+        vib = vib + rms(vib[n_settle:]) * _interference(t, motor, fs, speed, reality, rng)
         acc = apply_path(vib, fir)[n_settle:]
         acc = add_noise(acc, snr_db=reality.snr_db, rng=rng)
         tach = tacho_signal(motor[n_settle:], jitter=reality.tacho_jitter, rng=rng)
@@ -263,6 +240,20 @@ class VirtualRig:
             extras={"repetition": repetition, "rig_seed": int(self.seed),
                     "engine": type(getattr(engine, "func", engine)).__name__,
                     "fault_type": self.fault_type, **extras})
+
+    def _motor(self, t: np.ndarray, speed: float, end_speed: float | None,
+               reality: RigReality, rng: np.random.Generator) -> np.ndarray:
+        """Input-shaft angle (rev) over ``t``: drifting speed, or a ramp to ``end_speed``
+        over the recorded span; the per-revolution ripple either way."""
+        # relative position of the wheels at the start: a whole number of pinion turns
+        # (the tacho mark sits on the pinion), so SAs of different runs differ by whole teeth
+        start = float(rng.integers(0, self.gear_teeth))
+        if end_speed is None:
+            return motor_angle(t, speed=speed, drift=reality.speed_drift,
+                               ripple=reality.speed_ripple, rng=rng, start=start)
+        return ramp_angle(t, speed=speed, end_speed=end_speed, t_start=self.settle,
+                          t_end=float(t[-1]), ripple=reality.speed_ripple, rng=rng,
+                          start=start)
 
     # ------------------------------------------------------------------ campaigns
     @staticmethod
@@ -281,9 +272,11 @@ class VirtualRig:
         ``index.csv`` (rows of other conditions already in the folder are kept; rows of
         this condition are replaced).
 
-        Everything is first written to a hidden staging folder inside ``folder``; only when
-        all recordings succeeded are they moved into place (``os.replace``) and the index
-        replaced. A failed campaign leaves no partial file behind and the old index intact.
+        Everything is first written to a hidden staging folder inside ``folder``
+        (:func:`gearshot._atomic.staging_dir`); only when all recordings succeeded are they
+        moved into place and the index replaced, last
+        (:func:`gearshot._atomic.commit_staged`). A failed campaign leaves no partial file
+        behind and the old index intact.
 
         Returns
         -------
@@ -294,83 +287,87 @@ class VirtualRig:
         folder = Path(folder)
         speed = check_speed(speed)
         load = check_load(load)
-        healthy = check_int(healthy, "healthy", minimum=0)
-        repetitions = check_int(repetitions, "repetitions", minimum=0)
-        sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
+        jobs = _campaign_jobs(healthy, sizes, repetitions)
         check_positive(duration, "duration")
         self._build()
-        jobs = [(0.0, r) for r in range(healthy)] + [(y, r) for y in sizes
-                                                     for r in range(repetitions)]
         if not jobs:
             raise GearshotError("the campaign holds no recording (healthy=0 and no sizes)")
         check_writable(folder, "folder", folder=True)
         with staging_dir(folder) as staging:
-            rows = []
-            from .._progress import track
-
-            for y, r in track(jobs, f"rig {speed:g} rev/s {load:g} N m", enabled=progress):
-                rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
-                                  repetition=r)
-                name = self.file_name(speed, load, y, r)
-                try:
-                    rec.write(staging / name, dtype=dtype)
-                except GearshotError as exc:  # name the destination, not the staging copy
-                    raise GearshotError(str(exc).replace(str(staging / name),
-                                                         str(folder / name))) from None
-                rows.append({"path": name, "speed": speed, "load": load, "fault_size": y,
-                             "repetition": r})
-            new = pd.DataFrame(rows, columns=INDEX_COLUMNS)
-            index_path = folder / INDEX_NAME
-            if index_path.exists():
-                old = pd.read_csv(index_path)
-                if list(old.columns) != INDEX_COLUMNS:
-                    raise GearshotError(f"{str(index_path)!r} is not a campaign index "
-                                        f"(columns {list(old.columns)})")
-                same = np.isclose(old["speed"], speed) & np.isclose(old["load"], load)
-                new_index = pd.concat([old[~same], new], ignore_index=True)
-            else:
-                new_index = new
+            new = self._record_jobs(staging, folder, jobs, speed=speed, load=load,
+                                    duration=duration, dtype=dtype, progress=progress)
+            new_index = _merged_index(folder / INDEX_NAME, new, speed, load)
             with atomic_path(staging / INDEX_NAME) as tmp:
                 new_index.to_csv(tmp, index=False)
-            for name in new["path"]:
-                os.replace(staging / name, folder / name)
-            os.replace(staging / INDEX_NAME, index_path)
+            commit_staged(staging, folder, [*new["path"], INDEX_NAME])
         out = new.copy()
         out["path"] = [str((folder / p).resolve()) for p in out["path"]]
         return out
 
+    def _record_jobs(self, staging: Path, folder: Path, jobs: list[tuple[float, int]], *,
+                     speed: float, load: float, duration: float, dtype: str,
+                     progress: bool) -> pd.DataFrame:
+        """Record every (size, repetition) job into ``staging``; their index rows."""
+        from .._progress import track
 
-_RANGES = {  # field -> (low, high) accepted by with_reality / reality_overrides
-    "snr_db": (0.0, 200.0), "attenuation_db": (-60.0, 200.0), "speed_drift": (0.0, 0.05),
-    "speed_ripple": (0.0, 0.05), "load_ripple": (0.0, 0.5), "motor_level": (0.0, 10.0),
-    "extra_level": (0.0, 10.0), "impact_level": (0.0, 10.0), "tacho_jitter": (0.0, 0.01),
-    "fault_center": (0.0, 1.0), "fault_depth": (0.01, 1.0), "damping_factor": (0.1, 10.0),
-    "bearing_stiffness_factor": (0.1, 10.0), "shaft_stiffness_factor": (0.1, 10.0),
-    "mesh_stiffness_factor": (0.1, 10.0), "motor_slip": (0.0, 0.5),
-    "impact_frequency": (1.0, 1e6), "extra_order": (0.01, 1000.0),
-    "impact_order": (0.01, 1000.0),
-}
+        rows = []
+        for y, r in track(jobs, f"rig {speed:g} rev/s {load:g} N m", enabled=progress):
+            rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
+                              repetition=r)
+            name = self.file_name(speed, load, y, r)
+            try:
+                rec.write(staging / name, dtype=dtype)
+            except GearshotError as exc:  # name the destination, not the staging copy
+                raise GearshotError(str(exc).replace(str(staging / name),
+                                                     str(folder / name))) from None
+            rows.append({"path": name, "speed": speed, "load": load, "fault_size": y,
+                         "repetition": r})
+        return pd.DataFrame(rows, columns=INDEX_COLUMNS)
 
 
-def _override(reality: RigReality, changes: Mapping[str, Any], *, n_tfs: int) -> RigReality:
-    """``reality`` with validated field changes."""
-    fields = set(reality.as_dict())
-    out: dict[str, Any] = {}
-    for key, value in changes.items():
-        if key not in fields:
-            raise GearshotError(f"reality has no field {key!r}; fields: {sorted(fields)}")
-        if key == "grade":
-            out[key] = check_int(value, "grade", minimum=1, maximum=12)
-        elif key == "tf_index":
-            out[key] = check_int(value, "tf_index", minimum=0, maximum=n_tfs - 1)
-        elif key in ("profile_seed", "motor_pole_pairs"):
-            out[key] = check_int(value, key, minimum=0 if key == "profile_seed" else 1)
-        elif key in _RANGES:
-            out[key] = check_in_range(value, key, *_RANGES[key])
-        else:  # tuples: mass/inertia factors, fault edges/roughness
-            arr = tuple(float(v) for v in value)
-            if len(arr) != len(getattr(reality, key)):
-                raise GearshotError(f"{key} must hold {len(getattr(reality, key))} numbers; "
-                                    f"got {value!r}")
-            out[key] = arr
-    return dataclasses.replace(reality, **out)
+def _campaign_jobs(healthy: int, sizes: Sequence[float],
+                   repetitions: int) -> list[tuple[float, int]]:
+    """(fault size, repetition) of every recording of a campaign: healthy ones first."""
+    healthy = check_int(healthy, "healthy", minimum=0)
+    repetitions = check_int(repetitions, "repetitions", minimum=0)
+    sizes = [check_in_range(y, "sizes[i]", 0.0, 1.0, low_inclusive=False) for y in sizes]
+    return [(0.0, r) for r in range(healthy)] + [(y, r) for y in sizes
+                                                 for r in range(repetitions)]
+
+
+def _merged_index(index_path: Path, new: pd.DataFrame, speed: float,
+                  load: float) -> pd.DataFrame:
+    """The folder's index with this condition's rows replaced by ``new``."""
+    if not index_path.exists():
+        return new
+    old = pd.read_csv(index_path)
+    if list(old.columns) != INDEX_COLUMNS:
+        raise GearshotError(f"{str(index_path)!r} is not a campaign index "
+                            f"(columns {list(old.columns)})")
+    same = np.isclose(old["speed"], speed) & np.isclose(old["load"], load)
+    return pd.concat([old[~same], new], ignore_index=True)
+
+
+def _engine_vibration(engine: Callable[..., np.ndarray], motor: np.ndarray,
+                      torque: np.ndarray, fs: float, fault_size: float, reality: RigReality,
+                      rng: np.random.Generator) -> np.ndarray:
+    """The engine's gear vibration (g) for the run, checked: shaped like ``motor``, finite."""
+    vib = np.asarray(engine(motor_revs=motor, load_torque=torque, fs=fs,
+                            fault_size=fault_size, reality=reality, rng=rng), dtype=np.float64)
+    if vib.shape != motor.shape or not np.all(np.isfinite(vib)):
+        raise GearshotError(f"the physics engine returned shape {vib.shape} or non-finite "
+                            f"values; expected {motor.shape} finite")
+    return vib
+
+
+def _interference(t: np.ndarray, motor: np.ndarray, fs: float, speed: float,
+                  reality: RigReality, rng: np.random.Generator) -> np.ndarray:
+    """Non-synchronous interference relative to the vibration's RMS: motor electrical
+    harmonics, an extra shaft, bearing-like impacts (:mod:`.interference`)."""
+    return (reality.motor_level * motor_harmonics(t, speed=speed,
+                                                  pole_pairs=reality.motor_pole_pairs,
+                                                  slip=reality.motor_slip, rng=rng)
+            + reality.extra_level * extra_shaft(motor, order=reality.extra_order, rng=rng)
+            + reality.impact_level * bearing_impacts(motor, fs, order=reality.impact_order,
+                                                     frequency=reality.impact_frequency,
+                                                     rng=rng))

@@ -7,7 +7,8 @@ Pieces (SI units; angles in rad; accelerations in g):
   (Hertz, bending, shear, axial, Sainsot fillet foundation).
 * :class:`ToothFault` (extensible base), :class:`FullToothFaceFault` via ``Fault.ftff``;
   :class:`PartialFaceFault`, :class:`ToothBreakage`, :class:`ToothDestruction` and
-  :func:`fault_of_type` (``simulate_sa(..., fault_type=NAME)``).
+  :func:`fault_of_type` (``simulate_sa(..., fault_type=NAME)``; the types' records, codes
+  and versions in :mod:`gearshot.fault_registry`).
 * :func:`draw_profile_errors` — DIN 3962 profile errors per tooth.
 * :func:`simulate` — time signals with constant or time-varying speed and load;
   :func:`simulate_sa` — batched steady-state synchronous averages.

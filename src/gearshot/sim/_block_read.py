@@ -1,7 +1,7 @@
 """Reading database blocks: one read per file, checked while decoding; resume checks.
 
 :func:`read_block` reads every file of a block once, checks its size and CRC-32 (the
-block's checksum list, :mod:`gearshot.sim.database`) on the bytes read and decodes the
+block's checksum list, :mod:`gearshot.sim._db_checksums`) on the bytes read and decodes the
 block from those bytes; :func:`resume_problem` decides from file sizes and times alone
 whether a block can be kept when a build resumes.
 """
@@ -11,6 +11,8 @@ from __future__ import annotations
 import json
 import zlib
 from pathlib import Path
+
+from ._db_checksums import ATTR, ROOT, block_problem, block_record
 
 __all__ = ["read_block", "resume_problem"]
 
@@ -25,24 +27,22 @@ def read_block(path: Path):
     import zarr.storage
     from zarr.core.buffer import default_buffer_prototype
 
-    from .database import _ATTR, _ROOT
-
     try:
-        root = (path / _ROOT).read_bytes()
-        record = json.loads(root).get("attributes", {}).get(_ATTR, {})
+        root = (path / ROOT).read_bytes()
+        record = json.loads(root).get("attributes", {}).get(ATTR, {})
         if not isinstance(record, dict):
-            raise ValueError(f"attribute {_ATTR!r} is not a mapping")
+            raise ValueError(f"attribute {ATTR!r} is not a mapping")
     except FileNotFoundError:
-        return None, f"its metadata file {_ROOT!r} is missing"
+        return None, f"its metadata file {ROOT!r} is missing"
     except (OSError, ValueError) as exc:
-        return None, f"its metadata file {_ROOT!r} is unreadable ({exc})"
+        return None, f"its metadata file {ROOT!r} is unreadable ({exc})"
     if not record:     # never decoded unchecked (issue #22): rebuilt by the next build
-        return None, f"its checksum list (attribute {_ATTR!r}) is missing"
+        return None, f"its checksum list (attribute {ATTR!r}) is missing"
     files = record.get("files")
     if not isinstance(files, dict) or not files:
-        return None, f"its checksum list (attribute {_ATTR!r}) is damaged"
+        return None, f"its checksum list (attribute {ATTR!r}) is damaged"
     buf = default_buffer_prototype().buffer
-    content = {_ROOT: buf.from_bytes(root)}
+    content = {ROOT: buf.from_bytes(root)}
     for rel, want in sorted(files.items()):
         try:
             data = (path / rel).read_bytes()
@@ -66,23 +66,21 @@ def resume_problem(path: Path) -> str | None:
     """What is wrong with a built block, by file sizes and times only (resuming a build
     reads no chunk): every listed file present with its recorded size and not modified
     after the checksum list was written; a block failing that is checked in full
-    (``database._block_problem``). A damage that keeps a file's size and time (bit rot) is
-    caught when the block is read (:func:`read_block`)."""
-    from .database import _ROOT, _block_problem, _block_record
-
+    (:func:`~gearshot.sim._db_checksums.block_problem`). A damage that keeps a file's size
+    and time (bit rot) is caught when the block is read (:func:`read_block`)."""
     try:
-        record = _block_record(path)
-        stamp = (path / _ROOT).stat().st_mtime_ns
+        record = block_record(path)
+        stamp = (path / ROOT).stat().st_mtime_ns
     except (OSError, ValueError):
-        return _block_problem(path)
+        return block_problem(path)
     files = record.get("files") if record else None
     if not isinstance(files, dict) or not files:
-        return _block_problem(path)
+        return block_problem(path)
     for rel, want in files.items():
         try:
             st = (path / rel).stat()
         except OSError:
-            return _block_problem(path)
+            return block_problem(path)
         if [st.st_size] != list(want)[:1] or st.st_mtime_ns > stamp:
-            return _block_problem(path)
+            return block_problem(path)
     return None

@@ -7,8 +7,9 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_finite, check_int, check_positive, describe
-from .fault_types import check_fault_type, fault_of_type
-from .faults import FullToothFaceFault, ToothFault
+from ..fault_registry import fault_type_record
+from .fault_types import fault_class
+from .faults import ToothFault
 from .geometry import GearPair
 from .profile_errors import draw_profile_errors
 
@@ -93,8 +94,9 @@ def profile_fn(value, name, fs):
 
 def resolve_faults(fault_sizes, faults, center, depth, fault_type="ftff"
                    ) -> list[ToothFault]:
-    """One fault object per signal, from sizes of ``fault_type`` or from fault objects."""
-    fault_type = check_fault_type(fault_type)
+    """One fault object per signal, from sizes of ``fault_type`` (its class, with the
+    shared options ``center``/``depth`` its record takes) or from fault objects."""
+    record = fault_type_record(fault_type)      # refuses an unknown type, naming the known
     if faults is not None:
         if fault_sizes is not None:
             raise GearshotError("give fault_sizes or faults, not both")
@@ -109,11 +111,10 @@ def resolve_faults(fault_sizes, faults, center, depth, fault_type="ftff"
     if fault_sizes is None:
         raise GearshotError("give fault_sizes (FTFF sizes) or faults (fault objects)")
     sizes = check_sizes(fault_sizes)
-    if fault_type == "ftff":
-        return [FullToothFaceFault(size=float(y), center=center, depth=depth) for y in sizes]
-    options = {"partial_face": dict(center=center, depth=depth),
-               "destruction": dict(center=center)}.get(fault_type, {})
-    return [fault_of_type(fault_type, float(y), **options) for y in sizes]
+    shared = {"center": center, "depth": depth}
+    options = {k: shared[k] for k in record.options}
+    cls = fault_class(fault_type)     # sizes as given: an FTFF off the profile is an error
+    return [cls(size=float(y), **options) for y in sizes]
 
 
 def draw_errors(pair, grade, n, rng, same_gear, average_pinion):

@@ -51,15 +51,16 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from .faults import FullToothFaceFault, ToothFault
+from ..fault_registry import FAULT_TYPE_RECORDS, check_fault_type, fault_type_record
+from .faults import FullToothFaceFault, SizedToothFault, ToothFault
 from .geometry import GearPair
 
 __all__ = ["PartialFaceFault", "ToothBreakage", "ToothDestruction", "FAULT_TYPES",
-           "fault_of_type"]
+           "FAULT_MODEL_VERSIONS", "check_fault_type", "fault_class", "fault_of_type"]
 
 
 @dataclass(frozen=True)
-class PartialFaceFault(ToothFault):
+class PartialFaceFault(SizedToothFault):
     """A flank cut (as the FTFF's circular arc) over part of the face width.
 
     Parameters
@@ -77,7 +78,6 @@ class PartialFaceFault(ToothFault):
         Faulty gear tooth.
     """
 
-    size: float = 0.0
     profile_size: float = 0.6
     center: float = 0.5
     depth: float = 0.5
@@ -85,7 +85,6 @@ class PartialFaceFault(ToothFault):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_in_range(self.size, "size", 0.0, 1.0)
         check_in_range(self.face_start, "face_start", 0.0, 1.0)
         if self.face_start + self.size > 1 + 1e-12:
             raise GearshotError(f"a partial face fault of size {self.size!r} starting at "
@@ -111,7 +110,18 @@ class PartialFaceFault(ToothFault):
 
 
 @dataclass(frozen=True)
-class _TipLoss(ToothFault):
+class _ContactLoss(ToothFault):
+    """A transverse section whose tooth body is intact (its compliance unchanged) and
+    whose flank loses contact (:meth:`stiffness_scale`): a broken tip, a pitted band."""
+
+    scales_contact = True
+
+    def affected_range(self, pair: GearPair):
+        return 1.0, np.array([])     # the tooth section (its compliance) is unchanged
+
+
+@dataclass(frozen=True)
+class _TipLoss(_ContactLoss):
     """The transverse section of a broken tooth: everything above ``height`` (m, measured
     down from the tip circle) is gone."""
 
@@ -119,14 +129,9 @@ class _TipLoss(ToothFault):
     edge_relief: float = 0.0
     edge_width: float = 0.1
 
-    scales_contact = True
-
     @property
     def is_healthy(self) -> bool:
         return self.height <= 0.0
-
-    def affected_range(self, pair: GearPair):
-        return 1.0, np.array([])     # the compliance below the break is unchanged
 
     def cut_fraction(self, pair: GearPair) -> float:
         """Gear roll fraction of the break radius (contact above it is lost)."""
@@ -160,7 +165,7 @@ class _TipLoss(ToothFault):
 
 
 @dataclass(frozen=True)
-class ToothBreakage(ToothFault):
+class ToothBreakage(SizedToothFault):
     """Tooth breakage: a broken tip with a chipped corner (module docstring for the
     geometry).
 
@@ -191,7 +196,6 @@ class ToothBreakage(ToothFault):
         Faulty gear tooth.
     """
 
-    size: float = 0.0
     corner: float = 2.0 / 3.0
     corner_width: float = 0.8
     edge_relief: float = 0.01
@@ -201,7 +205,6 @@ class ToothBreakage(ToothFault):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_in_range(self.size, "size", 0.0, 1.0)
         if self.face_share is not None:
             check_in_range(self.face_share, "face_share", 0.0, 1.0, low_inclusive=False)
         check_in_range(self.corner, "corner", 0.0, 100.0)
@@ -209,10 +212,6 @@ class ToothBreakage(ToothFault):
         check_in_range(self.edge_relief, "edge_relief", 0.0, 0.1)
         check_in_range(self.edge_width, "edge_width", 0.0, 1.0, low_inclusive=False)
         check_int(self.n_bands, "n_bands", minimum=1, maximum=256)
-
-    @property
-    def is_healthy(self) -> bool:
-        return self.size <= 0.0
 
     @property
     def share(self) -> float:
@@ -223,8 +222,14 @@ class ToothBreakage(ToothFault):
         """Lost height (m, from the tip) at face positions ``zeta`` (0 ... 1)."""
         zeta = np.asarray(zeta, dtype=float)
         chip = (1 + self.corner) * np.clip(1 - zeta / self.corner_width, 0.0, None)
-        h = self.active_height(pair) * np.clip(self.size * np.maximum(1.0, chip), 0.0, 1.0)
+        h = self.active_height(pair) * np.clip(
+            self.size * np.maximum(1.0, chip) * self.line_shape(zeta), 0.0, 1.0)
         return np.where(zeta <= self.share + 1e-12, h, 0.0)
+
+    def line_shape(self, zeta) -> np.ndarray | float:
+        """Factor on the lost height along the break line at face positions ``zeta``
+        (1: a straight break line; a rig's irregular break overrides it)."""
+        return 1.0
 
     @staticmethod
     def active_height(pair: GearPair) -> float:
@@ -251,7 +256,7 @@ class ToothBreakage(ToothFault):
 
 
 @dataclass(frozen=True)
-class _DamagedBand(ToothFault):
+class _DamagedBand(_ContactLoss):
     """The transverse section of surface destruction: a band [s0, s1] of the active
     profile, ``depth`` deep, bearing ``1 - contact_loss`` of its contact line."""
 
@@ -262,14 +267,9 @@ class _DamagedBand(ToothFault):
     ramp: float = 0.03
     pit: float = 0.05
 
-    scales_contact = True
-
     @property
     def is_healthy(self) -> bool:
         return self.s1 <= self.s0
-
-    def affected_range(self, pair: GearPair):
-        return 1.0, np.array([])     # a surface band: the tooth section is unchanged
 
     def _inside(self, s):
         """Smooth 0 ... 1 indicator of the band (linear ramps ``ramp`` wide inside)."""
@@ -290,7 +290,7 @@ class _DamagedBand(ToothFault):
 
 
 @dataclass(frozen=True)
-class ToothDestruction(ToothFault):
+class ToothDestruction(SizedToothFault):
     """Surface destruction (pitting, wear) in a band along the profile, whole face.
 
     Parameters
@@ -308,21 +308,15 @@ class ToothDestruction(ToothFault):
         Faulty gear tooth.
     """
 
-    size: float = 0.0
     center: float = 0.5
     depth: float = 30e-6
     contact_loss: float = 0.5
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_in_range(self.size, "size", 0.0, 1.0)
         check_in_range(self.center, "center", 0.0, 1.0)
         check_in_range(self.depth, "depth", 0.0, 1e-3)
         check_in_range(self.contact_loss, "contact_loss", 0.0, 1.0, high_inclusive=False)
-
-    @property
-    def is_healthy(self) -> bool:
-        return self.size <= 0.0
 
     @property
     def window(self) -> tuple[float, float]:
@@ -339,40 +333,34 @@ class ToothDestruction(ToothFault):
                                         contact_loss=self.contact_loss)),)
 
 
-def _ftff(size, *, tooth=0, center=0.5, depth=0.5, **kw):
-    if size <= 0:
-        return FullToothFaceFault(tooth=tooth, size=0.0, center=center, depth=depth, **kw)
-    c = min(max(center, 0.5 * size), 1.0 - 0.5 * size)   # keep the cut on the profile
-    return FullToothFaceFault(tooth=tooth, size=size, center=c, depth=depth, **kw)
+_CLASSES: dict[str, type[SizedToothFault]] = {
+    c.__name__: c for c in (FullToothFaceFault, PartialFaceFault, ToothBreakage,
+                            ToothDestruction)}
 
 
-#: name -> constructor ``f(size, **options)`` of the fault types (keep the order: a type's
-#: position is its code in database seeds).
-FAULT_TYPES = {
-    "ftff": _ftff,
-    "partial_face": lambda size, **kw: PartialFaceFault(size=size, **kw),
-    "breakage": lambda size, **kw: ToothBreakage(size=size, **kw),
-    "destruction": lambda size, **kw: ToothDestruction(size=size, **kw),
-}
+def fault_class(name: str) -> type[SizedToothFault]:
+    """The class of fault type ``name`` (its record's ``class_``,
+    :mod:`gearshot.fault_registry`)."""
+    return _CLASSES[fault_type_record(name).class_]
 
 
-#: name -> version of the type's model; bump it when a type's geometry or physics changes,
-#: so that databases built with the older model are refused (``load_database``) instead of
-#: silently mixed with new SAs. breakage 2: the growth path over the face share (session 5).
-FAULT_MODEL_VERSIONS = {"ftff": 1, "partial_face": 1, "breakage": 2, "destruction": 1}
+#: name -> constructor ``f(size, **options)`` of the fault types (the classes'
+#: :meth:`~gearshot.sim.faults.SizedToothFault.of_size`), in code order
+#: (:data:`gearshot.fault_registry.FAULT_TYPE_RECORDS` holds each type's record).
+FAULT_TYPES = {name: fault_class(name).of_size for name in FAULT_TYPE_RECORDS}
 
-
-def check_fault_type(name) -> str:
-    """Validate a fault type name."""
-    if not isinstance(name, str) or name not in FAULT_TYPES:
-        raise GearshotError(f"fault_type must be one of {sorted(FAULT_TYPES)}; got {name!r}")
-    return name
+#: name -> version of the type's model (the records' ``version``): databases built with
+#: an older model of a type are refused (``load_database``) instead of silently mixed with
+#: new SAs.
+FAULT_MODEL_VERSIONS = {name: r.version for name, r in FAULT_TYPE_RECORDS.items()}
 
 
 def fault_of_type(name: str, size: float, **options) -> ToothFault:
     """A fault of type ``name`` (:data:`FAULT_TYPES`) and size ``size`` in [0, 1].
 
-    Options go to the type's class (e.g. ``tooth``, ``center``, ``depth``).
+    Options go to the type's class (e.g. ``tooth``, ``center``, ``depth``); an FTFF's
+    centre is moved so that the cut stays on the active profile
+    (:meth:`FullToothFaceFault.of_size`).
     """
     check_fault_type(name)
     try:

@@ -30,7 +30,7 @@ from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 from .geometry import GearPair, _involute_function, contact_angles, involute_half_angle
 
-__all__ = ["ToothFault", "Fault", "FullToothFaceFault"]
+__all__ = ["ToothFault", "SizedToothFault", "Fault", "FullToothFaceFault"]
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,37 @@ class ToothFault:
 
 
 @dataclass(frozen=True)
-class FullToothFaceFault(ToothFault):
+class SizedToothFault(ToothFault):
+    """Base class of the fault types (:mod:`gearshot.fault_registry`): a fault of size
+    y = ``size`` in [0, 1] (0 = healthy), whose meaning each type defines.
+
+    Parameters
+    ----------
+    size : float
+        y in [0, 1].
+    tooth : int
+        Faulty gear tooth.
+    """
+
+    size: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_in_range(self.size, "size", 0.0, 1.0)
+
+    @property
+    def is_healthy(self) -> bool:
+        return self.size <= 0.0
+
+    @classmethod
+    def of_size(cls, size: float, **options) -> SizedToothFault:
+        """The fault of size ``size`` with the type's other fields from ``options``
+        (the constructor of :data:`gearshot.sim.FAULT_TYPES`)."""
+        return cls(size=size, **options)
+
+
+@dataclass(frozen=True)
+class FullToothFaceFault(SizedToothFault):
     """Full tooth face fault (FTFF): the flank of one gear tooth is cut by a circular arc
     over the whole face width.
 
@@ -114,14 +144,12 @@ class FullToothFaceFault(ToothFault):
         :meth:`deviation_depth`; 0 = stiffness change only). For sensitivity studies.
     """
 
-    size: float = 0.0
     center: float = 0.5
     depth: float = 0.5
     transmission: float = 1.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_in_range(self.size, "size", 0.0, 1.0)
         check_in_range(self.center, "center", 0.0, 1.0)
         check_in_range(self.depth, "depth", 0.0, 1.0, low_inclusive=False)
         check_in_range(self.transmission, "transmission", 0.0, 10.0)
@@ -132,9 +160,16 @@ class FullToothFaceFault(ToothFault):
                 f"profile (spans {lo:.4g} to {hi:.4g}); choose center in "
                 f"[{self.size / 2:.4g}, {1 - self.size / 2:.4g}]")
 
-    @property
-    def is_healthy(self) -> bool:
-        return self.size <= 0.0
+    @classmethod
+    def of_size(cls, size: float, *, tooth: int = 0, center: float = 0.5,
+                depth: float = 0.5, **options) -> FullToothFaceFault:
+        """The FTFF of size ``size`` with its centre moved (when needed) so that the cut
+        stays on the active profile (``fault_of_type("ftff", ...)``)."""
+        if size > 0:
+            center = min(max(center, 0.5 * size), 1.0 - 0.5 * size)
+        else:
+            size = 0.0
+        return cls(tooth=tooth, size=size, center=center, depth=depth, **options)
 
     @property
     def window(self) -> tuple[float, float]:

@@ -1,0 +1,5 @@
+"""``python -m gearshot``: the ``gearshot`` command."""
+
+from .app.cli import main
+
+main()

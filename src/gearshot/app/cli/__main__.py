@@ -1,0 +1,5 @@
+"""``python -m gearshot.app.cli``: the ``gearshot`` command."""
+
+from . import main
+
+main()

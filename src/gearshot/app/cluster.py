@@ -1,0 +1,73 @@
+"""The Dask cluster of a long command: a running scheduler, a LocalCluster, or none.
+
+Examples
+--------
+>>> from gearshot.app.cluster import dask_client
+>>> with dask_client(None, workers=1) as client:   # one worker: work runs in-process
+...     print(client)
+None
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from .._errors import GearshotError
+
+__all__ = ["dask_client"]
+
+
+@contextmanager
+def dask_client(scheduler: str | None = None, workers: int = 2, *,
+                needed: bool = True) -> Iterator[Any]:
+    """A Dask client for the ``with`` block, closed (with its LocalCluster) on exit.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running Dask scheduler (``--scheduler``); it is left running.
+    workers : int
+        Workers of the LocalCluster started when no ``scheduler`` is given (one thread
+        each); with 1 worker no cluster is started and the client is None (in-process).
+    needed : bool
+        Whether the work has more than one task; when False and no ``scheduler`` is given,
+        no cluster is started (its start-up would cost more than it saves).
+
+    Yields
+    ------
+    dask.distributed.Client or None
+        None: run in-process.
+
+    Raises
+    ------
+    GearshotError
+        The scheduler cannot be reached (the message names ``--scheduler`` and the address).
+    """
+    client, cluster = _start(scheduler, workers, needed=needed)
+    try:
+        yield client
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _start(scheduler: str | None, workers: int, *, needed: bool) -> tuple[Any, Any]:
+    """(client, the LocalCluster this started or None); (None, None) to run in-process."""
+    if scheduler:
+        from dask.distributed import Client
+
+        try:
+            return Client(scheduler, timeout="10s"), None
+        except Exception as exc:
+            raise GearshotError(f"cannot reach the Dask scheduler at --scheduler "
+                                f"{scheduler!r}: {exc}") from None
+    if needed and workers > 1:
+        from dask.distributed import Client, LocalCluster
+
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=":0")
+        return Client(cluster), cluster
+    return None, None
