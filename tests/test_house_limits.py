@@ -28,7 +28,6 @@ _PENDING: frozenset[str] = frozenset(
     {
         "signal/ridge.py",
         "signal/tracking.py",
-        "sim/dynamics.py",
     }
 )
 
