@@ -8,6 +8,7 @@ contact stiffness, and the smooth segments a faulty tooth's compliance is evalua
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -26,6 +27,10 @@ _SAINSOT = np.array([
 ])
 
 _N_NODES = 240  # integration nodes along the tooth
+
+_N_TABLE = 1025
+_U_TABLE = np.linspace(0.0, 1.0, _N_TABLE)      # the tables' contact positions u
+_U_TABLE.setflags(write=False)
 
 
 def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
@@ -124,3 +129,13 @@ def _segments(s: np.ndarray, edges: np.ndarray):
 def _hertz_stiffness(pair: GearPair) -> float:
     """The Hertzian contact stiffness of the pair (N/m)."""
     return math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+
+
+@functools.lru_cache(maxsize=32)
+def _healthy_compliances(pair: GearPair):
+    """Pinion and gear tooth compliance tables over u (the healthy pair)."""
+    u = np.linspace(0.0, 1.0, _N_TABLE)
+    (p_lo, p_hi), (g_lo, g_hi) = pair.roll_limits
+    inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + u * (p_hi - p_lo))
+    inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + (1.0 - u) * (g_hi - g_lo))
+    return inv_p, inv_g

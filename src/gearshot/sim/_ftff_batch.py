@@ -24,8 +24,10 @@ import numpy as np
 
 from ._compliance import (
     _N_SEGMENT,
+    _U_TABLE,
     _contact_frame,
     _fillet_compliance,
+    _healthy_compliances,
     _hertz_stiffness,
     _materials,
     _simpson_nodes,
@@ -261,8 +263,6 @@ def ftff_tables(pair: GearPair, faults):
     """Tables over the spur contact position u (``_N_TABLE`` points) of non-healthy
     FTFFs: pair stiffness k (N/m) and displacement excitation e_f (m), arrays (n, n_u);
     as ``_pair_table(pair, fault)`` and ``fault.displacement(pair, 1 - u)``."""
-    from .stiffness import _U_TABLE, _healthy_compliances
-
     n = len(faults)
     s0s, s1s, arcs_all = _arcs(pair, faults)
     parts = [bridge_batch(pair, faults[i:i + _RETREAT_CHUNK],
@@ -390,10 +390,3 @@ def ftff_cached(pair: GearPair, faults):
         while len(_CACHE) > _CACHE_SIZE:
             del _CACHE[next(iter(_CACHE))]
     return [_CACHE[(pair, f)] for f in faults]
-
-
-def is_ftff(fault) -> bool:
-    """True for a non-healthy fault handled here (exactly the FTFF class)."""
-    from .faults import FullToothFaceFault
-
-    return type(fault) is FullToothFaceFault and not fault.is_healthy

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._ftff_batch import ftff_cached, is_ftff
+from ._ftff_batch import ftff_cached
 from ._helical import helical_batch_tables
 from ._kernel import (
     G0,
@@ -35,7 +35,7 @@ from ._kernel import (
     spur_shared,
     table_shared,
 )
-from .faults import ToothFault
+from .faults import ToothFault, is_ftff
 from .geometry import GearPair
 from .profile_errors import ToothProfileErrors, wave_amplitudes
 from .stiffness import _N_TABLE, _pair_table, face_bands, fault_tables

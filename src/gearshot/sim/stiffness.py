@@ -24,13 +24,16 @@ import numpy as np
 from .._errors import GearshotError
 from .._validation import as_signal_array
 from ._compliance import (
+    _N_TABLE,
+    _U_TABLE,
+    _healthy_compliances,
     _hertz_stiffness,
     _segments,
     _tooth_compliance,
 )
-from ._ftff_batch import ftff_cached, is_ftff
+from ._ftff_batch import ftff_cached
 from ._slices import box, tau_grid
-from .faults import ToothFault
+from .faults import ToothFault, is_ftff
 from .geometry import GearPair
 
 __all__ = ["mesh_stiffness", "pair_stiffness", "contact_ratio"]
@@ -100,26 +103,11 @@ def _whole_face(fault: ToothFault, pair: GearPair) -> bool:
     return len(bands) == 1 and bands[0][0] == 0.0 and bands[0][1] == 1.0 and bands[0][2] is fault
 
 
-_N_TABLE = 1025
-_U_TABLE = np.linspace(0.0, 1.0, _N_TABLE)      # the tables' contact positions u
-_U_TABLE.setflags(write=False)
-
-
 @functools.lru_cache(maxsize=256)
 def face_bands(pair: GearPair, fault: ToothFault) -> tuple:
     """``fault.face_bands(pair)``, computed once per (pair, fault) (a batch asks twice:
     for its FTFF bands and for its tables)."""
     return fault.face_bands(pair)
-
-
-@functools.lru_cache(maxsize=32)
-def _healthy_compliances(pair: GearPair):
-    """Pinion and gear tooth compliance tables over u (the healthy pair)."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    (p_lo, p_hi), (g_lo, g_hi) = pair.roll_limits
-    inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + u * (p_hi - p_lo))
-    inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + (1.0 - u) * (g_hi - g_lo))
-    return inv_p, inv_g
 
 
 def _faulty_gear_compliance(pair: GearPair, fault: ToothFault) -> np.ndarray:
