@@ -136,13 +136,13 @@ def test_a_setting_at_gain_1_and_width_1_is_the_twin_grade_model(paired_db, targ
     healthy, long, faulty, y, sel = target
     one = dict(gains=[1.0], widths=[1.0], tf_modes=["tf"], n_near=16, max_settings=3,
                temperature=1e6)   # every grade kept, nearly equal weights
-    kw = dict(random_state=0, select_features=False)
+    kw = dict(random_state=0, feature_selection=False)
     joint = OneFaultShotEstimator(calibration=one, **kw).fit(
         paired_db, healthy, faulty[20], y[20], long)
     assert [s["grade"] for s in joint.calibration_["settings"]] != []
     X = joint.features_of(faulty)
     for setting, model in zip(joint.calibration_["settings"], joint.setting_models_):
-        ref = OneFaultShotEstimator(calibration="grade", tune_simulation=False,
+        ref = OneFaultShotEstimator(calibration="nominal",
                                     nominal_grade=setting["grade"], **kw)
         ref.fit(paired_db, healthy, faulty[20], y[20], long)
         assert ref.simulated_reference_ == "twin"
@@ -164,7 +164,7 @@ def test_joint_needs_twins_and_falls_back_to_the_grade(paired_db, target):
 def test_without_a_tf_the_joint_calibration_uses_rms_normalization_only(paired_db, target):
     healthy, long, faulty, y, sel = target
     est = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL, calibration=SMALL,
-                                transfer_function="none", select_features=False)
+                                transfer_function="none", feature_selection=False)
     est.fit(paired_db, healthy, faulty[20], y[20])
     assert set(est.calibration_["grid"]["tf"]) == {"none"}
     assert all(s["tf"] == "none" for s in est.calibration_["settings"])

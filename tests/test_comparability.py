@@ -76,9 +76,9 @@ def test_estimator_carries_the_reference_from_fit(phm):
     # a synthetic database of 2048-point SAs serves the mechanics; the comparability
     # reference depends only on the target's healthy SAs and the example
     healthy, example = phm["spur3", "acc_input"][:-2], phm["spur2", "acc_input"][0]
-    est = OneFaultShotEstimator(mesh_order=MESHES, select_features=False,
-                                tune_simulation=False, nominal_grade=3,
-                                transfer_function="none", n_neighbors=range(1, 6),
+    est = OneFaultShotEstimator(mesh_order=MESHES, feature_selection=False,
+                                calibration="nominal", nominal_grade=3,
+                                transfer_function="none", options={"n_neighbors": range(1, 6)},
                                 random_state=0)
     est.fit(db, healthy, example, 0.5)
     got = est.comparability(phm["spur1", "acc_input"])

@@ -204,21 +204,22 @@ def test_ablation_switches_change_the_pipeline(data, tf_pair):
     db, healthy, long, faulty, y = data
     args = (db, healthy, faulty[20], y[20], long)
     raw = OneFaultShotEstimator(transfer_function="none", rms_normalization=False,
-                                select_features=False, random_state=0).fit(*args)
+                                feature_selection=False, random_state=0).fit(*args)
     assert raw.transfer_function_ is None
     assert raw.selected_features_ == ("rms_diff", "kurtosis_diff", "rms_env_diff",
                                       "skewness_env_diff")
-    fixed = OneFaultShotEstimator(tune_simulation=False, nominal_grade=9,
+    fixed = OneFaultShotEstimator(calibration="nominal", nominal_grade=9,
                                   random_state=0).fit(*args, selection_tf=tf_pair[1])
     assert fixed.grade_ == 9 and fixed.tuning_curve_ is None
-    given = OneFaultShotEstimator(transfer_function=tf_pair[0], select_features=False,
+    given = OneFaultShotEstimator(transfer_function=tf_pair[0], feature_selection=False,
                                   random_state=0).fit(*args)
     assert_allclose(given.transfer_function_, tf_pair[0])
 
 
 def test_zero_shot_needs_no_example(data):
     db, healthy, long, faulty, y = data
-    est = OneFaultShotEstimator(zero_shot=True, select_features=False, random_state=0)
+    est = OneFaultShotEstimator(calibration="zero_shot", feature_selection=False,
+                                random_state=0)
     est.fit(db, healthy, healthy_long=long)
     assert est.grade_ in (3, 6, 9)
     assert len(est.tuning_curve_["grade"]) == 3
@@ -241,7 +242,8 @@ def test_signature_weights_trust_a_matching_grade_and_fall_back_to_uniform():
 
 def test_zero_shot_soft_weights_are_a_distribution_over_grades(data):
     db, healthy, long, faulty, y = data
-    est = OneFaultShotEstimator(zero_shot=True, select_features=False, random_state=0)
+    est = OneFaultShotEstimator(calibration="zero_shot", feature_selection=False,
+                                random_state=0)
     est.fit(db, healthy, healthy_long=long)
     assert_allclose(sum(est.grade_weights_.values()), 1.0)
     assert set(est.grade_weights_) <= {3, 6, 9}
@@ -312,7 +314,7 @@ def test_bad_parameters_are_reported_at_fit(data):
     for params, word in [(dict(features=["nope"]), "features"),
                          (dict(transfer_function="magic"), "transfer_function"),
                          (dict(grades=[0]), "grades"),
-                         (dict(validation_fraction=0.0), "validation_fraction")]:
+                         (dict(options={"validation_fraction": 0.0}), "validation_fraction")]:
         with pytest.raises(GearshotError, match=word):
             OneFaultShotEstimator(**params).fit(db, healthy, faulty[0], y[0], long,
                                                 selection_tf=np.ones(N))
@@ -332,11 +334,6 @@ def test_isotonic_tuning_ignores_a_lucky_outlier():
 
 
 # ------------------------------------------------------------------- soft grade weighting
-def test_moved_uncertainty_names_still_resolve_from_steps():
-    with pytest.warns(DeprecationWarning, match="uncertainty"):
-        assert steps.grade_weights is uncertainty.grade_weights
-
-
 def test_grade_weights_follow_a_gaussian_likelihood_of_the_example():
     residuals = np.full(99, 0.1)  # 90 % quantile 0.1 → sigma 0.05
     w = uncertainty.grade_weights([0.30, 0.35, 0.40, 0.90], [1, 2, 3, 4], 0.35, residuals)
@@ -392,7 +389,7 @@ def test_model_discrepancy_widens_intervals_and_zero_is_split_conformal(fitted, 
                                                                          tf_pair):
     db, healthy, long, faulty, y = data
     args = (db, healthy, faulty[20], y[20], long)
-    pure = clone(fitted).set_params(grade_weighting="best", model_discrepancy=0.0).fit(
+    pure = clone(fitted).set_params(calibration="tuned", model_discrepancy=0.0).fit(
         *args, selection_tf=tf_pair[1])
     lo0, hi0 = pure.predict_interval(faulty)
     q = uncertainty.conformal_quantile(pure.model_.validation_residuals, 0.9)
@@ -413,7 +410,7 @@ def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):
     soft = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
         *args, selection_tf=tf_pair[1])
     best = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL,
-                                 grade_weighting="best").fit(
+                                 calibration="tuned").fit(
         *args, selection_tf=tf_pair[1])
     assert best.grade_weights_ == {best.grade_: 1.0}
     assert soft.grade_ == best.grade_ and soft.grade_ in soft.grade_weights_
@@ -422,8 +419,8 @@ def test_soft_weighting_averages_the_plausible_grades(data, tf_pair):
     mix = sum(w * soft.grade_models_[g].predict(X) for g, w in soft.grade_weights_.items())
     assert_allclose(soft.predict(faulty), mix)
     assert_allclose(best.predict(faulty), best.model_.predict(X))
-    with pytest.raises(GearshotError, match="grade_weighting"):
-        OneFaultShotEstimator(grade_weighting="mean").fit(*args, selection_tf=tf_pair[1])
+    with pytest.raises(GearshotError, match="calibration must be one of .*'mean'"):
+        OneFaultShotEstimator(calibration="mean").fit(*args, selection_tf=tf_pair[1])
 
 
 # ------------------------------------------------------------------------- paired simulation
@@ -434,6 +431,31 @@ def test_simulated_suppression_subtracts_each_twin():
                     sa - twins)
     with pytest.raises(GearshotError, match=r"twins must have the shape.*\(3, 64\)"):
         steps.suppress_harmonics_simulated(sa, np.ones(4, bool), twins[:3])
+
+
+def test_twin_path_equals_propagating_signals_and_twins_apart(tf_pair):
+    """Steps 4-6 with twins run on SA - twin (one propagation): the same differences as
+    propagating SAs and twins apart, each scaled by the propagated healthy SAs' mean RMS;
+    step 5's scale is one function for both domains."""
+    rng = np.random.default_rng(7)
+    sa = rng.normal(size=(6, N))
+    twins = sa + 0.1 * rng.normal(size=(6, N))
+    healthy = np.array([True, True, False, False, False, False])
+    twins[healthy] = sa[healthy]
+    noise = 0.01 * rng.normal(size=(6, N))
+    tf = tf_pair[0]
+    got = steps.simulated_features(sa, healthy, tf, mesh_order=38, names=["rms_diff"],
+                                   twins=twins, noise=noise)
+    p_sa, p_tw = steps.propagate_simulated(sa, tf), steps.propagate_simulated(twins, tf)
+    scale = steps.rms_scale(p_sa[healthy])
+    assert scale == pytest.approx(np.mean(np.sqrt(np.mean(p_sa[healthy] ** 2, axis=1))))
+    want, _ = steps.centred_features(p_sa / scale - p_tw / scale + noise, mesh_order=38,
+                                     names=["rms_diff"], healthy_mask=healthy)
+    assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    assert_allclose(steps.normalize_rms(p_sa, p_sa[healthy]), p_sa / scale)
+    assert_allclose(steps.normalize_rms(p_sa, scale=scale), p_sa / scale)
+    with pytest.raises(GearshotError, match="target_healthy has zero RMS"):
+        steps.rms_scale(np.zeros((2, N)), name="target_healthy")
 
 
 def test_residue_noise_has_the_measured_power_spectrum():
@@ -457,7 +479,7 @@ def paired_db():
 
 def test_twin_reference_fits_and_is_seeded(paired_db, data, tf_pair):
     _, healthy, long, faulty, y = data
-    kw = dict(simulated_reference="twin", random_state=0, nominal_grade=NOMINAL)
+    kw = dict(options={"simulated_reference": "twin"}, random_state=0, nominal_grade=NOMINAL)
     args = (paired_db, healthy, faulty[20], y[20], long)
     a = OneFaultShotEstimator(**kw).fit(*args, selection_tf=tf_pair[1])
     b = OneFaultShotEstimator(**kw).fit(*args, selection_tf=tf_pair[1])
@@ -485,7 +507,7 @@ def test_twin_reference_fits_and_is_seeded(paired_db, data, tf_pair):
     assert_allclose(np.std(train_feats[healthy_rows], axis=0), 0.0, atol=1e-9)
     # the paper's reference on the same database ignores the twins
     paper = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL,
-                                  simulated_reference="first_healthy").fit(
+                                  options={"simulated_reference": "first_healthy"}).fit(
         *args, selection_tf=tf_pair[1])
     plain = OneFaultShotEstimator(random_state=0, nominal_grade=NOMINAL).fit(
         paired_db.drop_vars("sa_twin"), *args[1:], selection_tf=tf_pair[1])
@@ -495,11 +517,13 @@ def test_twin_reference_fits_and_is_seeded(paired_db, data, tf_pair):
 
 def test_twin_reference_needs_a_paired_database(data, tf_pair):
     db, healthy, long, faulty, y = data
-    est = OneFaultShotEstimator(simulated_reference="twin", nominal_grade=NOMINAL)
+    est = OneFaultShotEstimator(options={"simulated_reference": "twin"},
+                                nominal_grade=NOMINAL)
     with pytest.raises(GearshotError, match="simulated_reference='twin' needs a paired"):
         est.fit(db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
-    with pytest.raises(GearshotError, match="simulated_reference must be one of .*'twins'"):
-        OneFaultShotEstimator(simulated_reference="twins").fit(
+    with pytest.raises(GearshotError,
+                       match="options: simulated_reference must be one of .*'twins'"):
+        OneFaultShotEstimator(options={"simulated_reference": "twins"}).fit(
             db, healthy, faulty[20], y[20], long, selection_tf=tf_pair[1])
 
 

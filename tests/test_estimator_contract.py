@@ -15,11 +15,17 @@ from sklearn.utils import estimator_checks
 from sklearn.utils.validation import check_is_fitted
 
 from gearshot import GearshotError
-from gearshot.estimator import STEP_SEEDS, NotFittedError, OneFaultShotEstimator, steps
+from gearshot.estimator import (
+    STEP_SEEDS,
+    EstimatorOptions,
+    NotFittedError,
+    OneFaultShotEstimator,
+    steps,
+)
 from gearshot.estimator._params import validate_params
 
 # The synthetic database holds grades 3, 6, 9: quick settings that still run every step.
-FAST = dict(nominal_grade=3, grades=[3, 6], grade_weighting="best", random_state=0)
+FAST = dict(nominal_grade=3, grades=[3, 6], calibration="tuned", random_state=0)
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +64,7 @@ def test_sklearn_checks_that_need_no_fit(check):
 
 def test_defaults_are_immutable():
     # sklearn's check_parameters_default_constructible would also refuse ``range``
-    # defaults (grades, n_neighbors), which are as immutable as the tuples it accepts.
+    # defaults (grades), which are as immutable as the tuples it accepts.
     import inspect
 
     for p in inspect.signature(OneFaultShotEstimator).parameters.values():
@@ -67,19 +73,21 @@ def test_defaults_are_immutable():
 
 
 def test_init_stores_arguments_untouched_and_clone_round_trips():
-    grades, neighbours, tf = range(3, 8), [1, 5, 9], np.ones(N, complex)
+    grades, tf = range(3, 8), np.ones(N, complex)
+    options = EstimatorOptions(n_neighbors=[1, 5, 9])
     rng = np.random.RandomState(3)
-    est = OneFaultShotEstimator(grades=grades, n_neighbors=neighbours, transfer_function=tf,
+    est = OneFaultShotEstimator(grades=grades, options=options, transfer_function=tf,
                                 random_state=rng, model_discrepancy=0.3)
     params = est.get_params()
-    assert params["grades"] is grades and params["n_neighbors"] is neighbours
+    assert params["grades"] is grades and params["options"] is options
     assert params["transfer_function"] is tf and params["random_state"] is rng
     again = clone(est)
     assert again is not est
     assert set(again.get_params()) == set(params)
     assert again.get_params()["model_discrepancy"] == 0.3
-    assert again.set_params(upsample=10) is again and again.upsample == 10
-    assert est.upsample == 100
+    assert again.options == options and again.options.n_neighbors == [1, 5, 9]
+    assert again.set_params(options={"upsample": 10}) is again
+    assert again.options == {"upsample": 10} and est.options is options
 
 
 def test_not_fitted_error_is_both_gearshot_and_sklearn(tmp_path):
@@ -124,9 +132,9 @@ def test_fixed_random_state_is_deterministic(data, tfs, fitted):
 # ------------------------------------------------------------------ one seed per step
 def test_feature_selection_does_not_move_the_knn_split(data, tfs):
     """The no_feature_selection ablation differs from the full method only in step 1."""
-    kw = dict(FAST, tune_simulation=False)
-    with_sel = _fit(OneFaultShotEstimator(**kw, select_features=True), data, tfs)
-    without = _fit(OneFaultShotEstimator(**kw, select_features=False), data, tfs)
+    kw = dict(FAST, calibration="nominal")
+    with_sel = _fit(OneFaultShotEstimator(**kw, feature_selection=True), data, tfs)
+    without = _fit(OneFaultShotEstimator(**kw, feature_selection=False), data, tfs)
     assert with_sel.feature_errors_ and not without.feature_errors_
     assert with_sel.step_seeds_ == without.step_seeds_
     assert_array_equal(with_sel.model_.validation_indices, without.model_.validation_indices)
@@ -148,6 +156,33 @@ def test_step_seeds_are_independent_children_of_random_state():
 
 
 # ------------------------------------------------------------------ the parameter table
+def test_public_constructor_is_short():
+    """Issue #21: at most 12 parameters; research settings live in ``options``."""
+    params = OneFaultShotEstimator().get_params()
+    assert len(params) <= 12, sorted(params)
+    assert "select_features" not in params and "feature_selection" in params
+    for knob in ("selection_threshold", "upsample", "n_neighbors", "zero_shot",
+                 "tune_simulation", "grade_weighting", "simulated_reference"):
+        assert knob not in params
+
+
+@pytest.mark.parametrize("calibration, strategy", [
+    ("grade", "soft"), ("tuned", "tuned"), ("nominal", "nominal"),
+    ("joint", "soft"),          # an unpaired database: joint falls back to the grades
+])
+def test_calibration_names_the_grade_strategy(data, tfs, calibration, strategy):
+    est = _fit(OneFaultShotEstimator(**{**FAST, "calibration": calibration}), data, tfs)
+    assert est.grade_strategy_ == strategy
+    assert est.calibration_["strategy"] == "grade"
+    if strategy in ("tuned", "nominal"):
+        assert est.grade_weights_ == {est.grade_: 1.0}
+    if strategy == "nominal":
+        assert est.grade_ == FAST["nominal_grade"] and est.tuning_curve_ is None
+    if strategy == "soft":
+        assert set(est.grade_weights_) <= set(FAST["grades"])
+        assert sum(est.grade_weights_.values()) == pytest.approx(1.0)
+
+
 def test_every_parameter_has_a_constraint():
     assert set(OneFaultShotEstimator._parameter_constraints) == \
         set(OneFaultShotEstimator().get_params())
@@ -157,15 +192,17 @@ def test_every_parameter_has_a_constraint():
     ("features", ["nope"], "nope"),
     ("features", "rms_diff", "rms_diff"),
     ("features", [], "[]"),
-    ("selection_threshold", 0, "0"),
-    ("selection_threshold", np.inf, "inf"),
     ("grades", [], "[]"),
     ("grades", [0], "[0]"),
     ("grades", [3, 13], "[3, 13]"),
     ("grades", (g for g in [3, 6]), "generator"),
-    ("select_features", "yes", "yes"),
-    ("select_features", 1, "1"),
-    ("tune_simulation", None, "None"),
+    ("feature_selection", "yes", "yes"),
+    ("feature_selection", 1, "1"),
+    ("calibration", None, "None"),
+    ("calibration", "soft", "soft"),
+    ("calibration", "best", "best"),
+    ("options", "fast", "fast"),
+    ("options", [("upsample", 10)], "upsample"),
     ("nominal_grade", 0, "0"),
     ("nominal_grade", 13, "13"),
     ("nominal_grade", 7.5, "7.5"),
@@ -173,32 +210,73 @@ def test_every_parameter_has_a_constraint():
     ("rms_normalization", "false", "false"),
     ("transfer_function", "magic", "magic"),
     ("transfer_function", np.ones((2, 3)), "shape=(2, 3)"),
-    ("n_neighbors", [0, 1], "[0, 1]"),
-    ("n_neighbors", 5, "5"),
-    ("validation_fraction", 0.0, "0.0"),
-    ("validation_fraction", 1, "1"),
     ("mesh_order", 0, "0"),
     ("mesh_order", 38.5, "38.5"),
     ("mesh_order", [38, 0], "[38, 0]"),
     ("mesh_order", [], "[]"),
-    ("selection_fallback", "none", "none"),
-    ("zero_shot", "no", "no"),
-    ("upsample", 0, "0"),
-    ("tuning_smoothing", "spline", "spline"),
-    ("grade_weighting", "mean", "mean"),
     ("model_discrepancy", -0.1, "-0.1"),
     ("model_discrepancy", np.nan, "nan"),
     ("random_state", -1, "-1"),
     ("random_state", "seed", "seed"),
 ])
 def test_bad_parameter_is_named_with_its_value_at_fit(data, tfs, name, value, shown):
-    est = OneFaultShotEstimator(**{**FAST, name: value})
+    _assert_refused_at_fit(OneFaultShotEstimator(**{**FAST, name: value}), data, tfs,
+                           f"{name} must be ", shown)
+
+
+def _assert_refused_at_fit(est, data, tfs, start, shown):
+    """``fit`` refuses ``est`` with a message that starts with ``start`` and quotes the
+    value as ``shown``, and leaves it unfitted."""
     with pytest.raises(GearshotError) as info:
         _fit(est, data, tfs)
     message = str(info.value)
-    assert message.startswith(f"{name} must be "), message
+    assert message.startswith(start), message
     assert shown in message, message
     assert not hasattr(est, "model_")
+
+
+@pytest.mark.parametrize("name, value, shown", [
+    ("selection_threshold", 0, "0"),
+    ("selection_threshold", np.inf, "inf"),
+    ("selection_fallback", "none", "none"),
+    ("tuning_smoothing", "spline", "spline"),
+    ("zero_shot_signature", "clean", "clean"),
+    ("zero_shot_weighting", "mean", "mean"),
+    ("simulated_reference", "twins", "twins"),
+    ("upsample", 0, "0"),
+    ("n_neighbors", [0, 1], "[0, 1]"),
+    ("n_neighbors", 5, "5"),
+    ("validation_fraction", 0.0, "0.0"),
+    ("validation_fraction", 1, "1"),
+])
+def test_bad_option_is_named_with_its_value(data, tfs, name, value, shown):
+    """A bad research setting: refused by EstimatorOptions at once, and as a mapping at
+    fit (the CLI's ``--param options=...``), naming the field and quoting the value."""
+    with pytest.raises(GearshotError) as info:
+        EstimatorOptions(**{name: value})
+    assert str(info.value).startswith(f"{name} must be "), str(info.value)
+    assert shown in str(info.value)
+    _assert_refused_at_fit(OneFaultShotEstimator(**{**FAST, "options": {name: value}}),
+                           data, tfs, f"options: {name} must be ", shown)
+
+
+def test_unknown_option_is_named():
+    est = OneFaultShotEstimator(options={"selection_treshold": 0.2})
+    with pytest.raises(GearshotError, match=r"options: options has unknown field\(s\) "
+                                            r"\['selection_treshold'\]"):
+        validate_params(est.get_params(deep=False), est._parameter_constraints)
+
+
+def test_options_change_what_they_name(data, tfs, fitted):
+    """A research setting reaches its step: fewer K candidates bound the chosen K, a
+    coarser delay grid changes the target features, the defaults repeat the default fit."""
+    same = _fit(OneFaultShotEstimator(**{**FAST, "options": EstimatorOptions()}), data, tfs)
+    assert_array_equal(same.predict(data[3]), fitted.predict(data[3]))
+    few = _fit(OneFaultShotEstimator(**{**FAST, "options": {"n_neighbors": [1, 2]}}),
+               data, tfs)
+    assert few.n_neighbors_ in (1, 2) and few.model_.validation_mae.size == 2
+    coarse = _fit(OneFaultShotEstimator(**{**FAST, "options": {"upsample": 1}}), data, tfs)
+    assert not np.array_equal(coarse.features_of(data[3]), fitted.features_of(data[3]))
 
 
 def test_model_discrepancy_has_no_upper_bound():
@@ -216,13 +294,13 @@ def test_absent_nominal_grade_is_an_error_where_it_is_used(data, tfs):
         _fit(OneFaultShotEstimator(**{**FAST, "nominal_grade": 7}), data, tfs)
     message = str(info.value)
     assert "nominal_grade=7" in message and "[3, 6, 9]" in message
-    assert "select_features=True" in message
-    with pytest.raises(GearshotError, match="tune_simulation=False"):
-        _fit(OneFaultShotEstimator(**{**FAST, "nominal_grade": 7, "select_features": False,
-                                      "tune_simulation": False}), data, tfs)
+    assert "feature_selection=True" in message
+    with pytest.raises(GearshotError, match="calibration='nominal'"):
+        _fit(OneFaultShotEstimator(**{**FAST, "nominal_grade": 7, "feature_selection": False,
+                                      "calibration": "nominal"}), data, tfs)
     # unused (no selection, tuned): no error
     est = _fit(OneFaultShotEstimator(**{**FAST, "nominal_grade": 7,
-                                        "select_features": False}), data, tfs)
+                                        "feature_selection": False}), data, tfs)
     assert est.grade_ in (3, 6)
 
 
@@ -250,8 +328,12 @@ def test_failed_refit_keeps_the_previous_model(data, tfs, fitted):
     assert_array_equal(est.predict(data[3]), before)
 
 
-def test_fault_type_names_follow_the_simulator():
-    from gearshot.estimator._model import FAULT_TYPE_NAMES
-    from gearshot.sim import FAULT_TYPES
+def test_fault_type_choices_are_the_registry():
+    """The estimator's fault_type choices are the one fault-type record's names."""
+    from gearshot.estimator import OneFaultShotEstimator, check_estimator_params
+    from gearshot.fault_registry import FAULT_TYPE_NAMES
 
-    assert FAULT_TYPE_NAMES == tuple(FAULT_TYPES)
+    for name in FAULT_TYPE_NAMES:
+        check_estimator_params(OneFaultShotEstimator(fault_type=name))
+    with pytest.raises(GearshotError, match="fault_type"):
+        check_estimator_params(OneFaultShotEstimator(fault_type="rust"))

@@ -89,7 +89,8 @@ def test_results_resume_and_tables(tmp_path, monkeypatch, paths):
     assert all(done == {(0, "full"), (1, "full")} for _, _, done in calls[4:])
     # another estimator configuration is a new set of rows
     frame = family.rig_family_experiment("db", range(50, 52), variants=["full"],
-                                         params={"selection_threshold": 0.2}, **kw)
+                                         params={"options": {"selection_threshold": 0.2}},
+                                         **kw)
     assert len(frame) == 4 and len(calls) == 10
     with open(out, "a") as fh:  # an interrupted write leaves a cut line: skipped
         fh.write('{"config": "x", "se')
@@ -156,11 +157,12 @@ def test_cli_rig_family_runs_resumes_and_writes_tables(tmp_path, monkeypatch, pa
 
 
 def test_parse_params_names_the_option_and_value():
-    assert family.parse_params(["model_discrepancy=0.16", "grade_weighting=best"]) == {
-        "model_discrepancy": 0.16, "grade_weighting": "best"}
+    assert family.parse_params(["model_discrepancy=0.16", "calibration=tuned"]) == {
+        "model_discrepancy": 0.16, "calibration": "tuned"}
     with pytest.raises(GearshotError, match="'nope'"):
         family.parse_params(["nope=1"])
     with pytest.raises(GearshotError, match=r"--param.*NAME=VALUE.*'x'"):
         family.parse_params(["x"])
-    with pytest.raises(GearshotError, match=r"--param: simulated_reference.*'other'"):
-        family.parse_params(["simulated_reference=other"])
+    with pytest.raises(GearshotError,
+                       match=r"--param: options: simulated_reference.*'other'"):
+        family.parse_params(['options={"simulated_reference": "other"}'])

@@ -12,8 +12,8 @@ from gearshot import GearshotError, paper
 from gearshot.estimator import OneFaultShotEstimator
 from gearshot.sim import GearPair, build_database, load_database, pair_attrs
 
-PLAIN = dict(select_features=False, tune_simulation=False, transfer_function="none",
-             n_neighbors=range(1, 4), random_state=0)
+PLAIN = dict(feature_selection=False, calibration="nominal", transfer_function="none",
+             options={"n_neighbors": range(1, 4)}, random_state=0)
 
 
 @pytest.fixture(scope="module")

@@ -6,6 +6,7 @@
 ``zero_shot``                  grade choice from healthy data alone
 ``comparability``              does a segment look like the fitted machine (issue #19)
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
+``EstimatorOptions``            its research settings (one constructor parameter)
 ``save_estimator`` / ``load``  persistence with version metadata
 =============================  ======================================================
 """
@@ -14,7 +15,9 @@ from .._errors import NotFittedError
 from . import comparability, steps, uncertainty
 from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from ._params import check_estimator_params
+from .calibration import CalibrationOptions
 from .comparability import Comparability, ComparabilityReference, harmonic_profile
+from .options import EstimatorOptions
 from .persistence import load_estimator, save_estimator
 from .steps import (
     centred_features,
@@ -33,6 +36,8 @@ from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = [
     "OneFaultShotEstimator",
+    "EstimatorOptions",
+    "CalibrationOptions",
     "NotFittedError",
     "STEP_SEEDS",
     "default_selection_tf",

@@ -28,6 +28,7 @@ __all__ = [
     "NameSequence",
     "ArrayOrObject",
     "RandomStateValue",
+    "Resolvable",
     "validate_params",
     "check_estimator_params",
 ]
@@ -189,6 +190,32 @@ class RandomStateValue(Constraint):
         return "None, an integer >= 0, a numpy RandomState or a numpy Generator"
 
 
+@dataclass(frozen=True)
+class Resolvable(Constraint):
+    """A value that ``resolve`` turns into its object without raising a GearshotError
+    (a strategy name, an options object or a mapping of its fields).
+
+    When it refuses a mapping, :meth:`reason` gives ``resolve``'s own message (naming the
+    inner field and value), which :func:`validate_params` reports after the parameter.
+    """
+
+    resolve: Callable[[Any], Any]
+    description: str
+
+    def reason(self, value: Any) -> str | None:
+        try:
+            self.resolve(value)
+        except (GearshotError, TypeError) as exc:
+            return str(exc)
+        return None
+
+    def accepts(self, value: Any) -> bool:
+        return self.reason(value) is None
+
+    def __str__(self) -> str:
+        return self.description
+
+
 def validate_params(params: Mapping[str, Any],
                     constraints: Mapping[str, Sequence[Constraint]]) -> None:
     """Raise a :class:`GearshotError` for the first parameter no constraint accepts.
@@ -206,6 +233,9 @@ def validate_params(params: Mapping[str, Any],
     for name, value in params.items():
         allowed = constraints[name]
         if not any(c.accepts(value) for c in allowed):
+            reasons = [c.reason(value) for c in allowed if isinstance(c, Resolvable)]
+            if reasons and reasons[0] is not None and isinstance(value, Mapping):
+                raise GearshotError(f"{name}: {reasons[0]}")
             expected = " or ".join(str(c) for c in allowed)
             raise GearshotError(f"{name} must be {expected}; got {describe(value)}")
 
@@ -230,9 +260,9 @@ def check_estimator_params(estimator: Any) -> None:
     --------
     >>> from gearshot.estimator import OneFaultShotEstimator, check_estimator_params
     >>> check_estimator_params(OneFaultShotEstimator())
-    >>> check_estimator_params(OneFaultShotEstimator(n_neighbors=0))
+    >>> check_estimator_params(OneFaultShotEstimator(grades=[0]))
     Traceback (most recent call last):
     ...
-    gearshot._errors.GearshotError: n_neighbors must be ...
+    gearshot._errors.GearshotError: grades must be ...
     """
     validate_params(estimator.get_params(deep=False), estimator._parameter_constraints)

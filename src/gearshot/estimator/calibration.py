@@ -41,8 +41,9 @@ __all__ = ["CalibrationOptions", "resolve_calibration", "fault_centre", "stretch
 
 FloatArray = NDArray[np.float64]
 
-#: What ``OneFaultShotEstimator(calibration=...)`` accepts as a string.
-CALIBRATION_STRATEGIES = ("joint", "grade")
+#: What ``OneFaultShotEstimator(calibration=...)`` accepts as a string: the grade-choice
+#: strategies (see the estimator's ``calibration`` parameter).
+CALIBRATION_STRATEGIES = ("grade", "tuned", "joint", "nominal", "zero_shot")
 
 TF_MODES = ("tf", "none")
 
@@ -118,15 +119,16 @@ class CalibrationOptions:
 
 
 def resolve_calibration(value: Any) -> CalibrationOptions | None:
-    """The options of ``calibration=``: ``"grade"`` → None (grade weights only),
-    ``"joint"`` → the defaults, a mapping or :class:`CalibrationOptions` → those."""
+    """The joint grid of ``calibration=``: ``"joint"`` → the default grid, a mapping or
+    :class:`CalibrationOptions` → that grid, the other strategies (``"grade"``,
+    ``"tuned"``, ``"nominal"``, ``"zero_shot"``: no joint grid) → None."""
     if isinstance(value, CalibrationOptions):
         return value
     if isinstance(value, str):
-        if value == "grade":
-            return None
         if value == "joint":
             return CalibrationOptions()
+        if value in CALIBRATION_STRATEGIES:
+            return None
     elif isinstance(value, Mapping):
         known = set(CalibrationOptions.__dataclass_fields__)
         unknown = sorted(set(value) - known)

@@ -36,8 +36,9 @@ _PICKLE_FORMAT = "gearshot-estimator/1"
 SAFE_TYPES = (
     "builtins.range",
     "gearshot.estimator._model.OneFaultShotEstimator",
-    "gearshot.estimator.steps.KnnModel",
+    "gearshot.estimator.knn.KnnModel",
     "gearshot.estimator.calibration.CalibrationOptions",
+    "gearshot.estimator.options.EstimatorOptions",
     "gearshot.estimator.comparability.Comparability",
     "gearshot.estimator.comparability.ComparabilityReference",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",

@@ -5,10 +5,12 @@
 3. :func:`estimate_tf`            TF from one long healthy target signal
 4. :func:`propagate_simulated`    simulated SAs through that TF
 5. :func:`normalize_rms`          divide by the mean RMS of the domain's healthy SAs
+   (:func:`rms_scale`: that mean, the one computation of step 5's scale)
 6. :func:`suppress_harmonics_simulated` / :func:`suppress_harmonics_target`
    (with :func:`split_target_healthy`, which sets the target's references apart)
 7. :func:`centred_features`       features minus the healthy mean of their domain
 8. :func:`fit_knn`                K-nearest-neighbour regression, K chosen on a 70/30 split
+   (defined with :class:`KnnModel` in :mod:`gearshot.estimator.knn`)
 
 :func:`simulated_features` chains steps 4–7 on one set of simulated SAs; step 1 and the
 estimator's grade models both use it. The grade weights and prediction intervals, which
@@ -18,22 +20,18 @@ are not steps of the paper, are in :mod:`gearshot.estimator.uncertainty`.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from sklearn.model_selection import ShuffleSplit
-from sklearn.neighbors import KNeighborsRegressor
-from sklearn.pipeline import Pipeline
-from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
 
 from .._errors import GearshotError
 from ..features import extract_features
-from ..signal import subtract_healthy
-from ..transfer import estimate_transfer_function, mean_rms, propagate, rms_normalize
+from ..signal import mean_rms, subtract_healthy
+from ..transfer import estimate_transfer_function, propagate
+from .knn import KnnModel, fit_knn
 
 __all__ = [
     "select_features",
@@ -41,6 +39,7 @@ __all__ = [
     "tune_grade",
     "estimate_tf",
     "propagate_simulated",
+    "rms_scale",
     "normalize_rms",
     "suppress_harmonics_simulated",
     "residue_power",
@@ -222,9 +221,28 @@ def propagate_simulated(sim_sa: ArrayLike, tf: ArrayLike | None) -> FloatArray:
 
 
 # ---------------------------------------------------------------- step 5
-def normalize_rms(signals: ArrayLike, healthy: ArrayLike) -> FloatArray:
-    """Step 5: divide by the mean RMS of the healthy SAs of the same domain."""
-    return rms_normalize(signals, healthy)
+def rms_scale(healthy: ArrayLike, *, name: str = "the healthy SAs") -> float:
+    """Step 5's scale: the mean RMS of a domain's healthy SAs (``name`` them for the error
+    when it is zero)."""
+    scale = mean_rms(healthy)
+    if not scale > 0:
+        raise GearshotError(f"{name} has zero RMS; step 5 cannot normalize by it")
+    return scale
+
+
+def normalize_rms(signals: ArrayLike, healthy: ArrayLike | None = None, *,
+                  scale: float | None = None) -> FloatArray:
+    """Step 5: divide by the mean RMS of the healthy SAs of the same domain.
+
+    The one home of step 5, for both domains: the simulated SAs by their own healthy SAs,
+    the target SAs by the target's healthy SAs (``scale``: :func:`rms_scale` of them,
+    measured once at fit).
+    """
+    if scale is None:
+        if healthy is None:
+            raise GearshotError("normalize_rms needs the healthy SAs or their scale")
+        scale = rms_scale(healthy)
+    return np.asarray(signals, dtype=float) / scale
 
 
 # ---------------------------------------------------------------- step 6
@@ -318,8 +336,7 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
                        mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True, twins: ArrayLike | None = None,
-                       noise_power: ArrayLike | None = None,
-                       random_state: RandomStateLike = None) -> FloatArray:
+                       noise: ArrayLike | None = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
 
     Parameters
@@ -336,12 +353,10 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
     twins : ndarray (n_signals, n_points), optional
         Each signal's healthy twin: step 6 subtracts it (propagated and scaled like the
         signals) instead of the first healthy SA.
-    noise_power : ndarray (n_points // 2 + 1,), optional
-        Power spectrum of the residue to add to the difference signals (noise matching,
-        :func:`residue_power` of the target's healthy differences); with twins the
+    noise : ndarray (n_signals, n_points), optional
+        Residue added to the difference signals (noise matching: :func:`residue_noise`
+        of the target's healthy differences' :func:`residue_power`); with twins the
         simulated differences have no residue of their own.
-    random_state : int, RandomState or None
-        Seeds the matched noise.
 
     Returns
     -------
@@ -350,124 +365,23 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         features).
     """
     healthy = np.asarray(healthy_mask, bool)
-    sim = propagate_simulated(sim_sa, tf)
-    twin = None if twins is None else propagate_simulated(twins, tf)
-    if rms_normalization:
-        if twin is not None:
-            twin = normalize_rms(twin, sim[healthy])
-        sim = normalize_rms(sim, sim[healthy])
-    sim = suppress_harmonics_simulated(sim, healthy, twin)
-    if noise_power is not None:
-        rng = np.random.default_rng(check_random_state(random_state).randint(2**31 - 1))
-        sim = sim + residue_noise(noise_power, sim.shape[0], sim.shape[1], rng)
+    if twins is None:
+        sim = propagate_simulated(sim_sa, tf)
+        if rms_normalization:
+            sim = normalize_rms(sim, sim[healthy])
+        sim = suppress_harmonics_simulated(sim, healthy)
+    else:
+        # steps 4-6 are linear in the signals: the twin's difference goes through the TF
+        # once (half the propagation), scaled by the propagated healthy SAs' mean RMS
+        sim = propagate_simulated(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
+        if rms_normalization:
+            sim = normalize_rms(sim, propagate_simulated(np.asarray(sim_sa)[healthy], tf))
+    if noise is not None:
+        sim = sim + np.asarray(noise, dtype=float)
     feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
     return feats
 
 
 # ---------------------------------------------------------------- step 8
-@dataclass(frozen=True)
-class KnnModel:
-    """A fitted step-8 regressor with what choosing K left behind.
-
-    Attributes
-    ----------
-    pipeline : sklearn.pipeline.Pipeline
-        Scaling by the training std, then ``KNeighborsRegressor``; fitted on all data.
-    n_neighbors : int
-        The chosen K.
-    validation_mae : ndarray
-        Validation MAE for K = 1 … len(validation_mae).
-    validation_residuals : ndarray
-        ``|y - ŷ|`` on the validation split at the chosen K (for conformal intervals).
-    validation_y : ndarray
-        Labels of the validation split.
-    validation_indices : ndarray of int
-        Rows of the training data in the validation split.
-    """
-
-    pipeline: Pipeline
-    n_neighbors: int
-    validation_mae: FloatArray
-    validation_residuals: FloatArray
-    validation_y: FloatArray
-    validation_indices: NDArray[np.intp]
-
-    def predict(self, X: ArrayLike) -> FloatArray:
-        """Fault sizes of feature rows ``X`` (n_samples, n_features)."""
-        return np.asarray(self.pipeline.predict(X), dtype=float)
-
-
-def _knn_pipeline(k: int) -> Pipeline:
-    return Pipeline([("scale", StandardScaler(with_mean=False)),
-                     ("knn", KNeighborsRegressor(n_neighbors=k))])
-
-
-def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1, 101),
-            validation_fraction: float = 0.3,
-            random_state: RandomStateLike = None) -> KnnModel:
-    """Step 8: KNN regression; K chosen by validation MAE on one random split.
-
-    Features are divided by the training standard deviation (``StandardScaler`` without
-    centring). For every candidate K the validation MAE is computed from one neighbour
-    query of the largest K (equivalent to refitting per K, much faster); the final model
-    is refitted on all of ``X`` with the best K.
-
-    Parameters
-    ----------
-    X : ndarray (n_samples, n_features)
-    y : ndarray (n_samples,)
-    n_neighbors : iterable of int
-        Candidate K values.
-    validation_fraction : float
-        Share of samples in the validation split.
-    random_state : int, RandomState or None
-        Seeds the split (which depends only on it and on ``n_samples``).
-
-    Returns
-    -------
-    KnnModel
-    """
-    X = np.asarray(X, dtype=float)
-    y = np.asarray(y, dtype=float)
-    candidates = np.unique(np.asarray(list(n_neighbors), dtype=int))
-    if candidates.size == 0 or candidates[0] < 1:
-        raise GearshotError(f"n_neighbors must hold positive integers; got {n_neighbors!r}")
-    if not 0 < validation_fraction < 1:
-        raise GearshotError(f"validation_fraction must lie in (0, 1); got "
-                            f"{validation_fraction!r}")
-    if X.shape[0] < 4:
-        raise GearshotError(f"fit_knn needs at least 4 training samples; got {X.shape[0]}")
-    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
-    split = ShuffleSplit(n_splits=1, test_size=validation_fraction, random_state=seed)
-    train, val = next(split.split(X))
-    candidates = candidates[candidates <= train.size]
-    if candidates.size == 0:
-        candidates = np.array([1])
-    k_max = int(candidates[-1])
-    probe = _knn_pipeline(k_max).fit(X[train], y[train])
-    scaled = probe.named_steps["scale"].transform(X[val])
-    _, idx = probe.named_steps["knn"].kneighbors(scaled, n_neighbors=k_max)
-    neighbour_y = y[train][idx]  # (n_val, k_max), nearest first
-    running_mean = np.cumsum(neighbour_y, axis=1) / np.arange(1, k_max + 1)
-    mae_all = np.mean(np.abs(running_mean - y[val][:, None]), axis=0)
-    mae = mae_all[candidates - 1]
-    best = int(candidates[int(np.argmin(mae))])
-    residuals = np.abs(running_mean[:, best - 1] - y[val])
-    final = _knn_pipeline(best).fit(X, y)
-    return KnnModel(final, best, mae_all, residuals, y[val], val)
-
-
-# ---------------------------------------------------------------- moved names
-_MOVED = {"grade_weights", "prune_weights", "conformal_quantile", "mixture_interval"}
-
-
-def __getattr__(name: str) -> Any:
-    # The uncertainty code lived here before it got its own module; keep the old names.
-    if name in _MOVED:
-        warnings.warn(f"gearshot.estimator.steps.{name} moved to "
-                      f"gearshot.estimator.uncertainty.{name}", DeprecationWarning,
-                      stacklevel=2)
-        from . import uncertainty
-
-        return getattr(uncertainty, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# fit_knn and KnnModel (imported above from .knn): K-nearest-neighbour regression, K chosen
+# on one validation split.

@@ -51,7 +51,7 @@ def _diagnostic_params(name, rig, paths):
     if name == "oracle_both":
         return dict(transfer_function=true_path_on_grid(rig, paths), calibration="joint")
     if name == "true_grade":
-        return dict(tune_simulation=False, nominal_grade=int(rig.grade))
+        return dict(calibration="nominal", nominal_grade=int(rig.grade))
     if name == "oracle_calibration":
         return dict(calibration="joint")
     raise GearshotError(f"unknown diagnostic variant {name!r}")

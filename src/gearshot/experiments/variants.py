@@ -9,18 +9,18 @@ __all__ = ["VARIANTS", "SIMULATED_VARIANTS", "RIG_VARIANTS", "variant_params"]
 VARIANTS = MappingProxyType({
     # no domain adaptation: simulated signals as they are, raw target levels
     "before_da": dict(transfer_function="none", rms_normalization=False,
-                      select_features=False),
+                      feature_selection=False),
     # domain adaptation by RMS normalization only
     "rms_only": dict(transfer_function="none", rms_normalization=True,
-                     select_features=False),
+                     feature_selection=False),
     # full algorithm without step 1
-    "no_feature_selection": dict(select_features=False),
+    "no_feature_selection": dict(feature_selection=False),
     # full algorithm without step 2 (nominal grade)
-    "no_tuning": dict(tune_simulation=False),
+    "no_tuning": dict(calibration="nominal"),
     # the full algorithm
     "full": dict(),
     # no faulty example at all: grade from healthy statistics (the paper's future work)
-    "zero_shot": dict(zero_shot=True),
+    "zero_shot": dict(calibration="zero_shot"),
 })
 
 SIMULATED_VARIANTS = ("before_da", "rms_only", "full")

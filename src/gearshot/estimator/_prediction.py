@@ -1,0 +1,164 @@
+"""What a fitted :class:`~gearshot.estimator.OneFaultShotEstimator` answers: sizes,
+intervals, comparability, score; saving and loading."""
+
+from __future__ import annotations
+
+from typing import Any, Self, cast
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from sklearn.base import BaseEstimator
+
+from .._errors import GearshotError, NotFittedError
+from .._validation import as_signal_array, check_in_range
+from ._target import target_features
+from .comparability import Comparability, ComparabilityReference
+from .uncertainty import conformal_quantile, mixture_interval
+
+FloatArray = NDArray[np.float64]
+
+
+# scikit-learn ships no type information: its classes are Any to mypy
+class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
+    """The prediction part of :class:`~gearshot.estimator.OneFaultShotEstimator`."""
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return hasattr(self, "model_")
+
+    def _check_fitted(self, method: str) -> None:
+        if not self.__sklearn_is_fitted__():
+            raise NotFittedError(f"This {type(self).__name__} is not fitted yet; call fit "
+                                 f"before {method}")
+
+    def features_of(self, sa: ArrayLike) -> FloatArray:
+        """Selected, centred target features of SAs (what the KNN sees, before scaling).
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+
+        Returns
+        -------
+        ndarray (n_signals, n_selected_features)
+        """
+        self._check_fitted("features_of")
+        arr = as_signal_array(sa, "sa", max_ndim=2)
+        if arr.shape[-1] != self.n_points_:
+            raise GearshotError(f"sa has {arr.shape[-1]} points per cycle; the estimator was "
+                                f"fitted on {self.n_points_}")
+        feats = target_features(self, arr, self.target_scale_, self.references_,
+                                self.target_healthy_mean_, self.candidate_features_)
+        return feats[:, self.selected_columns_]
+
+    def predict(self, sa: ArrayLike) -> FloatArray:
+        """Fault sizes of target SAs.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+
+        Returns
+        -------
+        ndarray (n_signals,)
+        """
+        self._check_fitted("predict")
+        X = self.features_of(sa)
+        return sum((st["weight"] * m.predict(X) for st, m in
+                    zip(self.calibration_["settings"], self.setting_models_)),
+                   np.zeros(len(X)))
+
+    def comparability(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
+        """Whether target SAs look like the fitted machine (know when not to answer).
+
+        Compares each SA's regular part — the unit-norm amplitudes of its mesh-harmonic
+        orders (:func:`~gearshot.estimator.comparability.harmonic_profile`) — with the
+        fitted machine's states: the healthy SAs' mean profile, moved toward the faulty
+        example's profile as a fault grows to size 1. The score is the distance from
+        those states in units of the healthy SAs' own spread; a segment of another build,
+        another speed or load than the database's, or another sensor lies far from them
+        and is not comparable: its estimate should not be acted on.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        threshold : float > 0, optional
+            Largest score of a comparable segment; default
+            :data:`~gearshot.estimator.comparability.DEFAULT_THRESHOLD` (3.0, chosen on
+            the PHM 2009 spur subset's 30 Hz cells, benchmarks/RESULTS.md).
+
+        Returns
+        -------
+        Comparability
+            ``score`` (n_signals,), ``comparable`` (bool, ``score <= threshold``) and
+            ``threshold``.
+        """
+        self._check_fitted("comparability")
+        reference: ComparabilityReference | None = getattr(self, "comparability_reference_",
+                                                            None)
+        if reference is None:  # an estimator saved before comparability existed
+            raise GearshotError("this estimator was fitted by an older gearshot without "
+                                "a comparability reference; fit it again")
+        return reference.evaluate(sa, threshold)
+
+    def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
+                         ) -> tuple[FloatArray, FloatArray]:
+        """Prediction intervals: split-conformal residuals widened by the model discrepancy.
+
+        Each grade model says ``y = ŷ_g ± r + δ``: ``r`` from its validation residuals
+        (split conformal), ``δ ~ N(0, model_discrepancy²)`` the simulation-to-reality
+        error the validation split cannot show. With soft grade weighting the interval
+        is the central ``coverage`` range of the weighted mixture over the grade models
+        (:func:`~gearshot.estimator.mixture_interval`); with one model and
+        ``model_discrepancy=0`` it is the plain split-conformal interval.
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        coverage : float in (0, 1), default 0.9
+
+        Returns
+        -------
+        low, high : ndarray (n_signals,)
+            Clipped to [0, 1].
+        """
+        self._check_fitted("predict_interval")
+        coverage = check_in_range(coverage, "coverage", 0, 1, low_inclusive=False,
+                                  high_inclusive=False)
+        X = self.features_of(sa)
+        discrepancy = float(self.model_discrepancy)
+        settings, models = self.calibration_["settings"], self.setting_models_
+        if len(models) == 1 and discrepancy == 0:
+            pred = models[0].predict(X)
+            q = conformal_quantile(models[0].validation_residuals, coverage)
+            return np.clip(pred - q, 0, 1), np.clip(pred + q, 0, 1)
+        low, high = mixture_interval(
+            {i: m.predict(X) for i, m in enumerate(models)},
+            {i: st["weight"] for i, st in enumerate(settings)},
+            {i: m.validation_residuals for i, m in enumerate(models)},
+            coverage, discrepancy=discrepancy)
+        return np.clip(low, 0, 1), np.clip(high, 0, 1)
+
+    def score(self, X: ArrayLike, y: ArrayLike,
+              sample_weight: ArrayLike | None = None) -> float:
+        """Negative mean absolute error (higher is better) on SAs ``X`` of sizes ``y``."""
+        pred = self.predict(X)
+        weights = None if sample_weight is None else np.asarray(sample_weight, float)
+        return -float(np.average(np.abs(pred - np.asarray(y, float)), weights=weights))
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path: str | Any) -> None:
+        """Save the fitted estimator (skops format: loading it runs no code) with version
+        metadata, atomically."""
+        from .persistence import save_estimator
+
+        save_estimator(self, path)
+
+    @classmethod
+    def load(cls, path: str | Any, *, trusted: bool = False) -> Self:
+        """Load an estimator saved by :meth:`save`; a file that would construct other types
+        than an estimator's, or an old joblib pickle, needs ``trusted=True`` (which runs
+        the file's code: only for files you made; see
+        :func:`gearshot.estimator.persistence.load_estimator`)."""
+        from .persistence import load_estimator
+
+        return cast(Self, load_estimator(path, trusted=trusted))

@@ -1,0 +1,70 @@
+"""The target side of ``fit``: steps 3 and 5–7 on the target machine's SAs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import steps
+from ._inputs import _FitInputs, _on_grid
+from .zero_shot import residue_mean_square
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+
+@dataclass(frozen=True)
+class _TargetSide:
+    """What steps 3 and 5–7 learn from the target's healthy SAs."""
+
+    transfer_function: ComplexArray | None
+    scale: float
+    scaled_healthy: FloatArray
+    references: FloatArray
+    healthy_mean: FloatArray
+    healthy_features: FloatArray
+    residue_power: FloatArray
+    residue_ms: float
+
+
+def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _TargetSide:
+    """Steps 3 and 5–7 on the target: TF, scale, references, healthy features."""
+    tf = target_tf(est, inputs.healthy_long, inputs.n_points)
+    scale = steps.rms_scale(inputs.target_healthy, name="target_healthy")
+    scaled = steps.normalize_rms(inputs.target_healthy, scale=scale) \
+        if est.rms_normalization else inputs.target_healthy
+    train_h, references = steps.split_target_healthy(scaled)
+    sub_h = steps.suppress_harmonics_target(train_h, references,
+                                            upsample=est._options().upsample)
+    feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
+                                             names=names,
+                                             healthy_mask=np.ones(len(sub_h), bool))
+    return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
+                       steps.residue_power(sub_h),
+                       residue_mean_square(sub_h, est._mesh_orders()))
+
+
+def target_tf(est: Any, healthy_long: FloatArray | None,
+              n_points: int) -> ComplexArray | None:
+    """Step 3, or the given TF on the SA grid, or None."""
+    tf = est.transfer_function
+    if isinstance(tf, str):
+        if tf == "none" or healthy_long is None:  # checked: "estimate" has it
+            return None
+        return steps.estimate_tf(healthy_long, n_points)
+    return _on_grid(tf, n_points, "transfer_function")
+
+
+def target_features(est: Any, sa: ArrayLike | None, scale: float, references: FloatArray,
+                    healthy_mean: FloatArray, names: tuple[str, ...]) -> FloatArray:
+    """Steps 5–7 on target SAs with the target side's scale, references and mean."""
+    x = np.atleast_2d(np.asarray(sa, dtype=float))
+    if est.rms_normalization:
+        x = steps.normalize_rms(x, scale=scale)
+    sub = steps.suppress_harmonics_target(x, references, upsample=est._options().upsample)
+    feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=est._mesh_orders(),
+                                      names=names)
+    return feats
