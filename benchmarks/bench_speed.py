@@ -7,6 +7,7 @@
     python benchmarks/bench_speed.py estimator           # fit + predict of one rig dataset
     python benchmarks/bench_speed.py sweep --conditions 8   # a measured fraction of the sweep
     python benchmarks/bench_speed.py compare             # CPU of a small paired machine db
+    python benchmarks/bench_speed.py breakdown           # CPU per step of 2 condition blocks
     PYTHONPATH=OLD/src python benchmarks/bench_speed.py compare   # ... with older code
 
 Prints numbers (no asserts). The box is shared, so every timing is printed with the load
@@ -165,6 +166,7 @@ def bench_condition(args):
                   f"{'+ twins' if paired else '(unpaired)'}, in-process (2 numba threads): "
                   f"{wall:.1f} s wall, {cpu:.1f} s CPU; load avg before {l0}, after "
                   f"{load_avg()}; {peak_mb()}")
+        k0 = children_cpu()
         client, cluster = _local_client()
         try:
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), client,
@@ -172,8 +174,11 @@ def bench_condition(args):
         finally:
             client.close()
             cluster.close()
+        workers_cpu = children_cpu() - k0
         print(f"  + twins on a LocalCluster (2 x 1 thread, started before timing): "
-              f"{wall:.1f} s wall; load avg before {l0}, after {load_avg()}; {peak_mb()}")
+              f"{wall:.1f} s wall, workers' CPU {workers_cpu:.1f} s (/2 = "
+              f"{workers_cpu / 2:.1f} s on 2 free cores); load avg before {l0}, after "
+              f"{load_avg()}; {peak_mb()}")
 
 
 def bench_scheduler(args):
@@ -303,10 +308,57 @@ def bench_sweep(args):
     print(frame.groupby("variant")["mae"].mean().mul(100).round(2).to_string())
 
 
+def bench_breakdown(args):
+    """CPU of the steps of 2 paired condition blocks (grades 7, 8 at 15 rps / 10 N m,
+    800 + twins each), in-process, numba one thread: wrappers around the steps."""
+    import numba
+
+    import gearshot.sim._system as system
+    import gearshot.sim.dynamics as dyn
+    from gearshot.sim import GearPair, build_database
+
+    numba.set_num_threads(1)
+    acc: dict = {}
+
+    def wrap(owner, name, key):
+        func = getattr(owner, name)
+
+        def timed(*a, **k):
+            c = time.process_time()
+            try:
+                return func(*a, **k)
+            finally:
+                acc[key] = acc.get(key, 0.0) + time.process_time() - c
+        setattr(owner, name, timed)
+
+    for owner, name, key in ((system, "newmark_spur", "kernel"),
+                             (dyn, "make_batch", "fault tables (make_batch)"),
+                             (dyn, "_fft_resample", "FFT resampling"),
+                             (dyn, "draw_errors", "profile errors"),
+                             (dyn, "as_rng", "one Generator per seed"),
+                             (dyn, "resolve_faults", "fault objects"),
+                             (system.Batch, "shared", "batch-shared contacts")):
+        wrap(owner, name, key)
+    kw = dict(speeds=[15.0], loads=[10.0], seed=0, paired=True, progress=False)
+    with tempfile.TemporaryDirectory(dir=args.tmp) as tmp:
+        build_database(Path(tmp) / "warm", GearPair.paper(), grades=[3], n_healthy=2,
+                       n_faulty=2, **kw)
+        acc.clear()
+        c0 = time.process_time()
+        build_database(Path(tmp) / "db", GearPair.paper(), grades=[7, 8], n_healthy=100,
+                       n_faulty=700, **kw)
+        total = time.process_time() - c0
+    print(f"2 paired condition blocks (3200 SAs), numba one thread: {total:.2f} s CPU = "
+          f"{1e3 * total / 3200:.3f} ms per SA; load avg {load_avg()}")
+    for key, v in sorted(acc.items(), key=lambda kv: -kv[1]):
+        print(f"  {key:28s} {v:6.2f} s  {100 * v / total:5.1f} %")
+    print(f"  {'rest (zarr, checksums, ...)':28s} {total - sum(acc.values()):6.2f} s")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("part", choices=["sim", "machine", "condition", "scheduler", "estimator",
-                                     "sweep", "compare"])
+                                     "sweep", "compare", "breakdown"])
     ap.add_argument("--paired-only", action="store_true")
     ap.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "gearshot-bench"))
     ap.add_argument("--tmp", default=None, help="folder for temporary stores")

@@ -43,7 +43,7 @@ def main():
 
 def components():
     """Compliance terms of one tooth, ours vs ROSS's, spur paper pair."""
-    from gearshot.sim import stiffness as st
+    from gearshot.sim import _compliance as st
 
     rs = _ross()
     p = GearPair.paper()
@@ -69,7 +69,7 @@ def components():
 
 
 def _theta_f(p, z):
-    from gearshot.sim import stiffness as st
+    from gearshot.sim import _compliance as st
 
     rb, rf = p.base_radius(z), p.root_radius(z)
     psi_b = float(st.involute_half_angle(z, p.transverse_pressure_angle, np.array(rb), rb))
@@ -78,7 +78,7 @@ def _theta_f(p, z):
 
 def _foundation(p, z, roll):
     """Our fillet-foundation compliance (Sainsot 2004), as in ``_tooth_compliance``."""
-    from gearshot.sim import stiffness as st
+    from gearshot.sim import _compliance as st
 
     rb, rf = p.base_radius(z), p.root_radius(z)
     theta_f = _theta_f(p, z)

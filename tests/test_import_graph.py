@@ -18,10 +18,7 @@ ROOT = Path(__file__).resolve().parents[1] / "src" / "gearshot"
 
 # (importer, imported) lazy edges that still close a circle, in files other work owns
 # (issue #21 left them to their owners); remove an entry when its circle is gone
-_EXCUSED: set[tuple[str, str]] = {
-    ("gearshot.sim.faults", "gearshot.sim._ftff_batch"),  # faults <-> _ftff_batch
-    ("gearshot.sim._ftff_batch", "gearshot.sim.stiffness"),  # stiffness <-> _ftff_batch
-}
+_EXCUSED: set[tuple[str, str]] = set()
 
 
 def _modules() -> dict[str, tuple[Path, bool]]:

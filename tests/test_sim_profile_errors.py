@@ -48,3 +48,22 @@ def test_mean_tooth_is_exact_average():
 def test_bad_grade(grade):
     with pytest.raises(GearshotError, match="grade"):
         draw_profile_errors(17, grade, np.random.default_rng(0))
+
+
+def test_one_formula_pieces():
+    """The pieces of ``tooth_error``: the waviness's sine/cosine amplitudes reproduce the
+    phase form, and the noise cell puts s = 1 at the end of the last cell."""
+    from gearshot.sim.profile_errors import noise_cell, tooth_error, wave_amplitudes
+
+    rng = np.random.default_rng(7)
+    wav, phase, s = rng.uniform(1, 2, 5), rng.uniform(-np.pi, np.pi, 5), rng.uniform(0, 1, 5)
+    wa, wb = wave_amplitudes(wav, phase)
+    ang = 2 * np.pi * 3.5 * s
+    np.testing.assert_allclose(wa * np.sin(ang) + wb * np.cos(ang),
+                               0.5 * wav * np.sin(ang + phase), rtol=1e-13)
+    i0, frac = noise_cell(np.array([0.0, 0.5, 1.0]), 16)
+    np.testing.assert_array_equal(i0, [0, 7, 14])
+    np.testing.assert_allclose(frac, [0.0, 0.5, 1.0])
+    # slope, waves and noise add: 2 * 0.25 + 1 * sin + 0 * cos + knot interpolation
+    assert tooth_error(0.25, 2.0, 1.0, 0.0, 0.5, 0.3, 4.0, 8.0, 0.25) == pytest.approx(
+        0.5 + 0.5 + 5.0)

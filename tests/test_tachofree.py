@@ -26,6 +26,7 @@ from gearshot.signal import (
     residual_signal,
     speed_ridge,
 )
+from gearshot.signal.speed_profile import fit_speed_profile
 
 ROOT = Path(__file__).resolve().parents[1]
 PHM09 = ROOT.parent / "shared" / "data" / "phm09"
@@ -87,8 +88,54 @@ def test_run_down_and_the_comb_picks_the_speed_not_half_of_it():
 def test_noise_is_refused_with_the_snr_found():
     x = np.random.default_rng(0).standard_normal(80_000)
     with pytest.raises(GearshotError, match=r"no mesh harmonic stands out.*-?\d+\.\d dB above "
-                                            r"the noise.*min_snr_db=3"):
+                                            r"the noise.*min_snr_db=3.*whole record the best "
+                                            r"speed profile's strongest mesh line is \d+\.\d dB "
+                                            r"over the floor \(0 whole orders") as info:
         estimate_shaft_angle(x, 20_000.0, orders=[32, 16], speed_range=(20, 35))
+    assert "\n" not in str(info.value)
+
+
+# ------------------------------------------------------------ whole-record speed profile
+def _rig_run_up(engine="surrogate", seed=5, speed=12.0, end=16.0):
+    from gearshot.rig import VirtualRig
+    from gearshot.signal import pulse_times
+    rec = VirtualRig(seed=seed, engine=engine).record(speed=speed, load=10, duration=4.0,
+                                                      end_speed=end)
+    return rec, pulse_times(rec.tacho, rec.fs)
+
+
+def test_a_virtual_rig_run_up_is_tracked_over_the_whole_record():
+    """The whole-record profile finds the rig's ramp; the angle (whichever path the
+    tracker takes) follows the rig's tacho."""
+    from scipy.interpolate import CubicSpline
+    rec, pulses = _rig_run_up()
+    p = fit_speed_profile(rec.acceleration, rec.fs, orders=[17], speed_range=(10, 19))
+    c, a, _ = p.coef  # the rig's ramp: 14 rev/s at mid-record, +1 rev/s per s
+    assert abs(c - 14.0) < 0.01 and abs(a - 1.0) < 0.02 and p.n_lines >= 2
+    est = estimate_shaft_angle(rec.acceleration, rec.fs, orders=[17], speed_range=(10, 19))
+    truth = CubicSpline(pulses, np.arange(pulses.size))
+    sel = (est.times > pulses[0]) & (est.times < pulses[-1])
+    err = est.angle[sel] - truth(est.times[sel])
+    assert np.std(err) * 360 < 5.0  # degrees of shaft angle against the tacho's
+
+
+def test_fit_speed_profile_recovers_a_curved_run_down_and_names_bad_options():
+    fs = 4000.0
+    t = np.arange(int(4 * fs)) / fs
+    u = t - 0.5 * (t.size - 1) / fs
+    revs = 15.0 * u - 0.4 * u ** 2 + 0.05 * u ** 3  # 15 rev/s at mid, -0.8 rev/s^2, curved
+    rng = np.random.default_rng(11)
+    x = np.cos(2 * np.pi * 20 * revs) + 0.5 * np.cos(2 * np.pi * 40 * revs + 1.0)
+    x = x + 1.5 * rng.standard_normal(t.size)
+    p = fit_speed_profile(x, fs, orders=[20], speed_range=(11, 19))
+    assert np.allclose(p.coef, (15.0, -0.8, 0.15), atol=0.01)
+    assert p.lines[0][0] == 20 and p.n_lines == 2
+    assert np.max(np.abs(p.angle(t) - p.angle(t)[0] - (revs - revs[0]))) * 360 < 2.0
+    for kwargs, message in [(dict(speed_range=(5, 5)), "speed_range"),
+                            (dict(max_rate=-1.0), "max_rate must be > 0"),
+                            (dict(orders=[3000]), r"orders=\[3000\].*above 0.4 fs")]:
+        with pytest.raises(GearshotError, match=message):
+            fit_speed_profile(x, fs, **{"orders": [20], "speed_range": (11, 19), **kwargs})
 
 
 @pytest.mark.parametrize("kwargs, message", [

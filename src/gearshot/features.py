@@ -31,7 +31,6 @@ from types import MappingProxyType
 from typing import cast
 
 import numpy as np
-import scipy.fft
 from numpy.typing import ArrayLike
 
 from ._errors import GearshotError
@@ -46,7 +45,6 @@ __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
 _TINY_RMS = 1e-10
 _SHAFT_ORDERS = (1, 2)
-_WORKERS = None  # scipy.fft threads: one (Dask workers parallelize across processes)
 
 
 class _Parts:
@@ -66,15 +64,14 @@ class _Parts:
 
     @cached_property
     def spectrum(self) -> ComplexArray:
-        return cast(ComplexArray, scipy.fft.rfft(self.sa, axis=-1, workers=_WORKERS))
+        return np.fft.rfft(self.sa, axis=-1)
 
     def _keep(self, orders: IntArray, *, invert: bool = False) -> FloatArray:
         mask = np.zeros(self.n // 2 + 1, dtype=bool)
         mask[orders] = True
         if invert:
             mask = ~mask
-        return cast(FloatArray, scipy.fft.irfft(self.spectrum * mask, n=self.n, axis=-1,
-                                                workers=_WORKERS))
+        return np.fft.irfft(self.spectrum * mask, n=self.n, axis=-1)
 
     def _mesh(self, n_sidebands: int) -> IntArray:
         return mesh_band_orders(self.n, self.mesh_order, n_sidebands)
@@ -87,8 +84,7 @@ class _Parts:
 
     @cached_property
     def diff(self) -> FloatArray:
-        return cast(FloatArray, scipy.fft.irfft(self.diff_spectrum, n=self.n, axis=-1,
-                                                workers=_WORKERS))
+        return np.fft.irfft(self.diff_spectrum, n=self.n, axis=-1)
 
     @cached_property
     def rms_diff(self) -> FloatArray:
@@ -104,7 +100,7 @@ class _Parts:
         quad[..., 0] = 0.0
         if n % 2 == 0:
             quad[..., n // 2] = 0.0
-        hilb = scipy.fft.irfft(quad, n=n, axis=-1, workers=_WORKERS)
+        hilb = np.fft.irfft(quad, n=n, axis=-1)
         return _centred_modulus(self.diff, hilb)
 
     @cached_property

@@ -27,7 +27,13 @@ import scipy.signal
 
 from .._validation import check_in_range, check_int
 from ..paper import GEAR_TEETH, PINION_TEETH
-from ..sim.profile_errors import DIN_PROFILE_TOLERANCES
+from ..sim.profile_errors import (
+    DIN_PROFILE_TOLERANCES,
+    noise_cell,
+    tooth_error,
+    wave_amplitudes,
+    waves_per_profile,
+)
 from .reality import RigReality
 
 __all__ = ["SurrogateEngine", "DIN_PROFILE_TOLERANCES_UM"]
@@ -92,13 +98,12 @@ class SurrogateEngine:
         wav = ff * rng.uniform(0.9, 1.1, z)
         phase = rng.uniform(-np.pi, np.pi, z)
         knots = rng.uniform(-c, c, (z, 16))
-        n_waves = 2.5 if z < 20 else 3.5
-        pos = s * 15
-        i0 = np.minimum(pos.astype(int), 14)
-        fr = pos - i0
-        noise = knots[tooth, i0] * (1 - fr) + knots[tooth, i0 + 1] * fr
-        return (slope[tooth] * (s - 0.5)
-                + 0.5 * wav[tooth] * np.sin(2 * np.pi * n_waves * s + phase[tooth]) + noise)
+        i0, fr = noise_cell(s, knots.shape[1])
+        wa, wb = wave_amplitudes(wav[tooth], phase[tooth])
+        angle = 2 * np.pi * waves_per_profile(z) * s
+        # the slope measured from mid-profile
+        return tooth_error(s - 0.5, slope[tooth], wa, wb, np.sin(angle), np.cos(angle),
+                           knots[tooth, i0], knots[tooth, i0 + 1], fr)
 
     def _fault(self, s: np.ndarray, size: float, reality: RigReality | None) -> np.ndarray:
         """Relative cut depth (0 ... ~1) along the mesh cycle of the faulty tooth."""

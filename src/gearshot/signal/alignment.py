@@ -6,12 +6,12 @@ import functools
 from typing import Literal, cast, overload
 
 import numpy as np
-import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
 from .._typing import ComplexArray, FloatArray, IntArray
 from .._validation import as_signal_array, check_int, describe, finite_result
+from . import _fft
 
 __all__ = ["fractional_shift", "subtract_healthy"]
 
@@ -22,7 +22,7 @@ def _shift_factors(n: int, tau: FloatArray) -> ComplexArray:
     ``x(t + tau)`` ↔ ``X_k exp(2πi k tau / n)``; the Nyquist bin of an even ``n`` is split
     evenly between ±n/2 (as frequency-domain interpolation does), giving ``cos(π tau)``.
     """
-    k = scipy.fft.fftfreq(n, 1.0 / n)
+    k = np.fft.fftfreq(n, 1.0 / n)
     factors = np.exp(2j * np.pi * np.multiply.outer(tau, k) / n)
     if n % 2 == 0:
         factors[..., n // 2] = np.cos(np.pi * tau)
@@ -77,8 +77,8 @@ def fractional_shift(x: ArrayLike, delay: ArrayLike) -> FloatArray:
         raise GearshotError(f"delay of shape {tau.shape} does not broadcast to the batch "
                             f"shape {x.shape[:-1]} of x (shape {x.shape})")
     n = x.shape[-1]
-    spectrum = scipy.fft.fft(x, axis=-1) * _shift_factors(n, -tau)
-    return cast(FloatArray, scipy.fft.ifft(spectrum, axis=-1).real)
+    spectrum = _fft.fft(x, axis=-1) * _shift_factors(n, -tau)
+    return _fft.ifft(spectrum, axis=-1).real
 
 
 class _LagSearch:
@@ -118,7 +118,7 @@ class _LagSearch:
         padded = np.zeros((cross.shape[0], n * self.coarse // 2 + 1), dtype=complex)
         padded[:, : half.shape[1]] = half
         padded[:, 1:] *= 0.5  # irfft doubles these bins itself
-        coarse = scipy.fft.irfft(padded, n=n * self.coarse, axis=-1)
+        coarse = np.fft.irfft(padded, n=n * self.coarse, axis=-1)
         n_cand = min(self.n_candidates, coarse.shape[-1])
         cand = _top_indices(coarse, n_cand)
         centres = cand * self.step  # (rows, n_candidates) on the fine grid
@@ -243,8 +243,8 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
             f"healthy_refs have {refs.shape[-1]} points per cycle but signals have {n}")
     batch_shape = signals.shape[:-1]
     flat = signals.reshape(-1, n)
-    spec_x = scipy.fft.fft(flat, axis=-1)
-    spec_r = scipy.fft.fft(refs, axis=-1)
+    spec_x = _fft.fft(flat, axis=-1)
+    spec_r = _fft.fft(refs, axis=-1)
     search = _LagSearch(n, upsample)
 
     residual = np.empty_like(flat)
@@ -277,4 +277,4 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch,
     best = np.argmin(energy, axis=-1)
     rows = np.arange(len(sx))
     back = res_spec[rows, best] * np.conj(advance[rows, best])
-    return scipy.fft.ifft(back, axis=-1).real, best, tau[rows, best]
+    return _fft.ifft(back, axis=-1).real, best, tau[rows, best]

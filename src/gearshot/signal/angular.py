@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import cast
 
 import numpy as np
@@ -19,6 +20,7 @@ from .._validation import (
     describe,
     finite_result,
 )
+from ._splines import NotAKnotSpline, bspline_read
 from .antialias import bandlimited_resynthesis, min_shaft_rate
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
@@ -107,9 +109,10 @@ def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
     """Time at which the shaft reaches given angles, from its tacho pulses.
 
     The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
-    revolutions from the first) is a cubic spline, so speed varies smoothly rather than
-    piecewise-constantly; where a spline would not be monotone (extreme speed jumps) a
-    monotone PCHIP is used instead.
+    revolutions from the first) is a cubic spline (not-a-knot ends, as
+    :class:`scipy.interpolate.CubicSpline`, computed in NumPy), so speed varies smoothly
+    rather than piecewise-constantly; where a spline would not be monotone (extreme speed
+    jumps) or with fewer than 4 pulses a monotone PCHIP is used instead.
 
     Parameters
     ----------
@@ -145,13 +148,15 @@ def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
             f"angles must lie within the pulsed span 0 … {span:g} revolutions "
             f"({pulses.size} pulses at pulses_per_rev={ppr}); got {first!r} "
             f"({int(outside.sum())} value(s) outside)")
-    from scipy.interpolate import CubicSpline, PchipInterpolator
+    curve: Callable[[FloatArray], FloatArray] | None = None
+    if pulses.size >= 4:  # not-a-knot cubic spline, as scipy.interpolate.CubicSpline
+        spline = NotAKnotSpline(revs, pulses)
+        if not (np.any(spline(revs[:-1] + 0.5 / ppr, 1) <= 0)
+                or np.any(spline(revs, 1) <= 0)):
+            curve = spline
+    if curve is None:  # too few pulses, or the spline turns back: monotone PCHIP
+        from scipy.interpolate import PchipInterpolator
 
-    if pulses.size >= 4:
-        curve = CubicSpline(revs, pulses)
-        if np.any(curve(revs[:-1] + 0.5 / ppr, 1) <= 0) or np.any(curve(revs, 1) <= 0):
-            curve = PchipInterpolator(revs, pulses)
-    else:
         curve = PchipInterpolator(revs, pulses)
     return cast(FloatArray, curve(np.clip(revs_at, 0.0, span)))
 
@@ -275,12 +280,8 @@ def _bandlimited_fine(x: FloatArray, fs: float, pulses: FloatArray, times: Float
 def _spline_read(x_fine: FloatArray, position: FloatArray) -> FloatArray:
     """Cubic-spline values of each signal (last axis) at fractional sample ``position``;
     shape (n_signals, position.size)."""
-    import scipy.ndimage
-
     flat = x_fine.reshape(-1, x_fine.shape[-1])
     out = np.empty((flat.shape[0], position.size))
     for i, row in enumerate(flat):
-        coeffs = scipy.ndimage.spline_filter1d(row, order=3, mode="mirror")
-        out[i] = scipy.ndimage.map_coordinates(coeffs, position[None, :], order=3,
-                                               mode="mirror", prefilter=False)
+        out[i] = bspline_read(row, position)
     return out

@@ -14,7 +14,6 @@ import math
 from typing import cast
 
 import numpy as np
-import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
@@ -27,6 +26,7 @@ from .._validation import (
     check_positive,
     finite_result,
 )
+from . import _fft
 
 __all__ = ["antialias_filter", "bandlimited_resynthesis", "min_shaft_rate"]
 
@@ -62,8 +62,8 @@ def _lowpass_spectrum(x: FloatArray, fs: float, cutoff: float,
     pad = min(n - 1, int(math.ceil(6.0 * fs / width)))
     widths = [(0, 0)] * (x.ndim - 1) + [(pad, pad)]
     xp = np.pad(x, widths, mode="reflect", reflect_type="odd")
-    n_fft = scipy.fft.next_fast_len(xp.shape[-1], real=True)
-    spec: ComplexArray = scipy.fft.rfft(xp, n=n_fft, axis=-1)
+    n_fft = _fft.next_fast_len(xp.shape[-1])
+    spec: ComplexArray = np.fft.rfft(xp, n=n_fft, axis=-1)
     f = np.arange(spec.shape[-1]) * (fs / n_fft)
     gain = np.ones(f.size)
     ramp = (f > f1) & (f < cutoff)
@@ -116,15 +116,15 @@ def bandlimited_resynthesis(x: ArrayLike, fs: float, *, cutoff: float, passband:
     passband = check_in_range(passband, "passband", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
     spec, n_fft, pad = _lowpass_spectrum(x, fs, min(cutoff, fs / 2), passband)
-    n_out = scipy.fft.next_fast_len(int(math.ceil(n_fft * rate / fs)), real=True)
+    n_out = _fft.next_fast_len(int(math.ceil(n_fft * rate / fs)))
     n_out += n_out % 2
     half = n_out // 2 + 1
     if half <= spec.shape[-1]:
         spec = spec[..., :half].copy()
         if n_out < n_fft:
             spec[..., -1] = spec[..., -1].real  # the new Nyquist bin of a real signal
-    y = scipy.fft.irfft(spec, n=n_out, axis=-1) * (n_out / n_fft)
-    return cast(FloatArray, y), fs * n_out / n_fft, -pad / fs
+    y = np.fft.irfft(spec, n=n_out, axis=-1) * (n_out / n_fft)
+    return y, fs * n_out / n_fft, -pad / fs
 
 
 @finite_result
@@ -185,7 +185,7 @@ def antialias_filter(x: ArrayLike, fs: float, *, cutoff: float, passband: float 
     spec, n_fft, pad = _lowpass_spectrum(x, fs, cutoff, passband)
     if n_fft % 2 == 0 and up > 1:
         spec[..., -1] *= 0.5  # the Nyquist bin splits in two when zero-padded
-    y = scipy.fft.irfft(spec, n=n_fft * up, axis=-1)
+    y = np.fft.irfft(spec, n=n_fft * up, axis=-1)
     if up > 1:
         y *= up
-    return cast(FloatArray, y[..., pad * up: (pad + n) * up])
+    return y[..., pad * up: (pad + n) * up]

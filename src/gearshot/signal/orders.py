@@ -24,7 +24,6 @@ from collections.abc import Sequence
 from typing import cast
 
 import numpy as np
-import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
@@ -202,9 +201,9 @@ def _split(sa: ArrayLike, mesh_order: MeshOrders, n_sidebands: int, keep_mesh: b
     mask = order_mask(n, mesh_order, n_sidebands=n_sidebands)
     if shaft_orders is not None:
         mask[[0, *_shaft_orders(shaft_orders, n)]] = True
-    spectrum = scipy.fft.rfft(sa, axis=-1)
+    spectrum = np.fft.rfft(sa, axis=-1)
     spectrum *= mask if keep_mesh else ~mask
-    return cast(FloatArray, scipy.fft.irfft(spectrum, n=n, axis=-1))
+    return np.fft.irfft(spectrum, n=n, axis=-1)
 
 
 @finite_result

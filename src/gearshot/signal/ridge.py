@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -54,7 +55,7 @@ class SpeedRidge:
 
 
 
-def _orders(orders) -> tuple[int, ...]:
+def _orders(orders: Any) -> tuple[int, ...]:
     if isinstance(orders, (int, np.integer)) and not isinstance(orders, bool):
         orders = [orders]
     if not isinstance(orders, (Sequence, np.ndarray)) or len(orders) == 0:
@@ -68,7 +69,7 @@ def _orders(orders) -> tuple[int, ...]:
     return tuple(out)
 
 
-def _speed_range(speed_range) -> tuple[float, float]:
+def _speed_range(speed_range: Any) -> tuple[float, float]:
     try:
         lo, hi = (float(v) for v in speed_range)
     except (TypeError, ValueError):
@@ -80,8 +81,9 @@ def _speed_range(speed_range) -> tuple[float, float]:
     return lo, hi
 
 
-def speed_ridge(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
-                max_rate=None, smooth=0.5, track=None) -> SpeedRidge:
+def speed_ridge(x: np.ndarray, fs: float, *, orders: Any, speed_range: Any,
+                n_harmonics: int = 3, window: float = 0.5, max_rate: float | None = None,
+                smooth: float = 0.5, track: int | None = None) -> SpeedRidge:
     """Shaft speed along the time–frequency ridge of its mesh harmonics.
 
     Parameters
@@ -122,46 +124,53 @@ def speed_ridge(x, fs, *, orders, speed_range, n_harmonics=3, window=0.5,
 
     Examples
     --------
+    Two stages' mesh lines of a shaft at a steady 25 rev/s (orders 32 and 16):
+
     >>> import numpy as np
     >>> from gearshot.signal import speed_ridge
-    >>> fs = 20_000.0
-    >>> t = np.arange(int(2 * fs)) / fs
-    >>> x = np.sin(2 * np.pi * 32 * 25.0 * t) + 0.5 * np.sin(2 * np.pi * 16 * 25.0 * t)
-    >>> x += 0.1 * np.random.default_rng(0).standard_normal(t.size)
-    >>> r = speed_ridge(x, fs, orders=[32, 16], speed_range=(15, 40))
+    >>> noise = 0.1 * np.random.default_rng(0).standard_normal(40_000)
+    >>> phase = 2 * np.pi * 25.0 * np.arange(noise.size) / 20_000.0
+    >>> x = np.sin(32 * phase) + 0.5 * np.sin(16 * phase) + noise
+    >>> r = speed_ridge(x, 20_000.0, orders=[32, 16], speed_range=(15, 40))
     >>> bool(abs(np.median(r.speed) - 25.0) < 0.1)
     True
     """
     x = as_signal_array(x, "x", max_ndim=1, min_length=16)
     fs = check_positive(fs, "fs")
-    orders = _orders(orders)
+    order_list = _orders(orders)
     lo, hi = _speed_range(speed_range)
     n_harmonics = check_int(n_harmonics, "n_harmonics", minimum=1, maximum=100)
     max_rate = 0.5 * hi if max_rate is None else check_positive(max_rate, "max_rate")
     smooth = check_positive(smooth, "smooth")
-    pairs = [(h * o, 1.0 / h) for o in orders for h in range(1, n_harmonics + 1)
-             if h * o * hi < 0.5 * fs]  # (order, weight): fundamentals count most
-    if not pairs:
-        raise GearshotError(f"orders={list(orders)} at speed_range top {hi:g} rev/s lie above "
-                            f"the Nyquist frequency {fs / 2:g} Hz")
-    if track is None:
-        candidates = [h * orders[0] for h in range(1, n_harmonics + 1)
-                      if h * orders[0] * hi < 0.5 * fs] or sorted({c for c, _ in pairs})
-    else:
-        track = check_int(track, "track", minimum=1, maximum=100_000)
-        if track * hi >= 0.5 * fs:
-            raise GearshotError(f"track={track} at {hi:g} rev/s is above the Nyquist "
-                                f"frequency {fs / 2:g} Hz")
-        candidates = [track]
+    pairs, candidates = _comb_lines(order_list, n_harmonics, hi, fs, track)
     args = (x, fs, pairs, candidates, lo, hi, max_rate, smooth)
     return _ridge_pass(*args, check_positive(window, "window"))
 
 
-def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> SpeedRidge:
-    """One STFT + comb + dynamic-programming pass of :func:`speed_ridge`."""
-    import scipy.ndimage  # lazy: a one-record call need not import it
-    import scipy.signal
-    combos = sorted({c for c, _ in pairs})
+def _comb_lines(orders: tuple[int, ...], n_harmonics: int, hi: float, fs: float,
+                track: int | None) -> tuple[list[tuple[int, float]], list[int]]:
+    """The comb's (order, weight) pairs below Nyquist (fundamentals count most) and the
+    orders that may be demodulated."""
+    pairs = [(h * o, 1.0 / h) for o in orders for h in range(1, n_harmonics + 1)
+             if h * o * hi < 0.5 * fs]
+    if not pairs:
+        raise GearshotError(f"orders={list(orders)} at speed_range top {hi:g} rev/s lie above "
+                            f"the Nyquist frequency {fs / 2:g} Hz")
+    if track is None:
+        return pairs, [h * orders[0] for h in range(1, n_harmonics + 1)
+                       if h * orders[0] * hi < 0.5 * fs] or sorted({c for c, _ in pairs})
+    track = check_int(track, "track", minimum=1, maximum=100_000)
+    if track * hi >= 0.5 * fs:
+        raise GearshotError(f"track={track} at {hi:g} rev/s is above the Nyquist "
+                            f"frequency {fs / 2:g} Hz")
+    return pairs, [track]
+
+
+def _levels(x: np.ndarray, fs: float, combos: list[int], lo: float, hi: float,
+            window: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, int]:
+    """STFT power, its level in dB over every frame's median in the searched band (capped
+    at 0 and :data:`_CAP_DB`), frame times, bin width, top bin and hop."""
+    import scipy.signal  # lazy: a one-record call need not import it
     nper = int(2 ** round(math.log2(max(window * fs, 16.0))))
     if nper > x.size:
         raise GearshotError(f"x holds {x.size} samples, shorter than one STFT window of "
@@ -177,30 +186,31 @@ def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> S
     bottom = max(1, int(math.floor(min(combos) * lo * 0.95 / df)) - 1)
     level = 10.0 * np.log10(power[: top + 1] + 1e-30 * (power.max() + 1e-300))
     level -= np.median(level[bottom: top + 1], axis=0, keepdims=True)
-    level = np.clip(level, 0.0, _CAP_DB)
-    step = df / (2.0 * max(combos))
-    speeds = np.arange(lo, hi + 0.5 * step, step)
-    score = np.zeros((speeds.size, times.size))
-    for c, w in pairs:
-        pos = c * speeds / df
-        i0 = np.clip(np.floor(pos).astype(np.int64), 0, top - 1)
-        score += w * np.maximum(level[i0], level[i0 + 1])
-    score /= sum(w for _, w in pairs)
-    # dynamic programming: best path with |jump| <= J candidates per frame
-    jump = max(1, int(math.ceil(max_rate * hop / fs / step)))
+    return power, np.clip(level, 0.0, _CAP_DB), times, df, top, hop
+
+
+def _best_path(score: np.ndarray, jump: int) -> np.ndarray:
+    """Indices of the best path through ``score`` (candidates × frames) that moves at
+    most ``jump`` candidates per frame (dynamic programming)."""
+    import scipy.ndimage  # lazy: a one-record call need not import it
     acc = np.empty_like(score)
     acc[:, 0] = score[:, 0]
-    for k in range(1, times.size):
+    for k in range(1, score.shape[1]):
         acc[:, k] = score[:, k] + scipy.ndimage.maximum_filter1d(acc[:, k - 1], 2 * jump + 1,
                                                                  mode="nearest")
-    path = np.empty(times.size, dtype=np.int64)
+    path = np.empty(score.shape[1], dtype=np.int64)
     path[-1] = int(np.argmax(acc[:, -1]))
-    for k in range(times.size - 1, 0, -1):
-        a, b = max(0, path[k] - jump), min(speeds.size, path[k] + jump + 1)
+    for k in range(score.shape[1] - 1, 0, -1):
+        a, b = max(0, path[k] - jump), min(score.shape[0], path[k] + jump + 1)
         path[k - 1] = a + int(np.argmax(acc[a:b, k - 1]))
-    ridge = speeds[path]
-    # the harmonic to follow (highest level along the ridge) and its peak by parabola
-    frames = np.arange(times.size)
+    return path
+
+
+def _followed(power: np.ndarray, level: np.ndarray, ridge: np.ndarray, df: float, top: int,
+              candidates: list[int]) -> tuple[int, float, np.ndarray]:
+    """The harmonic to follow (highest level along the ridge), its level, and the ridge
+    moved to that harmonic's peak (parabola through the log power, within ±1 bin)."""
+    frames = np.arange(ridge.size)
     best, best_level = candidates[0], -1.0
     for c in candidates:
         i0 = np.clip(np.rint(c * ridge / df).astype(np.int64), 1, top - 1)
@@ -216,7 +226,27 @@ def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> S
         delta = np.where(denom < 0, 0.5 * (a - c3) / denom, 0.0)
     refined = (k + np.clip(delta, -0.5, 0.5)) * df / best
     ok = np.abs(refined - ridge) <= 2.0 * df / best
-    ridge = np.where(ok, refined, ridge)
+    return int(best), best_level, np.where(ok, refined, ridge)
+
+
+def _ridge_pass(x: np.ndarray, fs: float, pairs: list[tuple[int, float]],
+                candidates: list[int], lo: float, hi: float, max_rate: float, smooth: float,
+                window: float) -> SpeedRidge:
+    """One STFT + comb + dynamic-programming pass of :func:`speed_ridge`."""
+    import scipy.signal  # lazy: a one-record call need not import it
+    combos = sorted({c for c, _ in pairs})
+    power, level, times, df, top, hop = _levels(x, fs, combos, lo, hi, window)
+    step = df / (2.0 * max(combos))
+    speeds = np.arange(lo, hi + 0.5 * step, step)
+    score = np.zeros((speeds.size, times.size))
+    for c, w in pairs:
+        pos = c * speeds / df
+        i0 = np.clip(np.floor(pos).astype(np.int64), 0, top - 1)
+        score += w * np.maximum(level[i0], level[i0 + 1])
+    score /= sum(w for _, w in pairs)
+    jump = max(1, int(math.ceil(max_rate * hop / fs / step)))
+    ridge = speeds[_best_path(score, jump)]
+    best, best_level, ridge = _followed(power, level, ridge, df, top, candidates)
     # the speed changes slowly: a local quadratic over ``smooth`` s takes out the beating of
     # the line with its sidebands inside one window, and keeps a ramp unbiased
     span = int(round(smooth * fs / hop)) | 1
@@ -224,10 +254,11 @@ def _ridge_pass(x, fs, pairs, candidates, lo, hi, max_rate, smooth, window) -> S
         ridge = scipy.signal.savgol_filter(ridge, min(span, times.size - 1 + times.size % 2),
                                            2, mode="interp")
     # how many comb lines (order x harmonic) stand out along the final ridge
+    frames = np.arange(times.size)
     lines = 0
     for c in combos:
         i0 = np.clip(np.rint(c * ridge / df).astype(np.int64), 0, top - 1)
         lev = np.maximum(level[i0, frames], level[np.minimum(i0 + 1, top), frames])
         lines += int(float(np.mean(lev)) >= _LINE_DB)
-    return SpeedRidge(times=times, speed=ridge, order=int(best), level_db=best_level,
+    return SpeedRidge(times=times, speed=ridge, order=best, level_db=best_level,
                       n_lines=lines, n_comb=len(combos))

@@ -23,6 +23,11 @@ harmonic gives the speed; its phase divided by the order gives the shaft angle. 
    what is left, added to the ridge's phase, is the harmonic's phase; divided by ``2π`` and
    the order it is the shaft angle (revolutions), with the ridge's coarse frequency
    corrected to within the phase noise.
+   Where the ridge path is refused (a run-up smears the lines over many bins of every
+   short window), :func:`gearshot.signal.speed_profile.fit_speed_profile` fits a
+   quadratic speed profile to the whole record's order spectrum instead (the coherent
+   integration a synchronous average does) and step 2 runs around that profile; its
+   polynomial angle is kept where the demodulated phase wanders like noise.
 3. **Virtual tacho** (:func:`angle_pulse_times`). The times at which the angle passes
    ``k / pulses_per_rev`` revolutions: pulses as a tacho would give, for the angular
    re-sampler and :func:`gearshot.signal.shaft_cycle_times`.
@@ -43,12 +48,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
-from .ridge import SpeedRidge, speed_ridge
+from .demodulation import angle_pulse_times, demodulate_angle
+from .ridge import SpeedRidge, _speed_range, speed_ridge
+from .speed_profile import SpeedProfile, fit_speed_profile
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
            "estimate_shaft_angle", "MIN_SNR_DB", "MAX_WANDER", "MIN_LINES"]
@@ -91,7 +99,10 @@ class ShaftAngle:
         ``1 / pulses_per_rev`` revolutions, s.
     pulses_per_rev : int
     ridge : SpeedRidge
-        The coarse time–frequency ridge.
+        The coarse time–frequency ridge (for a whole-record profile: the profile sampled
+        at the demodulation grid, its strongest mesh line's level and line counts).
+    profile : SpeedProfile or None
+        The whole-record speed profile where the ridge path was refused, else None.
     """
 
     times: np.ndarray
@@ -105,6 +116,7 @@ class ShaftAngle:
     pulse_times: np.ndarray
     pulses_per_rev: int
     ridge: SpeedRidge
+    profile: SpeedProfile | None = None
 
     @property
     def mean_speed(self) -> float:
@@ -114,151 +126,26 @@ class ShaftAngle:
         return float(np.polyfit(self.times - self.times.mean(), self.angle, 1)[0])
 
 
-
-def demodulate_angle(x, fs, *, order, ridge_times, ridge_speed, bandwidth=0.25
-                     ) -> tuple[np.ndarray, np.ndarray, float]:
-    """Shaft angle from the phase of one harmonic, refined around a speed ridge.
-
-    Parameters
-    ----------
-    x : array_like, shape (n,)
-        Vibration sampled at ``fs``.
-    fs : float
-        Sampling rate, Hz.
-    order : int
-        Order of the harmonic (per shaft revolution).
-    ridge_times, ridge_speed : array_like, shape (n_frames,)
-        Coarse speed (rev/s) at increasing times (s), e.g. from :func:`speed_ridge`;
-        held constant outside their span. It must be within ``bandwidth`` orders of the
-        truth.
-    bandwidth : float, default 0.25
-        Half-width of the kept band around the harmonic, in shaft orders at the lowest
-        ridge speed (speed changes faster than this many cycles per revolution are
-        smoothed away; keep it below the nearest sideband, e.g. 1/3 order for a 1:3 idler).
-
-    Returns
-    -------
-    times : ndarray, shape (m,)
-        Decimated sample times, s.
-    angle : ndarray, shape (m,)
-        Shaft angle, revolutions, starting near 0.
-    snr : float
-        In-band signal-to-noise power ratio of the harmonic (linear).
-
-    Examples
-    --------
-    A shaft at a steady 10 rev/s seen through its 8th order: the angle grows by 10
-    revolutions per second.
-
-    >>> import numpy as np
-    >>> from gearshot.signal.tracking import demodulate_angle
-    >>> t = np.arange(4000) / 2000.0
-    >>> times, angle, snr = demodulate_angle(np.cos(2 * np.pi * 80 * t), 2000.0, order=8,
-    ...                                      ridge_times=np.array([0.0, 2.0]),
-    ...                                      ridge_speed=np.array([10.0, 10.0]))
-    >>> print(round(float(np.polyfit(times, angle, 1)[0]), 3), bool(snr > 100))
-    10.0 True
-    """
-    import scipy.signal  # lazy: a one-record call need not import it
-    x = as_signal_array(x, "x", max_ndim=1, min_length=16)
-    fs = check_positive(fs, "fs")
-    order = check_int(order, "order", minimum=1, maximum=1_000_000)
-    bandwidth = check_in_range(bandwidth, "bandwidth", 0.0, 10.0, low_inclusive=False)
-    rt = as_signal_array(ridge_times, "ridge_times", max_ndim=1)
-    rs = as_signal_array(ridge_speed, "ridge_speed", max_ndim=1)
-    if rt.size != rs.size or rt.size < 1 or np.any(np.diff(rt) <= 0) or np.any(rs <= 0):
-        raise GearshotError(f"ridge_times must increase and ridge_speed be > 0 with the same "
-                            f"length; got {rt.size} times and {rs.size} speeds")
-    n = x.size
-    band = bandwidth * float(rs.min())  # Hz
-    rate = 20.0 * band
-    down = max(1, int(fs // rate))
-    t = np.arange(n) / fs
-    # beyond the first/last frame centre the speed goes on along the end slopes (a ridge
-    # held constant there would leave the band during a run-up)
-    k = min(5, rt.size)
-    if k >= 2 and rt[0] > 0:
-        rs = np.r_[np.polyval(np.polyfit(rt[:k], rs[:k], 1), 0.0), rs]
-        rt = np.r_[0.0, rt]
-    if k >= 2 and rt[-1] < t[-1]:
-        rs = np.r_[rs, np.polyval(np.polyfit(rt[-k:], rs[-k:], 1), t[-1])]
-        rt = np.r_[rt, t[-1]]
-    rs = np.maximum(rs, 0.05 * float(rs.max()))
-    freq = order * np.interp(t, rt, rs)
-    psi = np.empty(n)
-    psi[0] = 0.0
-    np.cumsum(freq[:-1] * (2 * np.pi / fs), out=psi[1:])
-    base = x * np.exp(-1j * psi)
-    if down > 1:
-        base = scipy.signal.resample_poly(base, 1, down, padtype="line")
-    fs_d = fs / down
-    m = base.size
-    td = np.arange(m) * (down / fs)
-    spec = np.abs(np.fft.fft(base)) ** 2
-    f = np.fft.fftfreq(m, 1.0 / fs_d)
-    inside = np.abs(f) <= band
-    outside = (np.abs(f) > 1.5 * band) & (np.abs(f) <= 0.4 * fs_d)
-    noise = float(np.median(spec[outside])) / math.log(2.0) if outside.any() else 0.0
-    signal_power = float(spec[inside].sum()) - noise * inside.sum()
-    snr = signal_power / (noise * inside.sum()) if noise > 0 else math.inf
-    sos = scipy.signal.butter(4, band, fs=fs_d, output="sos")
-    padlen = min(m - 1, int(3 * fs_d / band))
-    narrow = scipy.signal.sosfiltfilt(sos, base, padtype="odd", padlen=padlen)
-    phase = np.unwrap(np.angle(narrow))
-    angle = (psi[np.arange(m) * down] + phase - phase[0]) / (2 * np.pi * order)
-    return td, angle, max(snr, 1e-3)
-
-
-def angle_pulse_times(times, angle, *, pulses_per_rev=8) -> np.ndarray:
-    """Times at which a shaft angle passes whole multiples of ``1 / pulses_per_rev`` rev.
-
-    Parameters
-    ----------
-    times : array_like, shape (m,)
-        Increasing sample times, s.
-    angle : array_like, shape (m,)
-        Shaft angle at ``times``, revolutions, strictly increasing.
-    pulses_per_rev : int, default 8
-        Virtual pulses per revolution.
-
-    Returns
-    -------
-    ndarray, shape (n_pulses,)
-        Pulse times, s (a cubic spline of time against angle, read at the marks).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from gearshot.signal import angle_pulse_times
-    >>> t = np.linspace(0.0, 1.0, 101)
-    >>> angle_pulse_times(t, 10.0 * t + 0.05, pulses_per_rev=1)[:3]
-    array([0.095, 0.195, 0.295])
-    """
-    from scipy.interpolate import CubicSpline  # lazy: a one-record call need not import it
-    t = as_signal_array(times, "times", max_ndim=1, min_length=2)
-    a = as_signal_array(angle, "angle", max_ndim=1, min_length=2)
-    ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
-    if t.size != a.size:
-        raise GearshotError(f"times and angle must have the same length; got {t.size} and "
-                            f"{a.size}")
-    if np.any(np.diff(a) <= 0):
-        i = int(np.flatnonzero(np.diff(a) <= 0)[0])
-        raise GearshotError(f"angle must increase (a shaft turning one way); it stops or "
-                            f"reverses at t={t[i]:.4g} s")
-    marks = np.arange(math.ceil(a[0] * ppr), math.floor(a[-1] * ppr) + 1) / ppr
-    return np.asarray(CubicSpline(a, t)(marks))
-
-
-def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=None,
-                         max_rate=None, smooth=0.5, track=None, bandwidth=0.25,
-                         min_snr_db=MIN_SNR_DB, max_wander=MAX_WANDER, min_lines=MIN_LINES,
-                         pulses_per_rev=8,
-                         label="the vibration") -> ShaftAngle:
+def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_range: object,
+                         n_harmonics: int = 3, window: float | None = None,
+                         max_rate: float | None = None, smooth: float = 0.5,
+                         track: int | None = None, bandwidth: float = 0.25,
+                         min_snr_db: float = MIN_SNR_DB, max_wander: float = MAX_WANDER,
+                         min_lines: int = MIN_LINES, pulses_per_rev: int = 8,
+                         label: str = "the vibration") -> ShaftAngle:
     """Shaft angle and instantaneous speed from the vibration: ridge, then phase.
 
     :func:`speed_ridge` finds the speed coarsely from all mesh orders of the shaft;
     :func:`demodulate_angle` refines it on the strongest harmonic along the ridge;
-    :func:`angle_pulse_times` turns the angle into virtual tacho pulses.
+    :func:`angle_pulse_times` turns the angle into virtual tacho pulses. When that path is
+    refused, a speed profile fitted to the whole record
+    (:func:`gearshot.signal.speed_profile.fit_speed_profile`) is tried before refusing:
+    it is taken when at least ``min_lines`` whole orders of the shaft (mesh lines
+    included) stand 15 dB over the floor of the record's order spectrum and no speed
+    ratio 1/2, 2/3, 3/2 or 2 of the profile also lies in ``speed_range`` (the whole
+    orders of a multi-shaft train may fit such a ratio as well); the phase step
+    then runs around it, and the profile's own angle is kept where that phase wanders
+    more than ``max_wander`` or its SNR is below ``min_snr_db``.
 
     Parameters
     ----------
@@ -305,7 +192,8 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=No
     ------
     GearshotError
         No mesh harmonic stands out (in-band SNR below ``min_snr_db`` or a phase that
-        wanders like noise; the message states both), or bad input.
+        wanders like noise, and no whole-record profile either; the message states the
+        SNR, the wander and the profile's strongest line), or bad input.
 
     Examples
     --------
@@ -321,70 +209,140 @@ def estimate_shaft_angle(x, fs, *, orders, speed_range, n_harmonics=3, window=No
     >>> bool(abs(est.mean_speed - 22.0) < 0.01)
     True
     """
-    import scipy.signal  # lazy: a one-record call need not import it
     min_snr_db = check_in_range(min_snr_db, "min_snr_db", -100.0, 100.0)
     max_wander = check_positive(max_wander, "max_wander")
     min_lines = check_int(min_lines, "min_lines", minimum=0, maximum=1000)
     ppr = check_int(pulses_per_rev, "pulses_per_rev", minimum=1, maximum=100_000)
     x = as_signal_array(x, "x", max_ndim=1, min_length=16)
     fs = check_positive(fs, "fs")
-    def one_pass(win):
-        ridge = speed_ridge(x, fs, orders=orders, speed_range=speed_range,
-                            n_harmonics=n_harmonics, window=win, max_rate=max_rate,
-                            smooth=smooth, track=track)
-        times, angle, snr = demodulate_angle(x, fs, order=ridge.order,
-                                             ridge_times=ridge.times,
-                                             ridge_speed=ridge.speed, bandwidth=bandwidth)
-        band = bandwidth * float(ridge.speed.min())
-        speed = np.gradient(angle, times)
-        # how fast the demodulated phase wanders about the (independent) coarse ridge: a
-        # locked line barely moves, noise in the band sweeps it at ~band / sqrt(3)
-        span = times[-1] - times[0]
-        inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
-        ridge_at = np.interp(times, ridge.times, ridge.speed)
-        # above band/4 only: slow errors of the coarse ridge are not noise (the phase step
-        # corrects them), while noise's frequency wander lies almost all (98 %) up there
-        diff = ridge.order * (speed - ridge_at)
-        if times.size > 30:
-            fs_d = 1.0 / (times[1] - times[0])
-            hp = scipy.signal.butter(2, band / 4, btype="highpass", fs=fs_d, output="sos")
-            diff = scipy.signal.sosfiltfilt(hp, diff)
-        wander = float(np.std(diff[inner]) / band) if inner.any() else 0.0
-        return ridge, times, angle, snr, speed, wander, band
-
-    result = one_pass(window if window is not None else _AUTO_WINDOWS[-1])
-    if window is None and result[5] > _SETTLED:
-        # a run-up smears the line over many bins of the long window: retry with the
-        # window its chirp allows (the line moves < 1 bin: W <= 1 / sqrt(Hz/s))
-        ridge, times, _, _, speed, _, _ = result
-        span = times[-1] - times[0]
-        inner = (times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span)
-        slope = np.abs(np.polyfit(times[inner], speed[inner], 2)[1]) if inner.sum() > 3 \
-            else 0.0
-        slope = max(slope, float(np.max(np.abs(np.gradient(ridge.speed, ridge.times))))
-                    if ridge.times.size > 1 else 0.0)
-        chirp = ridge.order * slope
-        short = float(np.clip(1.0 / math.sqrt(max(chirp, 1e-9)), _AUTO_WINDOWS[0],
-                              _AUTO_WINDOWS[-1]))
+    ridge_kw = dict(orders=orders, speed_range=speed_range, n_harmonics=n_harmonics,
+                    max_rate=max_rate, smooth=smooth, track=track)
+    result = _ridge_pass(x, fs, ridge_kw, window if window is not None
+                         else _AUTO_WINDOWS[-1], bandwidth)
+    if window is None and result.wander > _SETTLED:
+        short = _chirp_window(result)
         if short < 0.75 * _AUTO_WINDOWS[-1]:
-            other = one_pass(short)
-            if other[5] < result[5]:
+            other = _ridge_pass(x, fs, ridge_kw, short, bandwidth)
+            if other.wander < result.wander:
                 result = other
-    ridge, times, angle, snr, speed, wander, band = result
-    snr_db = 10.0 * math.log10(snr) if snr > 0 else -math.inf
-    if not (snr_db >= min_snr_db and wander <= max_wander and ridge.n_lines >= min_lines):
-        raise GearshotError(
-            f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
-            f"tracked at {np.median(ridge.speed):.4g} rev/s, is {snr_db:.1f} dB above the "
-            f"noise in its band (min_snr_db={min_snr_db:g}), its phase wanders "
-            f"{wander:.2f} of the band (noise: 0.58; max_wander={max_wander:g}) and "
-            f"{ridge.n_lines} of {ridge.n_comb} comb lines stand out (min_lines="
-            f"{min_lines}); the speed cannot be estimated from the vibration (give a tacho, "
-            f"another sensor or a narrower speed range)")
-    sigma_phi = math.sqrt(1.0 / (2.0 * snr))
-    pulses = angle_pulse_times(times, angle, pulses_per_rev=ppr)
-    return ShaftAngle(times=times, angle=angle, speed=speed, order=ridge.order,
-                      snr_db=snr_db, speed_std=sigma_phi * band / (math.sqrt(3) * ridge.order),
-                      angle_std=sigma_phi / (2 * np.pi * ridge.order), wander=wander,
-                      pulse_times=pulses,
-                      pulses_per_rev=ppr, ridge=ridge)
+    snr_db = _db(result.snr)
+    if snr_db >= min_snr_db and result.wander <= max_wander and \
+            result.ridge.n_lines >= min_lines:
+        return _shaft_angle(result, ppr)
+    profile = fit_speed_profile(x, fs, orders=orders, speed_range=speed_range,
+                                max_rate=max_rate)
+    ratio = profile.ambiguous(_speed_range(speed_range), x.size / fs)
+    if profile.n_lines >= max(min_lines, 1) and ratio is None:
+        fine = _profile_pass(x, fs, profile, bandwidth, track)
+        if not (_db(fine.snr) >= min_snr_db and fine.wander <= max_wander):
+            fine = fine._replace(angle=profile.angle(fine.times),
+                                 speed=profile.speed(fine.times))
+        return _shaft_angle(fine, ppr, profile)
+    ridge = result.ridge
+    raise GearshotError(
+        f"no mesh harmonic stands out in {label}: order {ridge.order} of the shaft, "
+        f"tracked at {np.median(ridge.speed):.4g} rev/s, is {snr_db:.1f} dB above the "
+        f"noise in its band (min_snr_db={min_snr_db:g}), its phase wanders "
+        f"{result.wander:.2f} of the band (noise: 0.58; max_wander={max_wander:g}) and "
+        f"{ridge.n_lines} of {ridge.n_comb} comb lines stand out (min_lines={min_lines}); "
+        f"over the whole record the best speed profile's strongest mesh line is "
+        f"{profile.lines[0][1]:.1f} dB over the floor ({profile.n_lines} whole orders at "
+        f"15 dB or more{_ambiguity(ratio, profile)}); the speed cannot be estimated from "
+        f"the vibration (give a tacho, another sensor or a narrower speed range)")
+
+
+class _Pass(NamedTuple):
+    """One ridge (or profile) + phase pass of :func:`estimate_shaft_angle`."""
+
+    ridge: SpeedRidge
+    times: np.ndarray
+    angle: np.ndarray
+    snr: float
+    speed: np.ndarray
+    wander: float
+    band: float
+
+
+def _ambiguity(ratio: float | None, profile: SpeedProfile) -> str:
+    if ratio is None:
+        return ""
+    return (f", at {profile.coef[0]:.4g} rev/s mid-record, but {ratio:.3g} times that is "
+            f"in the speed range too")
+
+
+def _db(snr: float) -> float:
+    return 10.0 * math.log10(snr) if snr > 0 else -math.inf
+
+
+def _inner(times: np.ndarray) -> np.ndarray:
+    """The middle 80 % of the record (the zero-phase filters have both sides there)."""
+    span = times[-1] - times[0]
+    return np.asarray((times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span))
+
+
+def _phase_pass(x: np.ndarray, fs: float, ridge: SpeedRidge, bandwidth: float) -> _Pass:
+    """Phase demodulation around ``ridge`` and how much the phase wanders about it."""
+    import scipy.signal  # lazy: a one-record call need not import it
+    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
+                                         ridge_speed=ridge.speed, bandwidth=bandwidth)
+    band = bandwidth * float(ridge.speed.min())
+    speed = np.gradient(angle, times)
+    # how fast the demodulated phase wanders about the (independent) coarse ridge: a
+    # locked line barely moves, noise in the band sweeps it at ~band / sqrt(3)
+    inner = _inner(times)
+    ridge_at = np.interp(times, ridge.times, ridge.speed)
+    # above band/4 only: slow errors of the coarse ridge are not noise (the phase step
+    # corrects them), while noise's frequency wander lies almost all (98 %) up there
+    diff = ridge.order * (speed - ridge_at)
+    if times.size > 30:
+        fs_d = 1.0 / (times[1] - times[0])
+        hp = scipy.signal.butter(2, band / 4, btype="highpass", fs=fs_d, output="sos")
+        diff = scipy.signal.sosfiltfilt(hp, diff)
+    wander = float(np.std(diff[inner]) / band) if inner.any() else 0.0
+    return _Pass(ridge, times, angle, snr, speed, wander, band)
+
+
+def _ridge_pass(x: np.ndarray, fs: float, ridge_kw: dict[str, Any], window: float,
+                bandwidth: float) -> _Pass:
+    ridge = speed_ridge(x, fs, window=window, **ridge_kw)
+    return _phase_pass(x, fs, ridge, bandwidth)
+
+
+def _chirp_window(result: _Pass) -> float:
+    """The STFT window a run-up's chirp allows (the line moves < 1 bin: W <= 1 /
+    sqrt(Hz/s)): a run-up smears the line over many bins of the long window."""
+    ridge, times, speed = result.ridge, result.times, result.speed
+    inner = _inner(times)
+    slope = np.abs(np.polyfit(times[inner], speed[inner], 2)[1]) if inner.sum() > 3 \
+        else 0.0
+    slope = max(slope, float(np.max(np.abs(np.gradient(ridge.speed, ridge.times))))
+                if ridge.times.size > 1 else 0.0)
+    chirp = ridge.order * slope
+    return float(np.clip(1.0 / math.sqrt(max(chirp, 1e-9)), _AUTO_WINDOWS[0],
+                         _AUTO_WINDOWS[-1]))
+
+
+def _profile_pass(x: np.ndarray, fs: float, profile: SpeedProfile, bandwidth: float,
+                  track: int | None) -> _Pass:
+    """The phase step around a whole-record profile, on its strongest mesh line."""
+    order = int(track) if track is not None else profile.lines[0][0]
+    duration = x.size / fs
+    times = np.linspace(0.0, duration, max(16, int(duration * 8)) + 1)
+    level = dict(profile.lines).get(order, profile.lines[0][1])
+    ridge = SpeedRidge(times=times, speed=profile.speed(times), order=order,
+                       level_db=float(level), n_lines=profile.n_lines,
+                       n_comb=len(profile.lines))
+    return _phase_pass(x, fs, ridge, bandwidth)
+
+
+def _shaft_angle(result: _Pass, ppr: int, profile: SpeedProfile | None = None
+                 ) -> ShaftAngle:
+    sigma_phi = math.sqrt(1.0 / (2.0 * result.snr))
+    order = result.ridge.order
+    pulses = angle_pulse_times(result.times, result.angle, pulses_per_rev=ppr)
+    return ShaftAngle(times=result.times, angle=result.angle, speed=result.speed,
+                      order=order, snr_db=_db(result.snr),
+                      speed_std=sigma_phi * result.band / (math.sqrt(3) * order),
+                      angle_std=sigma_phi / (2 * np.pi * order), wander=result.wander,
+                      pulse_times=pulses, pulses_per_rev=ppr, ridge=result.ridge,
+                      profile=profile)

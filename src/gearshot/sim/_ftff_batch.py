@@ -22,6 +22,16 @@ import math
 import numba as nb
 import numpy as np
 
+from ._compliance import (
+    _N_SEGMENT,
+    _U_TABLE,
+    _contact_frame,
+    _fillet_compliance,
+    _healthy_compliances,
+    _hertz_stiffness,
+    _materials,
+    _simpson_nodes,
+)
 from .geometry import GearPair, contact_angles, involute_half_angle
 
 __all__ = ["bridge_batch", "ftff_gear_compliance"]
@@ -101,7 +111,7 @@ def _retreat(pair: GearPair, u, r, ang):
                     pair.center_distance, rb1, ra1)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot.
 
@@ -121,29 +131,32 @@ def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     # the pinion flank's ends count (rounding of the rotated points must not drop the
     # point at the pinion tip, where the contact at u = 1 lies)
     lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
-    for f in range(n):
-        for m in range(n_u):
-            best = np.inf
-            kb = 0
-            cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
-            for k in range(n_pts):
-                cth = cm * ca[f, k] - sm * sa[f, k]
-                sth = sm * ca[f, k] + cm * sa[f, k]
-                px = o2x + r[f, k] * cth
-                py = r[f, k] * sth
-                rp = math.hypot(px, py)
-                if rp < lo_r or rp > hi_r:
-                    continue
-                c = rb1 / rp
-                s = math.sqrt(max(1.0 - c * c, 0.0))
-                theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
-                gap = rb1 * (theta - pp)
-                gap = (gap + half) % circ - half
-                if gap < best:
-                    best = gap
-                    kb = k
-            ret[f, m] = max(best, 0.0)
-            rad[f, m] = r[f, kb]
+    for fm in nb.prange(n * n_u):          # every knot of every fault on its own
+        f, m = fm // n_u, fm % n_u
+        best = np.inf
+        kb = 0
+        cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
+        for k in range(n_pts):
+            cth = cm * ca[f, k] - sm * sa[f, k]
+            sth = sm * ca[f, k] + cm * sa[f, k]
+            px = o2x + r[f, k] * cth
+            py = r[f, k] * sth
+            rp = math.hypot(px, py)
+            if rp < lo_r or rp > hi_r:
+                continue
+            c = rb1 / rp
+            s = math.sqrt(max(1.0 - c * c, 0.0))
+            theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
+            gap = rb1 * (theta - pp)
+            t = gap + half                   # (gap + half) % circ - half, the modulo
+            if t < 0.0 or t >= circ:         # only where it changes t
+                t = t % circ
+            gap = t - half
+            if gap < best:
+                best = gap
+                kb = k
+        ret[f, m] = max(best, 0.0)
+        rad[f, m] = r[f, kb]
     return ret, rad
 
 
@@ -170,7 +183,6 @@ def ftff_gear_compliance(pair: GearPair, roll, arcs):
     point with its fault's cut ``arcs`` (n_points, 5): xa, xb, cx, ch, radius of
     :meth:`FullToothFaceFault._arc`. As ``_tooth_compliance(pair, z_gear, roll,
     fault.section_loss)``."""
-    from .stiffness import _contact_frame, _fillet_compliance, _materials, _simpson_nodes
 
     z = pair.z_gear
     E, G, L = _materials(pair)
@@ -199,7 +211,7 @@ def _interp_walk(x, xp, fp, j):
     return slope * (x - xp[j]) + fp[j], j
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab,
                E, G, L):
     """Bending + shear + axial compliance: the Simpson sums of ``_tooth_compliance``
@@ -207,7 +219,7 @@ def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs
     n = xc.shape[0]
     out = np.empty(n)
     n_nodes = xi.shape[0]
-    for p in range(n):
+    for p in nb.prange(n):
         xa, xe, cx, ch, rad = arcs[p, 0], arcs[p, 1], arcs[p, 2], arcs[p, 3], arcs[p, 4]
         span = xc[p] - x0
         cbp, sbp = cb[p], sb[p]
@@ -251,8 +263,6 @@ def ftff_tables(pair: GearPair, faults):
     """Tables over the spur contact position u (``_N_TABLE`` points) of non-healthy
     FTFFs: pair stiffness k (N/m) and displacement excitation e_f (m), arrays (n, n_u);
     as ``_pair_table(pair, fault)`` and ``fault.displacement(pair, 1 - u)``."""
-    from .stiffness import _N_SEGMENT, _N_TABLE, _healthy_compliances
-
     n = len(faults)
     s0s, s1s, arcs_all = _arcs(pair, faults)
     parts = [bridge_batch(pair, faults[i:i + _RETREAT_CHUNK],
@@ -260,49 +270,111 @@ def ftff_tables(pair: GearPair, faults):
                            arcs_all[i:i + _RETREAT_CHUNK]))
              for i in range(0, n, _RETREAT_CHUNK)]
     knots, ret, contact = (np.concatenate([p[m] for p in parts]) for m in range(3))
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    s = 1.0 - u
+    s = 1.0 - _U_TABLE
     inv_p, inv_g = _healthy_compliances(pair)
     _, (g_lo, g_hi) = pair.roll_limits
-    rolls, arcs, segs = [], [], []
+    seg_fault, seg_ab, kts, rolls = _segment_points(knots, contact, s0s, s1s, s, g_lo,
+                                                    g_hi, _N_SEGMENT)
+    vals = ftff_gear_compliance(pair, rolls, arcs_all[np.repeat(seg_fault, _N_SEGMENT)])
+    inv = np.tile(inv_g, (n, 1))
+    ef = np.zeros((n, s.size))
+    trans = np.array([f.transmission for f in faults], dtype=float)
+    _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals.reshape(kts.shape), knots, ret,
+                 s0s, s1s, trans)
+    k = 1.0 / (1.0 / _hertz_stiffness(pair) + inv_p + inv)
+    return k, ef
+
+
+@nb.njit(cache=True, inline="always")
+def _interp_point(x, xp, fp, lo, hi):
+    """``np.interp(x, xp[lo:hi], fp[lo:hi])`` of one point (numpy's formula: the
+    slope of the cell times the distance from its left node plus that node's value)."""
+    if x < xp[lo]:
+        return fp[lo]
+    if x >= xp[hi - 1]:
+        return fp[hi - 1]
+    j = lo
+    while xp[j + 1] <= x:
+        j += 1
+    if xp[j] == x:
+        return fp[j]
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
+
+
+@nb.njit(cache=True)
+def _segment_points(knots, contact, s0s, s1s, s, g_lo, g_hi, n_seg):
+    """The smooth segments of every fault's compliance (``stiffness._segments`` between
+    the cut's start, load switch, end and the tip) and the gear roll (m) at their
+    evaluation points (``FullToothFaceFault.contact_roll``): segment's fault (n_segs,),
+    ends (n_segs, 2), points (n_segs, n_seg), rolls (n_segs * n_seg,)."""
+    n, n_k = knots.shape
+    seg_fault = np.empty(4 * n, np.int64)
+    seg_ab = np.empty((4 * n, 2))
+    kts = np.empty((4 * n, n_seg))
+    rolls = np.empty(4 * n * n_seg)
+    m = 0
     for i in range(n):
-        kn, ct = knots[i], contact[i]
-        j = int(np.argmax(np.abs(np.diff(ct))))          # FullToothFaceFault._switch
-        sw = 0.5 * (kn[j] + kn[j + 1])
         s0, s1 = s0s[i], s1s[i]
-        edges = np.unique(np.clip(np.concatenate([[s0, 1.0], [s0, sw, s1]]), s0, 1.0))
-        k_hi, k_lo = kn > sw, kn <= sw
-        for a, b in zip(edges[:-1], edges[1:]):
-            if b - a <= 0:
-                continue
-            sel = (s >= a) & (s <= b) if b == 1.0 else (s >= a) & (s < b)
-            if not sel.any():
+        j = 0                                          # FullToothFaceFault._switch
+        for q in range(1, n_k - 1):
+            if abs(contact[i, q + 1] - contact[i, q]) > abs(contact[i, j + 1] - contact[i, j]):
+                j = q
+        sw = 0.5 * (knots[i, j] + knots[i, j + 1])
+        n_lo = 0                                       # knots <= sw: a prefix
+        while n_lo < n_k and knots[i, n_lo] <= sw:
+            n_lo += 1
+        edges = np.unique(np.minimum(np.maximum(np.array([s0, 1.0, s0, sw, s1]), s0), 1.0))
+        for e in range(edges.size - 1):
+            a, b = edges[e], edges[e + 1]
+            if b - a <= 0 or not _holds_point(s, a, b):
                 continue
             eta = 1e-9 * (b - a)
-            kts = np.linspace(a + eta, b - eta, _N_SEGMENT)
-            cr = kts.copy()                               # FullToothFaceFault.contact_roll
-            hi = (kts > sw) & (kts < s1)
-            lo = (kts > s0) & (kts <= sw)
-            if hi.any():
-                cr[hi] = np.interp(kts[hi], kn[k_hi], ct[k_hi])
-            if lo.any():
-                cr[lo] = np.interp(kts[lo], kn[k_lo], ct[k_lo])
-            rolls.append(g_lo + cr * (g_hi - g_lo))
-            arcs.append(np.broadcast_to(arcs_all[i], (_N_SEGMENT, 5)))
-            segs.append((i, sel, kts))
-    vals = ftff_gear_compliance(pair, np.concatenate(rolls), np.concatenate(arcs))
-    inv = np.tile(inv_g, (n, 1))
-    for m, (i, sel, kts) in enumerate(segs):
-        inv[i, sel] = np.interp(s[sel], kts, vals[m * _N_SEGMENT:(m + 1) * _N_SEGMENT])
-    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
-    k = 1.0 / (1.0 / k_h + inv_p + inv)
-    ef = np.zeros((n, _N_TABLE))
-    for i, f in enumerate(faults):                        # FullToothFaceFault.displacement
-        s0, s1 = s0s[i], s1s[i]
-        inside = (s > s0) & (s < s1)
-        if inside.any():
-            ef[i, inside] = -f.transmission * np.interp(s[inside], knots[i], ret[i])
-    return k, ef
+            start, step = a + eta, ((b - eta) - (a + eta)) / (n_seg - 1)
+            for q in range(n_seg):
+                x = q * step + start if q < n_seg - 1 else b - eta
+                cr = x
+                if x > sw and x < s1:
+                    cr = _interp_point(x, knots[i], contact[i], n_lo, n_k)
+                elif x > s0 and x <= sw:
+                    cr = _interp_point(x, knots[i], contact[i], 0, n_lo)
+                kts[m, q] = x
+                rolls[m * n_seg + q] = g_lo + cr * (g_hi - g_lo)
+            seg_fault[m] = i
+            seg_ab[m, 0], seg_ab[m, 1] = a, b
+            m += 1
+    return seg_fault[:m], seg_ab[:m], kts[:m], rolls[:m * n_seg]
+
+
+@nb.njit(cache=True, inline="always")
+def _in_segment(x, a, b):
+    return x >= a and (x <= b if b == 1.0 else x < b)
+
+
+@nb.njit(cache=True)
+def _holds_point(s, a, b):
+    for x in s:
+        if _in_segment(x, a, b):
+            return True
+    return False
+
+
+@nb.njit(cache=True)
+def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s, trans):
+    """The faulty gear tooth's compliance ``inv`` (interpolated from each segment's
+    points, healthy elsewhere) and the displacement excitation ``ef``
+    (``FullToothFaceFault.displacement``), in place."""
+    n_seg = kts.shape[1]
+    for m in range(seg_fault.shape[0]):
+        i = seg_fault[m]
+        a, b = seg_ab[m, 0], seg_ab[m, 1]
+        for p in range(s.shape[0]):
+            if _in_segment(s[p], a, b):
+                inv[i, p] = _interp_point(s[p], kts[m], vals[m], 0, n_seg)
+    for i in range(ef.shape[0]):
+        for p in range(s.shape[0]):
+            if s[p] > s0s[i] and s[p] < s1s[i]:
+                ef[i, p] = -trans[i] * _interp_point(s[p], knots[i], ret[i], 0,
+                                                     knots.shape[1])
 
 
 def ftff_cached(pair: GearPair, faults):
@@ -318,10 +390,3 @@ def ftff_cached(pair: GearPair, faults):
         while len(_CACHE) > _CACHE_SIZE:
             del _CACHE[next(iter(_CACHE))]
     return [_CACHE[(pair, f)] for f in faults]
-
-
-def is_ftff(fault) -> bool:
-    """True for a non-healthy fault handled here (exactly the FTFF class)."""
-    from .faults import FullToothFaceFault
-
-    return type(fault) is FullToothFaceFault and not fault.is_healthy

@@ -19,6 +19,7 @@ from threadpoolctl import threadpool_limits
 
 from ._slices import box
 from .geometry import GearPair
+from .profile_errors import noise_cell, wave_amplitudes
 from .stiffness import _N_TABLE, _pair_table, band_arrays, helical_tables
 
 __all__ = ["helical_batch_tables"]
@@ -32,9 +33,7 @@ def _error_basis(pair: GearPair, n_waves: float, n_knots: int) -> np.ndarray:
     span, k, _ = helical_tables(pair)
     tau = np.linspace(0.0, span, k.size)
     s = np.linspace(0.0, 1.0, _N_TABLE)
-    pos = s * (n_knots - 1)
-    i0 = np.minimum(pos.astype(int), n_knots - 2)
-    frac = pos - i0
+    i0, frac = noise_cell(s, n_knots)
     hats = np.zeros((n_knots, s.size))
     hats[i0, np.arange(s.size)] += 1 - frac
     hats[i0 + 1, np.arange(s.size)] += frac
@@ -47,12 +46,10 @@ def _error_basis(pair: GearPair, n_waves: float, n_knots: int) -> np.ndarray:
 
 def _params(errs) -> np.ndarray:
     """(n, z, 3 + n_knots): slope, waviness sine and cosine amplitudes, noise knots."""
-    half = 0.5 * np.stack([e.waviness for e in errs])
-    phase = np.stack([e.phase for e in errs])
-    return np.concatenate([np.stack([e.slope for e in errs])[..., None],
-                           (half * np.cos(phase))[..., None],
-                           (half * np.sin(phase))[..., None],
-                           np.stack([e.noise for e in errs])], axis=-1)
+    wa, wb = wave_amplitudes(np.stack([e.waviness for e in errs]),
+                             np.stack([e.phase for e in errs]))
+    return np.concatenate([np.stack([e.slope for e in errs])[..., None], wa[..., None],
+                           wb[..., None], np.stack([e.noise for e in errs])], axis=-1)
 
 
 def _forces(pair: GearPair, errs, n_pad: int) -> np.ndarray:

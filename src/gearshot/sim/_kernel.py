@@ -27,6 +27,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .profile_errors import tooth_error
+
 __all__ = ["G0", "contact_slots", "spur_shared", "table_shared", "newmark_spur",
            "newmark_tables"]
 
@@ -121,8 +123,9 @@ def table_shared(pos, count, k_tab):
 
 @nb.njit(cache=True)
 def spur_shared(pos, count, n_knots, g_nw, p_nw):
-    """Per contact: the profile-error noise cell and fraction (``n_knots`` knots) and
-    sin/cos of the waviness angle ``2 pi n_waves u`` of gear and pinion."""
+    """Per contact: the profile-error noise cell and fraction (``n_knots`` knots, as
+    :func:`~gearshot.sim.profile_errors.noise_cell`) and sin/cos of the waviness angle
+    ``2 pi n_waves u`` of gear and pinion."""
     n_steps, n_slots = pos.shape
     cell = np.zeros((n_steps, n_slots), np.int64)
     frac = np.zeros((n_steps, n_slots))
@@ -130,12 +133,7 @@ def spur_shared(pos, count, n_knots, g_nw, p_nw):
     for m in range(n_steps):
         for c in range(count[m]):
             s = pos[m, c]
-            p = s * (n_knots - 1)
-            i = int(p)
-            if i > n_knots - 2:
-                i = n_knots - 2
-            cell[m, c] = i
-            frac[m, c] = p - i
+            cell[m, c], frac[m, c] = _table_index(n_knots - 1, s)
             ag = 2.0 * math.pi * g_nw * s
             ap = 2.0 * math.pi * p_nw * s
             trig[m, c, 0] = math.sin(ag)
@@ -187,7 +185,9 @@ def _modal_step(x, vel, acc, y, corr, kk, fex, ld, ma, mc, sc, o):
 
 
 @nb.njit(cache=True, inline="always")
-def _load_group(X, V, A, b0, lanes):
+def _open_group(X, V, A, b0, lanes):
+    """The modal state of signals ``b0 ... b0 + lanes - 1`` (ndof, lanes) and the step's
+    work arrays ``y`` (as the state), ``corr, kk, fex, o`` (lanes)."""
     ndof = X.shape[1]
     x = np.empty((ndof, lanes))
     vel = np.empty((ndof, lanes))
@@ -197,7 +197,8 @@ def _load_group(X, V, A, b0, lanes):
             x[i, g] = X[b0 + g, i]
             vel[i, g] = V[b0 + g, i]
             acc[i, g] = A[b0 + g, i]
-    return x, vel, acc
+    return (x, vel, acc, np.empty_like(x), np.empty(lanes), np.empty(lanes),
+            np.empty(lanes), np.empty(lanes))
 
 
 @nb.njit(cache=True, inline="always")
@@ -211,10 +212,63 @@ def _store_group(X, V, A, b0, x, vel, acc):
 
 
 @nb.njit(cache=True, inline="always")
-def _record(out, b0, o, r):
+def _clear(kk, fex):
+    """Zero the step's mesh stiffness and excitation sums."""
+    for g in range(kk.shape[0]):
+        kk[g] = 0.0
+        fex[g] = 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def _contact(n, c, wgt, gtooth, ptooth, k_h, cell, frac, f_tooth, b0, lanes):
+    """Contact ``c`` of step ``n``: gear and pinion tooth, table cell, fraction and its
+    complement, weight, healthy stiffness, and whether the gear tooth is the faulty one
+    of any signal of the group."""
+    gt = gtooth[n, c]
+    hit = False
+    for g in range(lanes):
+        if f_tooth[b0 + g] == gt:
+            hit = True
+    f = frac[n, c]
+    return gt, ptooth[n, c], cell[n, c], f, 1.0 - f, wgt[n, c], k_h[n, c], hit
+
+
+@nb.njit(cache=True, inline="always")
+def _advance(x, vel, acc, y, corr, kk, fex, ld, ma, mc, sc, o, out, b0, r):
+    """The Newmark step of a group, its output written to column ``r`` of ``out``
+    (when it is one)."""
+    _modal_step(x, vel, acc, y, corr, kk, fex, ld, ma, mc, sc, o)
     if r >= 0 and r < out.shape[1]:
         for g in range(o.shape[0]):
             out[b0 + g, r] = o[g]
+
+
+_tooth_error = nb.njit(cache=True, inline="always")(tooth_error)
+
+
+@nb.njit(cache=True, inline="always")
+def _spur_mesh(n, b0, lanes, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_frac, trig,
+               kf_tab, ef_tab, f_tooth, g_slope, g_wa, g_wb, g_noise, p_slope, p_wa, p_wb,
+               p_noise, kk, fex):
+    """Mesh stiffness ``kk`` and excitation ``fex`` of step ``n`` of a spur group."""
+    _clear(kk, fex)
+    for c in range(count[n]):
+        u = pos[n, c]
+        sg, cg, sp, cp = trig[n, c, 0], trig[n, c, 1], trig[n, c, 2], trig[n, c, 3]
+        gt, pt, i, f, _, w, kh, hit = _contact(n, c, wgt, gtooth, ptooth, k_h, n_cell,
+                                               n_frac, f_tooth, b0, lanes)
+        for g in range(lanes):
+            b = b0 + g
+            e = (_tooth_error(u, g_slope[gt, b], g_wa[gt, b], g_wb[gt, b], sg, cg,
+                              g_noise[gt, i, b], g_noise[gt, i + 1, b], f)
+                 + _tooth_error(u, p_slope[pt, b], p_wa[pt, b], p_wb[pt, b], sp, cp,
+                                p_noise[pt, i, b], p_noise[pt, i + 1, b], f))
+            k = kh
+            if hit and f_tooth[b] == gt:
+                k = _interp_table(kf_tab[b], u)
+                e += _interp_table(ef_tab[b], u)
+            kk[g] += w * k
+            fex[g] += w * k * e
 
 
 @nb.njit(cache=True, parallel=True, fastmath=True)
@@ -226,53 +280,42 @@ def newmark_spur(load, motor_acc, count, wgt, pos, gtooth, ptooth, k_h, n_cell, 
 
     Per signal ``b``: faulty gear tooth ``f_tooth[b]`` (-1: none) with stiffness
     ``kf_tab[b]`` and displacement excitation ``ef_tab[b]`` over the contact position;
-    profile errors of tooth t at position s: ``slope[t, b] s + wa[t, b] sin(2 pi n s) +
-    wb[t, b] cos(2 pi n s) + noise[t, :, b](s)`` (``wa, wb`` = half the waviness times
-    cos, sin of the tooth's phase; tooth-major, signals last). The modal state ``X, V, A``
-    (n_batch, ndof) is updated in place and the output of steps ``rec_start ...
-    rec_start + out.shape[1] - 1`` is written into ``out``."""
-    n_steps = count.shape[0]
+    profile errors of tooth t at position s
+    (:func:`~gearshot.sim.profile_errors.tooth_error`): ``slope[t, b] s + wa[t, b]
+    sin(2 pi n s) + wb[t, b] cos(2 pi n s) + noise[t, :, b](s)`` (tooth-major, signals
+    last). The modal state ``X, V, A`` (n_batch, ndof) is updated in place and the output
+    of steps ``rec_start ... rec_start + out.shape[1] - 1`` is written into ``out``."""
     for grp in nb.prange(X.shape[0] // lanes):
         b0 = grp * lanes
-        x, vel, acc = _load_group(X, V, A, b0, lanes)
-        y = np.empty_like(x)
-        corr = np.empty(lanes)
-        kk = np.empty(lanes)
-        fex = np.empty(lanes)
-        o = np.empty(lanes)
-        for n in range(n_steps):
-            for g in range(lanes):
-                kk[g] = 0.0
-                fex[g] = 0.0
-            for c in range(count[n]):
-                u = pos[n, c]
-                gt = gtooth[n, c]
-                pt = ptooth[n, c]
-                i = n_cell[n, c]
-                f = n_frac[n, c]
-                fm = 1.0 - f
-                w = wgt[n, c]
-                sg, cg, sp, cp = trig[n, c, 0], trig[n, c, 1], trig[n, c, 2], trig[n, c, 3]
-                kh = k_h[n, c]
-                hit = False
-                for g in range(lanes):
-                    if f_tooth[b0 + g] == gt:
-                        hit = True
-                for g in range(lanes):
-                    b = b0 + g
-                    e = (g_slope[gt, b] * u + g_wa[gt, b] * sg + g_wb[gt, b] * cg
-                         + g_noise[gt, i, b] * fm + g_noise[gt, i + 1, b] * f
-                         + p_slope[pt, b] * u + p_wa[pt, b] * sp + p_wb[pt, b] * cp
-                         + p_noise[pt, i, b] * fm + p_noise[pt, i + 1, b] * f)
-                    k = kh
-                    if hit and f_tooth[b] == gt:
-                        k = _interp_table(kf_tab[b], u)
-                        e += _interp_table(ef_tab[b], u)
-                    kk[g] += w * k
-                    fex[g] += w * k * e
-            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
-            _record(out, b0, o, n - rec_start)
+        x, vel, acc, y, corr, kk, fex, o = _open_group(X, V, A, b0, lanes)
+        for n in range(count.shape[0]):
+            _spur_mesh(n, b0, lanes, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_frac,
+                       trig, kf_tab, ef_tab, f_tooth, g_slope, g_wa, g_wb, g_noise, p_slope,
+                       p_wa, p_wb, p_noise, kk, fex)
+            _advance(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o, out,
+                     b0, n - rec_start)
         _store_group(X, V, A, b0, x, vel, acc)
+
+
+@nb.njit(cache=True, inline="always")
+def _table_mesh(n, b0, lanes, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_tab, f_tooth,
+                fg_tab, fp_tab, fpf_tab, kk, fex):
+    """Mesh stiffness ``kk`` and excitation ``fex`` of step ``n`` of a table group."""
+    _clear(kk, fex)
+    for c in range(count[n]):
+        gt, pt, i, f, fm, w, kh, hit = _contact(n, c, wgt, gtooth, ptooth, k_h, cell, frac,
+                                                f_tooth, b0, lanes)
+        for g in range(lanes):
+            b = b0 + g
+            fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                fp_tab[pt, i, b] * fm + fp_tab[pt, i + 1, b] * f)
+            k = kh
+            if hit and f_tooth[b] == gt:
+                k = kf_tab[b, i] * fm + kf_tab[b, i + 1] * f
+                fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
+                    fpf_tab[b, pt, i] * fm + fpf_tab[b, pt, i + 1] * f)
+            kk[g] += w * k
+            fex[g] += w * fo
 
 
 @nb.njit(cache=True, parallel=True, fastmath=True)
@@ -284,42 +327,12 @@ def newmark_tables(load, motor_acc, count, wgt, gtooth, ptooth, k_h, cell, frac,
     ``fg_tab[gear tooth, :, b] + fp_tab[pinion tooth, :, b]`` (``fpf_tab[b, pinion
     tooth]`` instead of ``fp_tab`` when the gear tooth is the faulty one; tables
     tooth-major, signals last). Used for helical pairs."""
-    n_steps = count.shape[0]
     for grp in nb.prange(X.shape[0] // lanes):
         b0 = grp * lanes
-        x, vel, acc = _load_group(X, V, A, b0, lanes)
-        y = np.empty_like(x)
-        corr = np.empty(lanes)
-        kk = np.empty(lanes)
-        fex = np.empty(lanes)
-        o = np.empty(lanes)
-        for n in range(n_steps):
-            for g in range(lanes):
-                kk[g] = 0.0
-                fex[g] = 0.0
-            for c in range(count[n]):
-                gt = gtooth[n, c]
-                pt = ptooth[n, c]
-                i = cell[n, c]
-                f = frac[n, c]
-                fm = 1.0 - f
-                w = wgt[n, c]
-                kh = k_h[n, c]
-                hit = False
-                for g in range(lanes):
-                    if f_tooth[b0 + g] == gt:
-                        hit = True
-                for g in range(lanes):
-                    b = b0 + g
-                    fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
-                        fp_tab[pt, i, b] * fm + fp_tab[pt, i + 1, b] * f)
-                    k = kh
-                    if hit and f_tooth[b] == gt:
-                        k = kf_tab[b, i] * fm + kf_tab[b, i + 1] * f
-                        fo = (fg_tab[gt, i, b] * fm + fg_tab[gt, i + 1, b] * f) + (
-                            fpf_tab[b, pt, i] * fm + fpf_tab[b, pt, i + 1] * f)
-                    kk[g] += w * k
-                    fex[g] += w * fo
-            _modal_step(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o)
-            _record(out, b0, o, n - rec_start)
+        x, vel, acc, y, corr, kk, fex, o = _open_group(X, V, A, b0, lanes)
+        for n in range(count.shape[0]):
+            _table_mesh(n, b0, lanes, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_tab,
+                        f_tooth, fg_tab, fp_tab, fpf_tab, kk, fex)
+            _advance(x, vel, acc, y, corr, kk, fex, load[n], motor_acc[n], mc, sc, o, out,
+                     b0, n - rec_start)
         _store_group(X, V, A, b0, x, vel, acc)

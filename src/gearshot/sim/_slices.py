@@ -20,6 +20,7 @@ integral over x in [z0 eps_beta, z1 eps_beta] only.
 
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
 
 __all__ = ["tau_grid", "box"]
@@ -71,23 +72,32 @@ def box(f: np.ndarray, eps_alpha: float, eps_beta: float, lo, hi,
     cum[..., 1:n] = np.cumsum(0.5 * (f[..., 1:] + f[..., :-1]), axis=-1) * step
     cum[..., n] = cum[..., n - 1]
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    banded = lo.ndim > 0
+    rows = int(np.prod(f.shape[:-1], dtype=np.int64))
+    per_band = rows // f.shape[0] if lo.ndim > 0 and f.ndim > 1 else rows
+    lo_rows = np.repeat(np.broadcast_to(lo, (rows // per_band,)), per_band)
+    hi_rows = np.repeat(np.broadcast_to(hi, (rows // per_band,)), per_band)
+    out = np.empty((rows, tau.size))
+    _box_rows(fp.reshape(rows, n + 1), cum.reshape(rows, n + 1), step,
+              np.ascontiguousarray(tau, dtype=float), lo_rows, hi_rows, eps_beta, out)
+    return out.reshape(f.shape[:-1] + (tau.size,))
 
-    def at(shift):
-        if banded:      # shift (n_bands,) against f's first axis
-            shift = shift.reshape(shift.shape + (1,) * (f.ndim - 1))
-        p = np.clip((tau - shift) / step, 0.0, n - 1.0)
-        i = np.minimum(p.astype(np.int64), n - 1)
-        frac = p - i
-        if banded:
-            i = np.broadcast_to(i, f.shape[:-1] + (tau.size,))
-            f0 = np.take_along_axis(fp, i, axis=-1)
-            df = np.where(i < n - 1, np.take_along_axis(fp, i + 1, axis=-1) - f0, 0.0)
-            c0 = np.take_along_axis(cum, i, axis=-1)
-        else:
-            f0 = fp[..., i]
-            df = np.where(i < n - 1, fp[..., i + 1] - f0, 0.0)
-            c0 = cum[..., i]
-        return c0 + step * frac * (f0 + 0.5 * df * frac)
 
-    return (at(lo) - at(hi)) / eps_beta
+@nb.njit(cache=True, inline="always")
+def _running(fp, cum, r, n, step, t):
+    """The running integral of row ``r`` at delay ``t`` (mesh periods)."""
+    p = min(max(t / step, 0.0), n - 1.0)
+    i = min(int(p), n - 1)
+    frac = p - i
+    f0 = fp[r, i]
+    df = fp[r, i + 1] - f0 if i < n - 1 else 0.0
+    return cum[r, i] + step * frac * (f0 + 0.5 * df * frac)
+
+
+@nb.njit(cache=True)
+def _box_rows(fp, cum, step, tau, lo, hi, eps_beta, out):
+    """:func:`box` of every row (its own band ``lo[r] ... hi[r]``) into ``out``."""
+    n = fp.shape[1] - 1
+    for r in range(fp.shape[0]):
+        for j in range(tau.size):
+            out[r, j] = (_running(fp, cum, r, n, step, tau[j] - lo[r])
+                         - _running(fp, cum, r, n, step, tau[j] - hi[r])) / eps_beta

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._ftff_batch import ftff_cached, is_ftff
+from ._ftff_batch import ftff_cached
 from ._helical import helical_batch_tables
 from ._kernel import (
     G0,
@@ -35,10 +35,10 @@ from ._kernel import (
     spur_shared,
     table_shared,
 )
-from .faults import ToothFault
+from .faults import ToothFault, is_ftff
 from .geometry import GearPair
-from .profile_errors import ToothProfileErrors
-from .stiffness import _N_TABLE, _pair_table, fault_tables
+from .profile_errors import ToothProfileErrors, wave_amplitudes
+from .stiffness import _N_TABLE, _pair_table, face_bands, fault_tables
 
 __all__ = ["system_matrices", "Integrator", "integrator", "Batch", "HelicalBatch",
            "make_batch", "warmup_time"]
@@ -178,7 +178,7 @@ def prefetch_ftff(pair: GearPair, faults) -> None:
     """Compute the tables of every FTFF among ``faults`` (and their face bands) in one
     batch (:func:`._ftff_batch.ftff_cached`)."""
     todo = [band for f in faults if f is not None and not f.is_healthy
-            for _, _, band in f.face_bands(pair) if is_ftff(band)]
+            for _, _, band in face_bands(pair, f) if is_ftff(band)]
     if todo:
         ftff_cached(pair, todo)
 
@@ -186,14 +186,15 @@ def prefetch_ftff(pair: GearPair, faults) -> None:
 def _stack_errors(errs: list[ToothProfileErrors]):
     """Slope, the waviness as sine/cosine amplitudes (half the waviness times cos/sin of
     each tooth's phase) and noise knots of every signal; the waves per profile."""
-    half = 0.5 * np.stack([e.waviness for e in errs])
-    phase = np.stack([e.phase for e in errs])
-    return ((np.stack([e.slope for e in errs]), half * np.cos(phase), half * np.sin(phase),
+    wa, wb = wave_amplitudes(np.stack([e.waviness for e in errs]),
+                             np.stack([e.phase for e in errs]))
+    return ((np.stack([e.slope for e in errs]), wa, wb,
              np.ascontiguousarray(np.stack([e.noise for e in errs]))),
             float(errs[0].n_waves))
 
 
-LANES = 8      # signals integrated side by side by one thread (_kernel._modal_step)
+LANES = 32     # signals integrated side by side by one thread (_kernel._modal_step); 8 -> 32
+#                halves the kernel time per SA (benchmarks/RESULTS.md, session 7)
 
 
 def _lanes(n: int) -> tuple[int, int]:
@@ -249,14 +250,23 @@ class Batch:
         self.V = np.zeros((n_pad, x0.size))
         self.A = np.zeros((n_pad, x0.size))
 
-    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+    def shared(self, mesh_pos):
+        """What every signal shares at the steps' mesh positions ``mesh_pos``
+        (:func:`._kernel.contact_slots`, :func:`._kernel.table_shared`,
+        :func:`._kernel.spur_shared`); the same for every batch of a pair, so batches
+        run over the same steps compute it once (:meth:`run`'s ``shared``)."""
+        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, self.pair.contact_ratio,
+                                                        _pair_table(self.pair, None))
+        return (pair_id, wgt, pos, count, k_h,
+                *spur_shared(pos, count, self.g[3].shape[1], self.g_nw, self.p_nw))
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec, shared=None):
         """Advance over the given steps; return the vertical acceleration (g) of steps
-        ``rec_start ... rec_start + n_rec - 1``."""
-        pair, integ = self.pair, self.integ
-        pair_id, wgt, pos, count, _, _, k_h = _contacts(mesh_pos, pair.contact_ratio,
-                                                        _pair_table(pair, None))
-        n_cell, n_frac, trig = spur_shared(pos, count, self.g[3].shape[1], self.g_nw,
-                                           self.p_nw)
+        ``rec_start ... rec_start + n_rec - 1`` (``shared``: :meth:`shared` of
+        ``mesh_pos``, computed here when not given)."""
+        integ = self.integ
+        pair_id, wgt, pos, count, k_h, n_cell, n_frac, trig = (
+            self.shared(mesh_pos) if shared is None else shared)
         out = np.empty((self.X.shape[0], n_rec))
         newmark_spur(np.ascontiguousarray(load, dtype=float),
                      np.ascontiguousarray(motor_acc, dtype=float), count, wgt, pos,
@@ -282,9 +292,13 @@ class HelicalBatch(Batch):
         self.kf, self.fpf = _pad(self.kf, n_pad), _pad(self.fpf, n_pad)
         self._init_state(n)
 
-    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec):
+    def shared(self, mesh_pos):
+        return _contacts(mesh_pos, self.span, self.k)
+
+    def run(self, mesh_pos, motor_acc, load, rec_start, n_rec, shared=None):
         integ = self.integ
-        pair_id, wgt, _, count, cell, frac, k_h = _contacts(mesh_pos, self.span, self.k)
+        pair_id, wgt, _, count, cell, frac, k_h = (
+            self.shared(mesh_pos) if shared is None else shared)
         out = np.empty((self.X.shape[0], n_rec))
         newmark_tables(
             np.ascontiguousarray(load, dtype=float),

@@ -106,10 +106,13 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     loads = np.full(n_steps, load)
     ge, pe = draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=True)
     out = np.empty((n_sig, n_points))
+    shared = None                        # the same steps for every batch: computed once
     for start in range(0, n_sig, _BATCH_CHUNK):
         sl = slice(start, start + _BATCH_CHUNK)
-        acc = make_batch(pair, integ, faults[sl], ge[sl], pe[sl]).run(
-            mesh_pos, zeros, loads, n_warm - 1, n_rev)
+        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        if shared is None:
+            shared = batch.shared(mesh_pos)
+        acc = batch.run(mesh_pos, zeros, loads, n_warm - 1, n_rev, shared)
         out[sl] = _fft_resample(acc, n_points)
     return out
 
@@ -190,11 +193,34 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     n_sig = len(faults)
     min_fs = check_positive(min_fs, "min_fs")
     rng = as_rng(rng, n_sig)
+    up = max(1, int(math.ceil(min_fs / fs)))
+    speed_fn, load_fn, n_out = _profiles(speed, load, fs, duration, n_revs)
+    dt = 1.0 / (fs * up)
+    ld0 = float(load_fn(np.zeros(1))[0])
+    integ = integrator(pair, dt, ld0)
+    half = fir_half_length(up)             # the anti-aliasing FIR's half length
+    n_warm = max(int(math.ceil(warmup_time(pair, integ) / dt)), half + 1)
+    ge, pe = draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=False)
+    acc = np.empty((n_sig, n_out))
+    angle = np.zeros(n_out)
+    for start in range(0, n_sig, _BATCH_CHUNK):
+        sl = slice(start, start + _BATCH_CHUNK)
+        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
+        decimator = StreamingDecimator(acc[sl], up)
+        _warm_up(batch, decimator, float(speed_fn(np.zeros(1))[0]) * pair.z_pinion, ld0,
+                 n_warm, half, dt)
+        _run_profile(batch, decimator, speed_fn, load_fn, dt, up, n_out, half,
+                     angle if start == 0 else None)
+    return SimulationResult(acceleration=acc, pinion_angle=angle,
+                            time=np.arange(n_out) / fs, fs=fs)
+
+
+def _profiles(speed, load, fs, duration, n_revs):
+    """Speed and load as functions of time (s) and the output length (samples at
+    ``fs``), from :func:`simulate`'s arguments (checked)."""
     if (duration is None) == (n_revs is None):
         raise GearshotError("give exactly one of duration and n_revs; got "
                             f"duration={duration!r}, n_revs={n_revs!r}")
-    up = max(1, int(math.ceil(min_fs / fs)))
-    dt = 1.0 / (fs * up)
     speed_fn = profile_fn(speed, "speed", fs)
     load_fn = profile_fn(load, "load", fs)
     if duration is None:
@@ -206,49 +232,44 @@ def simulate(pair: GearPair, *, speed, load, grade: int, fault_sizes=None, fs: f
     n_out = int(round(duration * fs))
     if n_out < 2:
         raise GearshotError(f"duration must span >= 2 samples at fs; got {duration!r} s")
-    if not callable(speed) and np.ndim(speed) and np.size(speed) < n_out:
-        raise GearshotError(f"speed holds {np.size(speed)} samples; the duration needs "
-                            f"{n_out} at fs")
-    if not callable(load) and np.ndim(load) and np.size(load) < n_out:
-        raise GearshotError(f"load holds {np.size(load)} samples; the duration needs "
-                            f"{n_out} at fs")
-    n_fine = n_out * up
-    sp0 = float(speed_fn(np.zeros(1))[0])
-    ld0 = float(load_fn(np.zeros(1))[0])
-    integ = integrator(pair, dt, ld0)
-    half = fir_half_length(up)             # the anti-aliasing FIR's half length
-    n_warm = max(int(math.ceil(warmup_time(pair, integ) / dt)), half + 1)
-    ge, pe = draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=False)
-    acc = np.empty((n_sig, n_out))
-    angle = np.zeros(n_out)
-    z1 = pair.z_pinion
-    chunk = 1 << 16
-    for start in range(0, n_sig, _BATCH_CHUNK):
-        sl = slice(start, start + _BATCH_CHUNK)
-        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
-        decimator = StreamingDecimator(acc[sl], up)
-        # warm-up at the initial speed and load, t = -(n_warm - 1) dt ... 0; keep the
-        # samples from t = -half dt to 0 (the filter's history and the first sample)
-        tau = (np.arange(n_warm) - (n_warm - 1)) * dt
-        zero = np.zeros(n_warm)
-        decimator.start(batch.run(sp0 * z1 * tau, zero, np.full(n_warm, ld0),
-                                  n_warm - 1 - half, half + 1))
-        theta = 0.0
-        n_total = n_fine + half
-        for c0 in range(1, n_total, chunk):
-            c1 = min(c0 + chunk, n_total)
-            t = np.arange(c0 - 1, c1 + 1) * dt          # one step of margin each side
-            sp = speed_fn(t)
-            omega = 2 * np.pi * sp
-            inc = np.pi * (sp[1:-1] + sp[:-2]) * dt      # trapezoid, steps c0 ... c1-1
-            th = theta + np.cumsum(inc)
-            theta = th[-1]
-            if start == 0:                               # the motor angle at output times
-                fidx = np.arange(c0, c1)
-                sel = (fidx % up == 0) & (fidx // up < n_out)
-                angle[fidx[sel] // up] = th[sel]
-            motor_acc = (omega[2:] - omega[:-2]) / (2 * dt)
-            decimator.push(batch.run(th * z1 / (2 * np.pi), motor_acc, load_fn(t[1:-1]),
-                                     0, c1 - c0))
-    return SimulationResult(acceleration=acc, pinion_angle=angle,
-                            time=np.arange(n_out) / fs, fs=fs)
+    for name, profile in (("speed", speed), ("load", load)):
+        if not callable(profile) and np.ndim(profile) and np.size(profile) < n_out:
+            raise GearshotError(f"{name} holds {np.size(profile)} samples; the duration "
+                                f"needs {n_out} at fs")
+    return speed_fn, load_fn, n_out
+
+
+def _warm_up(batch, decimator, mesh_rate, ld0, n_warm, half, dt):
+    """Warm-up at the initial mesh rate (mesh periods per s) and load, t = -(n_warm - 1)
+    dt ... 0; the samples from t = -half dt to 0 (the filter's history and the first
+    sample) start ``decimator``."""
+    tau = (np.arange(n_warm) - (n_warm - 1)) * dt
+    decimator.start(batch.run(mesh_rate * tau, np.zeros(n_warm), np.full(n_warm, ld0),
+                              n_warm - 1 - half, half + 1))
+
+
+_CHUNK_STEPS = 1 << 16     # integration steps per kernel call of :func:`simulate`
+
+
+def _run_profile(batch, decimator, speed_fn, load_fn, dt, up, n_out, half, angle):
+    """Integrate the batch along the speed and load profiles in chunks of
+    ``_CHUNK_STEPS`` steps into ``decimator``; ``angle`` (when given) receives the motor
+    angle at the output times."""
+    theta = 0.0
+    z1 = batch.pair.z_pinion
+    n_total = n_out * up + half
+    for c0 in range(1, n_total, _CHUNK_STEPS):
+        c1 = min(c0 + _CHUNK_STEPS, n_total)
+        t = np.arange(c0 - 1, c1 + 1) * dt          # one step of margin each side
+        sp = speed_fn(t)
+        omega = 2 * np.pi * sp
+        inc = np.pi * (sp[1:-1] + sp[:-2]) * dt      # trapezoid, steps c0 ... c1-1
+        th = theta + np.cumsum(inc)
+        theta = th[-1]
+        if angle is not None:                        # the motor angle at output times
+            fidx = np.arange(c0, c1)
+            sel = (fidx % up == 0) & (fidx // up < n_out)
+            angle[fidx[sel] // up] = th[sel]
+        motor_acc = (omega[2:] - omega[:-2]) / (2 * dt)
+        decimator.push(batch.run(th * z1 / (2 * np.pi), motor_acc, load_fn(t[1:-1]),
+                                 0, c1 - c0))

@@ -366,3 +366,9 @@ def _as_float(value, name):
         return float(value)
     except (TypeError, ValueError):
         raise GearshotError(f"{name} must be a real number; got {value!r}") from None
+
+
+def is_ftff(fault: object) -> bool:
+    """True for a non-healthy full-tooth-face fault (exactly the FTFF class: its tables are
+    built by :mod:`gearshot.sim._ftff_batch`)."""
+    return type(fault) is FullToothFaceFault and not fault.is_healthy

@@ -11,6 +11,7 @@ transverse section; with ``helix_angle == 0`` they are exactly the spur values.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -154,21 +155,21 @@ class GearPair:
         """True when ``helix_angle`` > 0."""
         return self.helix_angle > 0.0
 
-    @property
+    @functools.cached_property
     def transverse_module(self) -> float:
         """Transverse module m_n / cos(beta), m (``module`` for a spur pair)."""
         if not self.is_helical:
             return self.module
         return self.module / math.cos(self.helix_angle)
 
-    @property
+    @functools.cached_property
     def transverse_pressure_angle(self) -> float:
         """Transverse pressure angle atan(tan(alpha_n) / cos(beta)), rad."""
         if not self.is_helical:
             return self.pressure_angle
         return math.atan(math.tan(self.pressure_angle) / math.cos(self.helix_angle))
 
-    @property
+    @functools.cached_property
     def base_helix_angle(self) -> float:
         """Helix angle at the base circle, rad: sin(beta_b) = sin(beta) cos(alpha_n)."""
         return math.asin(math.sin(self.helix_angle) * math.cos(self.pressure_angle))
@@ -185,17 +186,17 @@ class GearPair:
     def root_radius(self, z: int) -> float:
         return self.pitch_radius(z) - self.dedendum * self.module
 
-    @property
+    @functools.cached_property
     def center_distance(self) -> float:
         return 0.5 * self.transverse_module * (self.z_pinion + self.z_gear)
 
-    @property
+    @functools.cached_property
     def base_pitch(self) -> float:
         """Transverse base pitch, m (distance between successive pairs along the line of
         action)."""
         return math.pi * self.transverse_module * math.cos(self.transverse_pressure_angle)
 
-    @property
+    @functools.cached_property
     def roll_limits(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """Roll lengths (distance from the base-circle tangency, m) of the active profile,
         ((pinion_low, pinion_tip), (gear_low, gear_tip))."""
@@ -206,13 +207,13 @@ class GearPair:
         l2_tip = math.sqrt(ra2 ** 2 - rb2 ** 2)
         return (total - l2_tip, l1_tip), (total - l1_tip, l2_tip)
 
-    @property
+    @functools.cached_property
     def contact_length(self) -> float:
         """Length of the path of contact along the line of action, m."""
         (p_lo, p_hi), _ = self.roll_limits
         return p_hi - p_lo
 
-    @property
+    @functools.cached_property
     def contact_ratio(self) -> float:
         """Transverse contact ratio epsilon_alpha (path of contact / transverse base
         pitch); see :attr:`total_contact_ratio` for a helical pair."""
@@ -226,14 +227,14 @@ class GearPair:
         """Transverse contact ratio epsilon_alpha (same as :attr:`contact_ratio`)."""
         return self.contact_ratio
 
-    @property
+    @functools.cached_property
     def overlap_ratio(self) -> float:
         """Overlap (face) contact ratio epsilon_beta = b sin(beta) / (pi m_n): how many
         base pitches one tooth's contact line advances across the face width (0 for
         spur)."""
         return self.face_width * math.sin(self.helix_angle) / (math.pi * self.module)
 
-    @property
+    @functools.cached_property
     def total_contact_ratio(self) -> float:
         """Total contact ratio epsilon_gamma = epsilon_alpha + epsilon_beta: the mesh
         periods during which one tooth pair is (partly) in contact."""

@@ -20,7 +20,8 @@ import numpy as np
 
 from .._validation import check_int
 
-__all__ = ["DIN_PROFILE_TOLERANCES", "ToothProfileErrors", "draw_profile_errors"]
+__all__ = ["DIN_PROFILE_TOLERANCES", "ToothProfileErrors", "draw_profile_errors",
+           "tooth_error", "noise_cell", "wave_amplitudes", "waves_per_profile"]
 
 #: grade -> (fHa, ffa, c) in micrometres, DIN 3962 grades 1..12.
 DIN_PROFILE_TOLERANCES = {
@@ -32,6 +33,35 @@ DIN_PROFILE_TOLERANCES = {
 }
 
 N_NOISE_KNOTS = 16
+
+
+def tooth_error(x, slope, wa, wb, sin_w, cos_w, knot_lo, knot_hi, frac):
+    """The profile error of a tooth, the one formula of the package.
+
+    ``slope x + wa sin(2 pi n s) + wb cos(2 pi n s) + noise(s)``: ``x`` is the roll
+    fraction measured from the slope's origin (``s`` in the simulator), ``sin_w, cos_w``
+    the sine and cosine of the waviness angle ``2 pi n s``, ``wa, wb`` the waviness's
+    amplitudes (:func:`wave_amplitudes`), and the noise is interpolated linearly between
+    ``knot_lo`` and ``knot_hi`` at fraction ``frac`` (:func:`noise_cell`). Plain
+    arithmetic on numpy arrays or scalars; the integration kernel compiles it inline
+    (:mod:`gearshot.sim._kernel`).
+    """
+    return slope * x + wa * sin_w + wb * cos_w + (knot_lo * (1.0 - frac) + knot_hi * frac)
+
+
+def noise_cell(s, n_knots: int):
+    """Knot cell and fraction of roll fractions ``s`` in [0, 1] on ``n_knots`` equally
+    spaced noise knots (``s = 1`` is the end of the last cell)."""
+    pos = np.asarray(s) * (n_knots - 1)
+    i0 = np.minimum(pos.astype(int), n_knots - 2)
+    return i0, pos - i0
+
+
+def wave_amplitudes(waviness, phase):
+    """Sine and cosine amplitudes ``wa, wb`` of the waviness term ``0.5 ffa sin(2 pi n s
+    + phi) = wa sin(2 pi n s) + wb cos(2 pi n s)``."""
+    half = 0.5 * np.asarray(waviness)
+    return half * np.cos(phase), half * np.sin(phase)
 
 
 @dataclass(frozen=True)
@@ -62,15 +92,11 @@ class ToothProfileErrors:
         """Deviation (m) of tooth ``tooth`` at roll fractions ``s`` (broadcast)."""
         tooth = np.asarray(tooth) % self.slope.size
         s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
-        knots = self.noise.shape[1]
-        pos = s * (knots - 1)
-        i0 = np.minimum(pos.astype(int), knots - 2)
-        frac = pos - i0
-        noise = self.noise[tooth, i0] * (1 - frac) + self.noise[tooth, i0 + 1] * frac
-        return (self.slope[tooth] * s
-                + 0.5 * self.waviness[tooth] * np.sin(2 * np.pi * self.n_waves * s
-                                                      + self.phase[tooth])
-                + noise)
+        i0, frac = noise_cell(s, self.noise.shape[1])
+        wa, wb = wave_amplitudes(self.waviness[tooth], self.phase[tooth])
+        angle = 2 * np.pi * self.n_waves * s
+        return tooth_error(s, self.slope[tooth], wa, wb, np.sin(angle), np.cos(angle),
+                           self.noise[tooth, i0], self.noise[tooth, i0 + 1], frac)
 
     def mean_tooth(self) -> ToothProfileErrors:
         """The average over teeth as a one-tooth wheel (exact: the sine terms share one
@@ -91,4 +117,9 @@ def draw_profile_errors(z: int, grade: int, rng: np.random.Generator) -> ToothPr
     waviness = ff * rng.uniform(0.9, 1.1, z)
     phase = rng.uniform(-np.pi, np.pi, z)
     noise = rng.uniform(-c, c, (z, N_NOISE_KNOTS))
-    return ToothProfileErrors(slope, waviness, phase, noise, 2.5 if z < 20 else 3.5)
+    return ToothProfileErrors(slope, waviness, phase, noise, waves_per_profile(z))
+
+
+def waves_per_profile(z: int) -> float:
+    """Waviness waves per active profile of a ``z``-tooth wheel (DESIGN.md section 2)."""
+    return 2.5 if z < 20 else 3.5

@@ -23,24 +23,20 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array
-from ._ftff_batch import ftff_cached, is_ftff
+from ._compliance import (
+    _N_TABLE,
+    _U_TABLE,
+    _healthy_compliances,
+    _hertz_stiffness,
+    _segments,
+    _tooth_compliance,
+)
+from ._ftff_batch import ftff_cached
 from ._slices import box, tau_grid
-from .faults import ToothFault
-from .geometry import GearPair, involute_half_angle
+from .faults import ToothFault, is_ftff
+from .geometry import GearPair
 
 __all__ = ["mesh_stiffness", "pair_stiffness", "contact_ratio"]
-
-# Sainsot et al. (2004) fillet-foundation coefficients: rows L*, M*, P*, Q*;
-# columns A, B, C, D, E, F of X* = A/theta^2 + B h^2 + C h/theta + D/theta + E h + F.
-_SAINSOT = np.array([
-    [-5.574e-5, -1.9986e-3, -2.3015e-4, 4.7702e-3, 0.0271, 6.8045],
-    [60.111e-5, 28.100e-3, -83.431e-4, -9.9256e-3, 0.1624, 0.9086],
-    [-50.952e-5, 185.50e-3, 0.0538e-4, 53.300e-3, 0.2895, 0.9236],
-    [-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904],
-])
-
-_N_NODES = 240  # integration nodes along the tooth
-
 
 def contact_ratio(pair: GearPair, *, kind: str = "total") -> float:
     """Contact ratio of ``pair``.
@@ -60,85 +56,6 @@ def contact_ratio(pair: GearPair, *, kind: str = "total") -> float:
     if kind == "overlap":
         return pair.overlap_ratio
     raise GearshotError(f"kind must be 'total', 'transverse' or 'overlap'; got {kind!r}")
-
-
-def _tooth_compliance(pair: GearPair, z: int, roll: np.ndarray,
-                      section_loss=None) -> np.ndarray:
-    """Bending + shear + axial + fillet compliance (m/N) of one tooth of a ``z``-tooth wheel
-    loaded along the line of action at roll lengths ``roll`` (m)."""
-    E, G, L = _materials(pair)
-    rb = pair.base_radius(z)
-    a0 = pair.transverse_pressure_angle
-    xc, hc, beta, hb, xb, x0 = _contact_frame(pair, z, roll)
-    # involute table for h(x)
-    r_tab = np.linspace(rb, pair.tip_radius(z) * 1.001, 1200)
-    psi_t = involute_half_angle(z, a0, r_tab, rb)
-    x_tab, h_tab = r_tab * np.cos(psi_t), r_tab * np.sin(psi_t)
-    # composite Simpson nodes from the root circle to each contact point
-    xi, w = _simpson_nodes()
-    span = (xc - x0)[:, None]
-    x = x0 + span * xi[None, :]
-    h = np.where(x <= xb, hb, np.interp(x, x_tab, h_tab))
-    t = 2.0 * h
-    if section_loss is not None:
-        t = np.maximum(t - section_loss(x), 0.05 * t)
-    area = t * L
-    inertia = t ** 3 * L / 12.0
-    cb, sb = np.cos(beta)[:, None], np.sin(beta)[:, None]
-    moment_arm = cb * (xc[:, None] - x) - sb * hc[:, None]
-    wk = w[None, :] * span
-    inv_kb = np.sum(wk * moment_arm ** 2 / (E * inertia), axis=1)
-    inv_ks = np.sum(wk * 1.2 * cb ** 2 / (G * area), axis=1)
-    inv_ka = np.sum(wk * sb ** 2 / (E * area), axis=1)
-    return inv_kb + inv_ks + inv_ka + _fillet_compliance(pair, z, xc, hc, beta, hb)
-
-
-def _materials(pair: GearPair) -> tuple[float, float, float]:
-    """Young's modulus, shear modulus (Pa) and face width (m) of the pair."""
-    E, nu, L = pair.youngs_modulus, pair.poisson, pair.face_width
-    return E, E / (2 * (1 + nu)), L
-
-
-def _contact_frame(pair: GearPair, z: int,
-                   roll) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, float]:
-    """Contact point ``xc, hc`` (m, tooth frame), load angle ``beta`` to the tooth's
-    transverse axis at roll lengths ``roll`` (m), and the base-circle point ``hb, xb`` and
-    integration start ``x0`` of a ``z``-tooth wheel's tooth."""
-    rb, rf = pair.base_radius(z), pair.root_radius(z)
-    a0 = pair.transverse_pressure_angle
-    roll = np.asarray(roll, dtype=float)
-    rc = np.hypot(rb, roll)
-    psi_c = involute_half_angle(z, a0, rc, rb)
-    xc, hc = rc * np.cos(psi_c), rc * np.sin(psi_c)
-    beta = np.arccos(rb / rc) - psi_c          # load angle to the tooth's transverse axis
-    psi_b = float(involute_half_angle(z, a0, np.array(rb), rb))
-    hb = rb * math.sin(psi_b)
-    xb = rb * math.cos(psi_b)
-    return xc, hc, beta, hb, xb, float(min(rf, xb))
-
-
-def _simpson_nodes() -> tuple[np.ndarray, np.ndarray]:
-    """Composite Simpson nodes on [0, 1] and their weights (``_N_NODES`` intervals)."""
-    xi = np.linspace(0.0, 1.0, _N_NODES + 1)
-    w = np.ones(_N_NODES + 1)
-    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
-    w /= 3.0 * _N_NODES
-    return xi, w
-
-
-def _fillet_compliance(pair: GearPair, z: int, xc, hc, beta, hb) -> np.ndarray:
-    """Fillet-foundation compliance (m/N) of a ``z``-tooth wheel's tooth (Sainsot 2004)."""
-    E, _, L = _materials(pair)
-    rf = pair.root_radius(z)
-    theta_f = math.asin(min(hb / rf, 1.0))
-    s_f = 2 * rf * theta_f
-    h_fi = rf / pair.bore_radius
-    basis = np.array([1 / theta_f ** 2, h_fi ** 2, h_fi / theta_f, 1 / theta_f, h_fi, 1.0])
-    Ls, Ms, Ps, Qs = _SAINSOT @ basis
-    u_f = xc - hc * np.tan(beta) - rf
-    cbeta = np.cos(beta)
-    return cbeta ** 2 / (E * L) * (Ls * (u_f / s_f) ** 2 + Ms * (u_f / s_f)
-                                   + Ps * (1 + Qs * np.tan(beta) ** 2))
 
 
 def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = None
@@ -173,7 +90,7 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
         sec = functools.partial(fault.section_loss, pair)
     inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + s_pin * (p_hi - p_lo))
     inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + s_gear * (g_hi - g_lo), sec)
-    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+    k_h = _hertz_stiffness(pair)
     k = 1.0 / (1.0 / k_h + inv_p + inv_g)
     if fault is not None and not fault.is_healthy and fault.scales_contact:
         k = k * fault.stiffness_scale(pair, 1.0 - u)
@@ -182,45 +99,31 @@ def pair_stiffness(pair: GearPair, u: np.ndarray, *, fault: ToothFault | None = 
 
 def _whole_face(fault: ToothFault, pair: GearPair) -> bool:
     """True when ``fault`` is its own transverse fault over the whole face width."""
-    bands = fault.face_bands(pair)
+    bands = fault.face_bands(pair)        # not the cache: its band may be an equal copy
     return len(bands) == 1 and bands[0][0] == 0.0 and bands[0][1] == 1.0 and bands[0][2] is fault
 
 
-_N_TABLE = 1025
-_N_SEGMENT = 24  # exact evaluations per smooth segment of a faulty tooth's compliance
-
-
-@functools.lru_cache(maxsize=32)
-def _healthy_compliances(pair: GearPair):
-    """Pinion and gear tooth compliance tables over u (the healthy pair)."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    (p_lo, p_hi), (g_lo, g_hi) = pair.roll_limits
-    inv_p = _tooth_compliance(pair, pair.z_pinion, p_lo + u * (p_hi - p_lo))
-    inv_g = _tooth_compliance(pair, pair.z_gear, g_lo + (1.0 - u) * (g_hi - g_lo))
-    return inv_p, inv_g
+@functools.lru_cache(maxsize=256)
+def face_bands(pair: GearPair, fault: ToothFault) -> tuple:
+    """``fault.face_bands(pair)``, computed once per (pair, fault) (a batch asks twice:
+    for its FTFF bands and for its tables)."""
+    return fault.face_bands(pair)
 
 
 def _faulty_gear_compliance(pair: GearPair, fault: ToothFault) -> np.ndarray:
     """Gear-tooth compliance over the u table for a faulty tooth: exact on a few points
     of each smooth segment (between the fault's breakpoints) and interpolated, healthy
     outside the affected range."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
-    s = 1.0 - u
     _, inv_g = _healthy_compliances(pair)
+    s_min, breaks = fault.affected_range(pair)
+    if s_min >= 1.0 and len(breaks) == 0:       # a surface or tip fault: section unchanged
+        return inv_g.copy()
+    s = 1.0 - _U_TABLE
     out = inv_g.copy()
     (_, _), (g_lo, g_hi) = pair.roll_limits
-    s_min, breaks = fault.affected_range(pair)
     edges = np.unique(np.clip(np.concatenate([[s_min, 1.0], breaks]), s_min, 1.0))
     sec = functools.partial(fault.section_loss, pair)
-    for a, b in zip(edges[:-1], edges[1:]):
-        if b - a <= 0:
-            continue
-        sel = (s >= a) & (s <= b) if b == 1.0 else (s >= a) & (s < b)
-        if not sel.any():
-            continue
-        # evaluate just inside the segment so one-sided limits are respected
-        eta = 1e-9 * (b - a)
-        knots = np.linspace(a + eta, b - eta, _N_SEGMENT)
+    for sel, knots in _segments(s, edges):
         roll = g_lo + fault.contact_roll(pair, knots) * (g_hi - g_lo)
         vals = _tooth_compliance(pair, pair.z_gear, roll, sec)
         out[sel] = np.interp(s[sel], knots, vals)
@@ -234,10 +137,10 @@ def _pair_table(pair: GearPair, fault: ToothFault | None) -> np.ndarray:
     inv_p, inv_g = _healthy_compliances(pair)
     if fault is not None and not fault.is_healthy:
         inv_g = _faulty_gear_compliance(pair, fault)
-    k_h = math.pi * pair.youngs_modulus * pair.face_width / (4 * (1 - pair.poisson ** 2))
+    k_h = _hertz_stiffness(pair)
     tab = 1.0 / (1.0 / k_h + inv_p + inv_g)
     if fault is not None and not fault.is_healthy and fault.scales_contact:
-        tab = tab * fault.stiffness_scale(pair, 1.0 - np.linspace(0.0, 1.0, _N_TABLE))
+        tab = tab * fault.stiffness_scale(pair, 1.0 - _U_TABLE)
     tab.setflags(write=False)
     return tab
 
@@ -247,9 +150,9 @@ def _band_tables(pair: GearPair, fault: ToothFault):
     """The fault's face bands as ``((z0, z1, k, d), ...)``: face fractions, the band's
     transverse pair stiffness (N/m, full-width scale) and displacement excitation (m)
     over the spur contact position u."""
-    u = np.linspace(0.0, 1.0, _N_TABLE)
+    u = _U_TABLE
     out = []
-    for z0, z1, f in fault.face_bands(pair):
+    for z0, z1, f in face_bands(pair, fault):
         if z1 <= z0 or f is None or f.is_healthy:
             continue
         if is_ftff(f):

@@ -32,7 +32,7 @@ from ._options import (
 __all__ = ["demo", "simulate", "rig"]
 
 HELP_PAIRED = ("Store each signal's healthy twin (same profile errors, no fault): the "
-               "estimator subtracts each signal's own twin (simulated_reference 'auto' -> "
+               "estimator subtracts each signal's own twin (options.simulated_reference 'auto' -> "
                "'twin') and calibrates fault gain and width on it. Default on; --no-paired "
                "builds the old layout (half the simulation time).")
 HELP_MACHINE = ("Machine description (TOML): simulate its monitored pair; --speed is then "

@@ -42,10 +42,10 @@ HELP_VARIANT = ("Estimator variant(s): full, no_feature_selection, no_tuning, be
 HELP_FAMILY_FRF = ("Measured FRFs of the path bank (the family of issue #12 uses the 12 real "
                    "ones); synthetic paths only when omitted.")
 HELP_RIG_PAIRED = ("Build and use the database with healthy twins (default): the estimator's "
-                   "simulated_reference='auto' then subtracts each signal's own twin (steps 1 "
-                   "and 6). --no-paired: the old layout.")
+                   "options.simulated_reference='auto' then subtracts each signal's own "
+                   "twin (steps 1 and 6). --no-paired: the old layout.")
 HELP_FAMILY_PAIRED = ("Use the database with healthy twins (default; the estimator's "
-                      "simulated_reference='auto' then uses them). --no-paired: the old "
+                      "options.simulated_reference='auto' then uses them). --no-paired: the old "
                       "layout.")
 
 
