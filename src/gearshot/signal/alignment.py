@@ -120,7 +120,7 @@ class _LagSearch:
         padded[:, 1:] *= 0.5  # irfft doubles these bins itself
         coarse = np.fft.irfft(padded, n=n * self.coarse, axis=-1)
         n_cand = min(self.n_candidates, coarse.shape[-1])
-        cand = _top_indices(coarse, n_cand)
+        cand = _top_indices(coarse, n_cand)  # overwrites coarse, not used after
         centres = cand * self.step  # (rows, n_candidates) on the fine grid
         # exp(2πi·centre·k/n_fine) = w^(cand·k mod n·coarse), w = exp(2πi/(n·coarse))
         turns = (cand[:, :, None] * self.k) % (n * self.coarse)
@@ -136,12 +136,12 @@ class _LagSearch:
         return cast(IntArray, np.where(top, fine, n_fine).min(axis=-1))  # first max., as argmax
 
 
-def _top_indices(x: FloatArray, count: int) -> IntArray:
+def _top_indices(work: FloatArray, count: int) -> IntArray:
     """Column indices of the ``count`` largest values of each row, ascending: ``count``
-    row-wise argmax passes (each found maximum masked), cheaper than ``argpartition``."""
-    work = x.copy()
-    rows = np.arange(len(x))
-    found = np.empty((len(x), count), dtype=np.intp)
+    row-wise argmax passes (each found maximum masked in place: ``work`` is overwritten),
+    cheaper than ``argpartition``."""
+    rows = np.arange(len(work))
+    found = np.empty((len(work), count), dtype=np.intp)
     for i in range(count):
         found[:, i] = np.argmax(work, axis=-1)
         work[rows, found[:, i]] = -np.inf
