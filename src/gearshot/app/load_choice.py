@@ -94,15 +94,14 @@ def _profiles(sa: np.ndarray, mesh_order: int) -> np.ndarray:
 
 
 def _spread(prof: np.ndarray) -> float:
-    """RMS leave-one-out distance of profiles from the mean of the others."""
-    from ..estimator.comparability import MIN_SPREAD
+    """The recordings' healthy spread (the comparability score's unit)."""
+    from ..estimator.comparability import healthy_spread
 
     n = len(prof)
     if n < 2:
         raise GearshotError(f"the healthy recordings give {n} SA segment(s); choosing the "
                             f"load needs at least 2")
-    loo = (n * prof.mean(axis=0) - prof) / (n - 1)
-    return max(float(np.sqrt(np.mean(np.sum((prof - loo) ** 2, axis=1)))), MIN_SPREAD)
+    return healthy_spread(prof)
 
 
 def _healthy_by_grade(db) -> dict[int, np.ndarray]:

@@ -40,7 +40,7 @@ from .._validation import as_signal_array, check_in_range, check_positive
 from ..signal.orders import check_mesh_orders
 
 __all__ = ["DEFAULT_THRESHOLD", "Comparability", "ComparabilityReference",
-           "harmonic_orders", "harmonic_profile", "fit_comparability"]
+           "harmonic_orders", "harmonic_profile", "healthy_spread", "fit_comparability"]
 
 FloatArray = NDArray[np.float64]
 
@@ -154,6 +154,14 @@ class ComparabilityReference:
         return Comparability(score, score <= thr, float(thr))
 
 
+def healthy_spread(profiles: FloatArray) -> float:
+    """RMS leave-one-out distance of each healthy profile from the mean of the others (the
+    unit of the comparability score), at least :data:`MIN_SPREAD`; needs 2 profiles."""
+    n = len(profiles)
+    loo = (n * profiles.mean(axis=0) - profiles) / (n - 1)  # the mean of the others
+    return max(float(np.sqrt(np.mean(np.sum((profiles - loo) ** 2, axis=1)))), MIN_SPREAD)
+
+
 def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
                       faulty_example: ArrayLike | None = None,
                       faulty_size: float | None = None,
@@ -184,9 +192,7 @@ def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
     meshes = check_mesh_orders(mesh_order, n_points)
     prof = harmonic_profile(healthy, list(meshes))
     mean = prof.mean(axis=0)
-    n = len(prof)
-    loo = (n * mean - prof) / (n - 1)  # the mean of the others, for each profile
-    spread = max(float(np.sqrt(np.mean(np.sum((prof - loo) ** 2, axis=1)))), MIN_SPREAD)
+    spread = healthy_spread(prof)
     direction, max_step = np.zeros_like(mean), 0.0
     if faulty_example is not None:
         if faulty_size is None:
