@@ -64,7 +64,7 @@ def test_rig_defaults_are_the_papers():
 
 
 def test_dask_client_in_process_without_a_cluster():
-    from gearshot.app.cluster import dask_client
+    from gearshot._cluster import dask_client
 
     with dask_client(None, workers=1) as client:
         assert client is None
@@ -73,7 +73,7 @@ def test_dask_client_in_process_without_a_cluster():
 
 
 def test_dask_client_closes_its_local_cluster():
-    from gearshot.app.cluster import dask_client
+    from gearshot._cluster import dask_client
 
     with dask_client(None, workers=2) as client:
         assert client.submit(sum, [1, 2, 3]).result() == 6
@@ -84,7 +84,7 @@ def test_dask_client_closes_its_local_cluster():
 
 
 def test_dask_client_closes_on_error():
-    from gearshot.app.cluster import dask_client
+    from gearshot._cluster import dask_client
 
     with pytest.raises(GearshotError, match="boom"):
         with dask_client(None, workers=2) as client:

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .._cluster import dask_client
 from ..paper import (
     PAPER_LOADS,
     PAPER_SPEEDS,
@@ -23,7 +24,6 @@ from ..paper import (
     RIG_REPETITIONS,
     TABLE1_SIZES,
 )
-from .cluster import dask_client
 
 __all__ = ["ExperimentRun", "run_simulated_experiment", "run_rig_experiment",
            "run_rig_family", "family_results_file", "simulated_store_tag"]

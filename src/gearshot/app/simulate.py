@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from .cluster import dask_client
+from .._cluster import dask_client
 
 __all__ = ["default_store", "simulate_database", "simulate_machine_database"]
 
@@ -28,7 +28,7 @@ def simulate_database(store: Path, *, speeds: Sequence[float], loads: Sequence[f
                       scheduler: str | None = None, workers: int = 2) -> Path:
     """The paper pair's database over ``speeds`` × ``loads`` × ``grades`` × ``fault_types``
     (blocks on a Dask cluster when there are several; see
-    :func:`gearshot.app.cluster.dask_client`); returns ``store``."""
+    :func:`gearshot._cluster.dask_client`); returns ``store``."""
     from ..sim import GearPair, build_database
 
     n_blocks = len(speeds) * len(loads) * len(grades) * len(fault_types)

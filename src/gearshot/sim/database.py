@@ -39,6 +39,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._atomic import atomic_dir, check_writable, remove_tree
+from .._cluster import dask_client
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, check_load, check_speed, describe
@@ -223,19 +224,10 @@ def _build_locked(store: Path, pair: GearPair, manifest: dict, client, progress)
              for k, g in enumerate(manifest["grades"])
              for ft in manifest.get("fault_types", ["ftff"])]
     todo = _blocks_to_build(store, manifest, tasks, progress)
-    own_cluster = None
-    if client is None and len(todo) > _SMALL_BUILD:
-        from dask.distributed import Client, LocalCluster
-        own_cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
-                                   processes=True, dashboard_address=":0")
-        client = Client(own_cluster)
-    try:
-        _run_tasks(store, pair, todo, len(tasks), manifest, client if client else None,
-                   progress)
-    finally:
-        if own_cluster is not None:
-            client.close()
-            own_cluster.close()
+    # no client given and many blocks: a LocalCluster of one worker per core, closed after
+    with dask_client(None, os.cpu_count() or 1,
+                     needed=client is None and len(todo) > _SMALL_BUILD) as own:
+        _run_tasks(store, pair, todo, len(tasks), manifest, client or own, progress)
 
 
 def _blocks_to_build(store: Path, manifest: dict, tasks: list[_Task],

@@ -1,8 +1,9 @@
-"""The Dask cluster of a long command: a running scheduler, a LocalCluster, or none.
+"""The Dask cluster of a long job (a command, a database build): a running scheduler, a
+LocalCluster, or none.
 
 Examples
 --------
->>> from gearshot.app.cluster import dask_client
+>>> from gearshot._cluster import dask_client
 >>> with dask_client(None, workers=1) as client:   # one worker: work runs in-process
 ...     print(client)
 None
@@ -14,7 +15,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from .._errors import GearshotError
+from ._errors import GearshotError
 
 __all__ = ["dask_client"]
 
