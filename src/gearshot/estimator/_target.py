@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,6 +18,76 @@ from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
+
+# the results of target-side work inside a ``shared_target_work`` block (None outside one)
+_SHARED: ContextVar[dict[tuple[Any, ...], FloatArray] | None] = ContextVar(
+    "gearshot_shared_target_work", default=None)
+
+
+@contextmanager
+def shared_target_work() -> Iterator[None]:
+    """Within the block, target-side work on the same inputs is done once.
+
+    Step 6's delay-aligned subtraction (the costliest part of the target side) and step 7's
+    centred features of target SAs are kept, keyed by the exact bytes of their inputs (SAs,
+    references, healthy mean, scale, feature names, mesh orders, ``upsample``), and handed
+    out again (copies) when the same inputs come back: e.g. the estimator variants of one
+    dataset (:func:`gearshot.experiments.evaluate_variants`) that see the same target arrays,
+    or ``predict`` and ``predict_interval`` of the same SAs. The results are those of the
+    plain computation, bit for bit. Blocks nest (an inner block shares the outer one's
+    store); everything kept is dropped when the outermost block ends.
+
+    Examples
+    --------
+    >>> from gearshot.estimator._target import shared_target_work
+    >>> with shared_target_work():
+    ...     pass                     # fit / predict several estimators on one dataset here
+    """
+    if _SHARED.get() is not None:
+        yield
+        return
+    token = _SHARED.set({})
+    try:
+        yield
+    finally:
+        _SHARED.reset(token)
+
+
+def _digest(value: Any) -> Any:
+    """A key part for ``value``: arrays by dtype, shape and a hash of their bytes."""
+    if isinstance(value, np.ndarray):
+        data = np.ascontiguousarray(value)
+        return (data.dtype.str, data.shape,
+                hashlib.blake2b(data.view(np.uint8).reshape(-1), digest_size=16).digest())
+    if isinstance(value, (list, tuple)):
+        return tuple(_digest(v) for v in value)
+    if isinstance(value, float):
+        return ("float", value.hex())
+    return value
+
+
+def _shared(kind: str, parts: tuple[Any, ...], compute: Callable[[], FloatArray]
+            ) -> FloatArray:
+    """``compute()``, or a copy of what it gave for the same ``kind`` and ``parts`` in the
+    current :func:`shared_target_work` block."""
+    store = _SHARED.get()
+    if store is None:
+        return compute()
+    key = (kind, *(_digest(p) for p in parts))
+    if key not in store:
+        result = compute()
+        result.flags.writeable = False
+        store[key] = result
+    return store[key].copy()
+
+
+def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int
+                      ) -> FloatArray:
+    """Step 6 on target SAs (:func:`steps.suppress_harmonics_target`), shared inside a
+    :func:`shared_target_work` block."""
+    return _shared("suppress", (signals, references, int(upsample)),
+                   lambda: steps.suppress_harmonics_target(signals, references,
+                                                           upsample=upsample))
 
 
 @dataclass(frozen=True)
@@ -37,8 +111,7 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _Ta
     scaled = steps.normalize_rms(inputs.target_healthy, scale=scale) \
         if est.rms_normalization else inputs.target_healthy
     train_h, references = steps.split_target_healthy(scaled)
-    sub_h = steps.suppress_harmonics_target(train_h, references,
-                                            upsample=est._options().upsample)
+    sub_h = suppressed_target(train_h, references, est._options().upsample)
     feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
@@ -60,11 +133,17 @@ def target_tf(est: Any, healthy_long: FloatArray | None,
 
 def target_features(est: Any, sa: ArrayLike | None, scale: float, references: FloatArray,
                     healthy_mean: FloatArray, names: tuple[str, ...]) -> FloatArray:
-    """Steps 5–7 on target SAs with the target side's scale, references and mean."""
+    """Steps 5–7 on target SAs with the target side's scale, references and mean
+    (shared inside a :func:`shared_target_work` block)."""
     x = np.atleast_2d(np.asarray(sa, dtype=float))
-    if est.rms_normalization:
-        x = steps.normalize_rms(x, scale=scale)
-    sub = steps.suppress_harmonics_target(x, references, upsample=est._options().upsample)
-    feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=est._mesh_orders(),
-                                      names=names)
-    return feats
+    upsample, orders = est._options().upsample, est._mesh_orders()
+
+    def compute() -> FloatArray:
+        y = steps.normalize_rms(x, scale=scale) if est.rms_normalization else x
+        sub = suppressed_target(y, references, upsample)
+        feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
+        return feats
+
+    return _shared("features", (x, bool(est.rms_normalization), float(scale), references,
+                                np.asarray(healthy_mean, dtype=float), tuple(names),
+                                orders, int(upsample)), compute)

@@ -35,25 +35,35 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
         ``seconds``, plus ``prediction`` (array) and, with ``keep_estimators``, ``estimator``.
     """
     from ..estimator import OneFaultShotEstimator
+    from ..estimator._target import shared_target_work
 
     rows = []
-    for name in variants:
-        t0 = time.perf_counter()
-        est = (estimator_class or OneFaultShotEstimator)(
-            random_state=random_state, **{**params, **variant_params(name)})
-        est.fit(*fit_args, selection_tf=selection_tf, **dict(fit_kwargs or {}))
-        pred = est.predict(test_sa)
-        seconds = time.perf_counter() - t0
-        low, high = est.predict_interval(test_sa, coverage=coverage)
-        inside = (test_size >= low - 1e-12) & (test_size <= high + 1e-12)
-        row = dict(variant=name, mae=float(np.mean(np.abs(pred - test_size))),
-                   grade=est.grade_, selected=",".join(est.selected_features_),
-                   n_neighbors=est.n_neighbors_, coverage=float(np.mean(inside)),
-                   width=float(np.mean(high - low)), seconds=seconds, prediction=pred)
-        if keep_estimators:
-            row["estimator"] = est
-        rows.append(row)
+    with shared_target_work():   # the variants share the target-side work on one dataset
+        for name in variants:
+            rows.append(_evaluate_one(
+                (estimator_class or OneFaultShotEstimator)(
+                    random_state=random_state, **{**params, **variant_params(name)}),
+                name, fit_args, fit_kwargs, test_sa, test_size, selection_tf, coverage,
+                keep_estimators))
     return rows
+
+
+def _evaluate_one(est, name, fit_args, fit_kwargs, test_sa, test_size, selection_tf,
+                  coverage, keep_estimators):
+    """Fit one variant's estimator and score it (one row of :func:`evaluate_variants`)."""
+    t0 = time.perf_counter()
+    est.fit(*fit_args, selection_tf=selection_tf, **dict(fit_kwargs or {}))
+    pred = est.predict(test_sa)
+    seconds = time.perf_counter() - t0
+    low, high = est.predict_interval(test_sa, coverage=coverage)
+    inside = (test_size >= low - 1e-12) & (test_size <= high + 1e-12)
+    row = dict(variant=name, mae=float(np.mean(np.abs(pred - test_size))),
+               grade=est.grade_, selected=",".join(est.selected_features_),
+               n_neighbors=est.n_neighbors_, coverage=float(np.mean(inside)),
+               width=float(np.mean(high - low)), seconds=seconds, prediction=pred)
+    if keep_estimators:
+        row["estimator"] = est
+    return row
 
 
 # ------------------------------------------------------------------ resumable result store
