@@ -1,0 +1,101 @@
+"""The target-side work shared by the variants of one dataset (issue #23, the paper sweep):
+same numbers as the plain path, bit for bit, and no alignment done twice on the same inputs."""
+
+import numpy as np
+import pytest
+from estimator_data import N, synthetic_sa
+
+import gearshot.estimator.steps as steps
+from gearshot.estimator import OneFaultShotEstimator
+from gearshot.estimator._target import _SHARED, shared_target_work, suppressed_target
+from gearshot.experiments import evaluate_variants, simulated_dataset, variant_params
+
+
+@pytest.fixture(scope="module")
+def dataset():
+    rng = np.random.default_rng(3)
+    y = np.r_[np.zeros(40), rng.uniform(0, 1, 160)]
+    return simulated_dataset(synthetic_sa(y, 4, rng), y, np.ones(N), random_state=2)
+
+
+@pytest.fixture
+def count_alignments(monkeypatch):
+    """Count the signals step 6 aligns on the target side (rows given to subtract_healthy)."""
+    rows = []
+    plain = steps.subtract_healthy
+
+    def counted(signals, refs, **kw):
+        rows.append(np.atleast_2d(signals).shape[0])
+        return plain(signals, refs, **kw)
+
+    monkeypatch.setattr(steps, "subtract_healthy", counted)
+    return rows
+
+
+def _plain_rows(ds, variants):
+    """evaluate_variants' numbers, each variant fitted and scored on its own (no sharing)."""
+    out = []
+    for name in variants:
+        est = OneFaultShotEstimator(random_state=0, **variant_params(name))
+        est.fit(*ds.fit_args(), selection_tf=np.ones(N))
+        low, high = est.predict_interval(ds.test_sa)
+        out.append((est.predict(ds.test_sa), low, high, est.grade_, est.selected_features_))
+    return out
+
+
+def test_shared_variants_give_the_plain_numbers_bit_for_bit(dataset):
+    variants = ("before_da", "rms_only", "full")
+    rows = evaluate_variants(dataset.fit_args(), dataset.test_sa, dataset.test_size,
+                             variants=variants, selection_tf=np.ones(N), random_state=0)
+    assert _SHARED.get() is None                          # nothing kept after the block
+    for row, (pred, low, high, grade, selected) in zip(rows, _plain_rows(dataset, variants)):
+        np.testing.assert_array_equal(row["prediction"], pred)
+        assert row["mae"] == float(np.mean(np.abs(pred - dataset.test_size)))
+        assert row["width"] == float(np.mean(high - low))
+        assert (row["grade"], row["selected"]) == (grade, ",".join(selected))
+
+
+def test_variants_of_one_dataset_do_not_realign(dataset, count_alignments):
+    def aligned(variants):
+        count_alignments.clear()
+        evaluate_variants(dataset.fit_args(), dataset.test_sa, dataset.test_size,
+                          variants=variants, selection_tf=np.ones(N), random_state=0)
+        return sum(count_alignments)
+
+    rms_only = aligned(["rms_only"])
+    # the test set once (predict and predict_interval share it) + the target healthy
+    assert rms_only <= len(dataset.test_sa) + len(dataset.target_healthy) + 1
+    # "full" sees the same RMS-normalized target arrays as "rms_only": nothing new
+    assert aligned(["rms_only", "full"]) == rms_only
+    # "before_da" sees the raw arrays: its own alignment, once
+    assert aligned(["before_da", "rms_only", "full"]) == rms_only + aligned(["before_da"])
+
+
+def test_shared_features_equal_plain_ones_and_are_copies(dataset):
+    est = OneFaultShotEstimator(random_state=0).fit(*dataset.fit_args(),
+                                                    selection_tf=np.ones(N))
+    plain = est.features_of(dataset.test_sa)
+    with shared_target_work():
+        first = est.features_of(dataset.test_sa)
+        first[:] = np.nan                                 # the caller's copy, not the store's
+        with shared_target_work():                        # nested: the same store
+            second = est.features_of(dataset.test_sa)
+    np.testing.assert_array_equal(second, plain)
+
+
+def test_shared_alignment_tells_inputs_apart(dataset, count_alignments):
+    x, refs = dataset.test_sa[:6], dataset.target_healthy[-2:]
+    with shared_target_work():
+        a = suppressed_target(x, refs, 100)
+        b = suppressed_target(x * 1.5, refs, 100)         # other signals
+        c = suppressed_target(x, refs[::-1], 100)         # other references
+        d = suppressed_target(x, refs, 10)                # another resolution
+        again = suppressed_target(x.copy(), refs.copy(), 100)   # equal bytes: kept
+    assert count_alignments == [6, 6, 6, 6]
+    outside = suppressed_target(x, refs, 100)             # no block: computed again
+    assert count_alignments == [6, 6, 6, 6, 6]
+    np.testing.assert_array_equal(outside, a)
+    np.testing.assert_array_equal(again, a)
+    np.testing.assert_array_equal(b, steps.suppress_harmonics_target(x * 1.5, refs))
+    np.testing.assert_array_equal(c, steps.suppress_harmonics_target(x, refs[::-1]))
+    np.testing.assert_array_equal(d, steps.suppress_harmonics_target(x, refs, upsample=10))
