@@ -290,14 +290,15 @@ def bench_sweep(args):
     then the Sec. 4.1 datasets x 3 variants, on a LocalCluster of 2 single-threaded
     workers. Prints the wall and the workers' CPU of each part, peak memory and the MAE by
     variant; a fraction is also extrapolated to the whole sweep."""
+    from gearshot._cluster import dask_client
     from gearshot.experiments import simulated_experiment
     from gearshot.paper import PAPER_LOADS, PAPER_SPEEDS
     from gearshot.sim import GearPair, build_database
 
     speeds, loads = _sweep_conditions(args)
     n_cond, n_all = len(speeds) * len(loads), len(PAPER_SPEEDS) * len(PAPER_LOADS)
-    client, cluster = _local_client()
-    try:
+    # the commands' cluster (gearshot._cluster): 2 single-thread workers, their allocator set
+    with dask_client(None, workers=2) as client:
         with tempfile.TemporaryDirectory(dir=args.tmp) as tmp:
             store = Path(tmp) / "db"
             l0, (c0, _) = load_avg(), _workers_usage(client)
@@ -310,9 +311,6 @@ def bench_sweep(args):
             frame = simulated_experiment(store, speeds=speeds, loads=loads, grade=7,
                                          results_dir=Path(tmp) / "res", client=client)
             t_sweep, (c2, rss) = time.perf_counter() - t0, _workers_usage(client)
-    finally:
-        client.close()
-        cluster.close()
     n_sets = len(frame) // frame["variant"].nunique()
     print(f"{'whole sweep' if n_cond == n_all else 'sweep fraction'}: {n_cond} conditions "
           f"({len(speeds)} speeds x {len(loads)} loads), {n_sets} datasets x "
