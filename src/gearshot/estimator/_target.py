@@ -2,120 +2,44 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..signal.alignment import subtract_with_lags
 from . import steps
 from ._inputs import _FitInputs, _on_grid
+from ._shared_work import keep, kept, shared, sharing
 from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
-# the results of target-side work inside a ``shared_target_work`` block (None outside one)
-_SHARED: ContextVar[dict[tuple[Any, ...], list[tuple[Any, FloatArray]]] | None] = ContextVar(
-    "gearshot_shared_target_work", default=None)
 
-
-@contextmanager
-def shared_target_work() -> Iterator[None]:
-    """Within the block, target-side work on the same inputs is done once.
-
-    Step 6's delay-aligned subtraction (the costliest part of the target side) and step 7's
-    centred features of target SAs are kept with their inputs (SAs, references, healthy
-    mean, scale, feature names, mesh orders, ``upsample``) and handed out again (copies)
-    when inputs equal to the bit come back: e.g. the estimator variants of one
-    dataset (:func:`gearshot.experiments.evaluate_variants`) that see the same target arrays,
-    or ``predict`` and ``predict_interval`` of the same SAs. The results are those of the
-    plain computation, bit for bit. Blocks nest (an inner block shares the outer one's
-    store); everything kept is dropped when the outermost block ends.
-
-    Examples
-    --------
-    >>> from gearshot.estimator._target import shared_target_work
-    >>> with shared_target_work():
-    ...     pass                     # fit / predict several estimators on one dataset here
-    """
-    if _SHARED.get() is not None:
-        yield
-        return
-    token = _SHARED.set({})
-    try:
-        yield
-    finally:
-        _SHARED.reset(token)
-
-
-def _fingerprint(value: Any) -> Any:
-    """A cheap key part for ``value``: an array by dtype, shape and a strided sample of its
-    values (equal arrays give equal fingerprints; :func:`_same` tells the rest apart)."""
-    if isinstance(value, np.ndarray):
-        flat = value.reshape(-1)
-        return (value.dtype.str, value.shape,
-                flat[:: max(1, flat.size // 64)].tobytes() if flat.size else b"")
-    if isinstance(value, (list, tuple)):
-        return tuple(_fingerprint(v) for v in value)
-    if isinstance(value, float):
-        return ("float", value.hex())
-    return value
-
-
-def _same(a: Any, b: Any) -> bool:
-    """Whether two inputs are equal to the bit (arrays compared byte for byte)."""
-    if isinstance(a, np.ndarray):
-        return (isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape
-                and np.array_equal(_raw(a), _raw(b)))
-    if isinstance(a, (list, tuple)):
-        return (isinstance(b, (list, tuple)) and len(a) == len(b)
-                and all(_same(x, y) for x, y in zip(a, b)))
-    return type(a) is type(b) and (a.hex() == b.hex() if isinstance(a, float) else a == b)
-
-
-def _raw(a: NDArray[Any]) -> NDArray[Any]:
-    """The bytes of an array as integers (compared exactly: -0.0 differs from 0.0)."""
-    data = np.ascontiguousarray(a).reshape(-1)
-    return data.view(np.int64) if data.itemsize == 8 else data.view(np.uint8)
-
-
-def _shared(kind: str, parts: tuple[Any, ...], compute: Callable[[], FloatArray]
-            ) -> FloatArray:
-    """``compute()``, or a copy of what it gave for the same ``kind`` and equal ``parts``
-    (to the bit) in the current :func:`shared_target_work` block."""
-    store = _SHARED.get()
-    if store is None:
-        return compute()
-    entries = store.setdefault((kind, _fingerprint(parts)), [])
-    for kept_parts, kept in entries:
-        if _same(parts, kept_parts):
-            return kept.copy()
-    result = compute()
-    result.flags.writeable = False
-    entries.append((_frozen(parts), result))
-    return result.copy()
-
-
-def _frozen(value: Any) -> Any:
-    """``value`` with its arrays copied (the caller may change its own afterwards)."""
-    if isinstance(value, np.ndarray):
-        return value.copy()
-    if isinstance(value, (list, tuple)):
-        return tuple(_frozen(v) for v in value)
-    return value
-
-
-def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int
-                      ) -> FloatArray:
+def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int,
+                      unscaled: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
     """Step 6 on target SAs (:func:`steps.suppress_harmonics_target`), shared inside a
-    :func:`shared_target_work` block."""
-    return _shared("suppress", (signals, references, int(upsample)),
-                   lambda: steps.suppress_harmonics_target(signals, references,
-                                                           upsample=upsample))
+    :func:`shared_target_work` block.
+
+    ``unscaled``: the same SAs and references before a common scale was divided out
+    (``signals == unscaled[0] / s``, ``references == unscaled[1] / s``). The lag search
+    does not depend on that scale, so the lags found for the unscaled arrays serve the
+    scaled ones (and the other way round); the residual is computed as without them.
+    """
+    def compute() -> FloatArray:
+        if not sharing():
+            return steps.suppress_harmonics_target(signals, references, upsample=upsample)
+        on = (*(unscaled or (signals, references)), int(upsample))
+        lags = kept("lags", on)
+        residual, found = subtract_with_lags(signals, references, upsample=upsample,
+                                             lags=lags)
+        if lags is None:
+            keep("lags", on, found)
+        return residual
+
+    return shared("suppress", (signals, references, int(upsample)), compute)
 
 
 @dataclass(frozen=True)
@@ -139,7 +63,11 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _Ta
     scaled = steps.normalize_rms(inputs.target_healthy, scale=scale) \
         if est.rms_normalization else inputs.target_healthy
     train_h, references = steps.split_target_healthy(scaled)
-    sub_h = suppressed_target(train_h, references, est._options().upsample)
+    unscaled = None
+    if est.rms_normalization:  # the unscaled arrays' lags serve (shared_target_work)
+        unscaled = steps.split_target_healthy(inputs.target_healthy)
+        keep("unscaled references", (references, float(scale)), unscaled[1])
+    sub_h = suppressed_target(train_h, references, est._options().upsample, unscaled)
     feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
@@ -167,11 +95,15 @@ def target_features(est: Any, sa: ArrayLike | None, scale: float, references: Fl
     upsample, orders = est._options().upsample, est._mesh_orders()
 
     def compute() -> FloatArray:
-        y = steps.normalize_rms(x, scale=scale) if est.rms_normalization else x
-        sub = suppressed_target(y, references, upsample)
+        y, unscaled = x, None
+        if est.rms_normalization:
+            y = steps.normalize_rms(x, scale=scale)
+            raw_refs = kept("unscaled references", (references, float(scale)))
+            unscaled = None if raw_refs is None else (x, raw_refs)
+        sub = suppressed_target(y, references, upsample, unscaled)
         feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
         return feats
 
-    return _shared("features", (x, bool(est.rms_normalization), float(scale), references,
+    return shared("features", (x, bool(est.rms_normalization), float(scale), references,
                                 np.asarray(healthy_mean, dtype=float), tuple(names),
                                 orders, int(upsample)), compute)

@@ -35,7 +35,7 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
         ``seconds``, plus ``prediction`` (array) and, with ``keep_estimators``, ``estimator``.
     """
     from ..estimator import OneFaultShotEstimator
-    from ..estimator._target import shared_target_work
+    from ..estimator._shared_work import shared_target_work
 
     rows = []
     with shared_target_work():   # the variants share the target-side work on one dataset
