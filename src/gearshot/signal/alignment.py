@@ -299,6 +299,23 @@ def subtract_with_lags(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample:
     -------
     residual : ndarray, shape (c, n)
     lags : ndarray of int, shape (c, n_refs)
+
+    Examples
+    --------
+    The lags found on signals and references serve the same arrays at another scale:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import fractional_shift, subtract_healthy
+    >>> from gearshot.signal.alignment import subtract_with_lags
+    >>> theta = np.arange(64) / 64
+    >>> refs = np.vstack([np.cos(2 * np.pi * 7 * theta), np.cos(2 * np.pi * 5 * theta)])
+    >>> signals = np.vstack([fractional_shift(refs[1], 2.25), fractional_shift(refs[0], 1.5)])
+    >>> residual, lags = subtract_with_lags(signals, refs)
+    >>> print(lags[0, 1], lags[1, 0])          # delays in 1/100 sample
+    225 150
+    >>> half, _ = subtract_with_lags(signals / 2, refs / 2, lags=lags)
+    >>> bool(np.array_equal(half, subtract_healthy(signals / 2, refs / 2)))
+    True
     """
     x = as_signal_array(signals, "signals", max_ndim=2, min_length=2)
     flat = np.atleast_2d(x)
