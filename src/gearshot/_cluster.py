@@ -36,7 +36,10 @@ def dask_client(scheduler: str | None = None, workers: int = 2, *,
     Parameters
     ----------
     scheduler : str, optional
-        Address of a running Dask scheduler (``--scheduler``); it is left running.
+        Address of a running Dask scheduler (``--scheduler``); it is left running. Its
+        workers keep the environment they were started with: start them with
+        :data:`WORKER_MALLOC` in it (``MALLOC_TRIM_THRESHOLD_=134217728
+        MALLOC_MMAP_THRESHOLD_=33554432 dask worker ADDRESS``) for the LocalCluster's speed.
     workers : int
         Workers of the LocalCluster started when no ``scheduler`` is given (one thread
         each); with 1 worker no cluster is started and the client is None (in-process).
