@@ -24,7 +24,11 @@ def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
 
     ``estimator_class`` (default :class:`OneFaultShotEstimator`) is what is fitted; the
     family's diagnostics pass a subclass. ``fit_args`` (and ``fit_kwargs``, e.g. the SAs'
-    tooth counts) go to every ``fit``; ``params`` to every estimator.
+    tooth counts) go to every ``fit``; ``params`` to every estimator. The variants share
+    their target-side work (:func:`gearshot.estimator._shared_work.shared_target_work`:
+    step 6's alignment and step 7's target features are done once per distinct input;
+    the numbers are those of separate fits, bit for bit), so a variant's ``seconds`` is
+    shorter when an earlier one did that work.
 
     Returns
     -------
