@@ -56,7 +56,7 @@ from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
 from .ridge import SpeedRidge, _speed_range, speed_ridge
-from .speed_profile import SpeedProfile, fit_speed_profile
+from .speed_profile import SpeedProfile, _fit
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
            "estimate_shaft_angle", "MIN_SNR_DB", "MAX_WANDER", "MIN_LINES"]
@@ -229,8 +229,8 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     if snr_db >= min_snr_db and result.wander <= max_wander and \
             result.ridge.n_lines >= min_lines:
         return _shaft_angle(result, ppr)
-    profile = fit_speed_profile(x, fs, orders=orders, speed_range=speed_range,
-                                max_rate=max_rate)
+    # the whole-record profile (unrefined where a ratio of it is in the range: refused)
+    profile = _fit(x, fs, orders, speed_range, 5, max_rate, guard=True)
     ratio = profile.ambiguous(_speed_range(speed_range), x.size / fs)
     if profile.n_lines >= max(min_lines, 1) and ratio is None:
         fine = _profile_pass(x, fs, profile, bandwidth, track)
