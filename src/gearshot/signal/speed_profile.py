@@ -43,7 +43,7 @@ _RATIOS = (1 / 2, 2 / 3, 3 / 2, 2)  # speed ratios a comb of whole orders cannot
 _RATES = 160  # rates searched on the first span at most
 _KEEP = 6  # rate candidates carried from one stage to the next
 _KEEP_LAST = 3  # ... into the whole record's stage (the half record has sorted them)
-_PEAKS = 16  # mesh-comb peaks rescored with every whole order
+_CELL = 16  # neighbouring candidate speeds bounded together by the comb's search
 _MEDIAN_BINS = 129  # local floor: running median over this many spectrum bins
 
 
@@ -142,33 +142,58 @@ def _levels(power: np.ndarray) -> np.ndarray:
     return np.asarray(10.0 * np.log10(power / (floor + 1e-300) + 1e-30))
 
 
+def _comb_rows(gain: np.ndarray, rows: np.ndarray, per_bin: np.ndarray, mesh: np.ndarray,
+               n_kept: np.ndarray) -> np.ndarray:
+    """The comb score of the speeds ``rows`` (float32) as :func:`_comb` defines it."""
+    g = gain[np.minimum(np.outer(rows, per_bin).astype(np.int32), gain.size - 1)]
+    shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
+    kept = shaft[np.arange(rows.size), np.maximum(n_kept - 1, 0)]
+    return np.asarray(g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept > 0, kept, 0.0))
+
+
 def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
-          top_hz: float) -> np.ndarray:
-    """Comb score of every candidate speed: the levels above the floor summed over the
-    mesh ``lines``; at the :data:`_PEAKS` strongest peaks of that mesh comb (and the
-    speeds next to them) plus, at half weight, every other whole order below ``top_hz``
-    (Hz, the same for every candidate, so that twice the speed, which meets only the even
-    orders, loses; half weight, since some whole order ``j`` meets any line at the speed
-    ``f / j``). Elsewhere the mesh comb alone, which is below every rescored peak."""
+          top_hz: float) -> tuple[float, int]:
+    """Best comb score over the candidate speeds and its index (the first of equals). The
+    score sums the levels above the floor over the mesh ``lines`` and, at half weight,
+    every other whole order below ``top_hz`` (Hz, the same for every candidate, so that
+    twice the speed, which meets only the even orders, loses; half weight, since some
+    whole order ``j`` meets any line at the speed ``f / j``).
+
+    Branch and bound: for cells of :data:`_CELL` neighbouring speeds an upper bound (each
+    order's largest gain over the bins the cell's speeds reach, every order the cell's
+    slowest speed keeps) orders the cells; exact scores are computed cell by cell until
+    no bound is above the best — the same maximum as scoring every speed."""
+    import scipy.ndimage
     gain = np.clip(level - _FLOOR_DB, 0.0, _CAP_DB).astype(np.float32)
     gain = np.maximum(gain[:-1], gain[1:])  # the line between two bins: the larger
-    top = gain.size - 1
-    sf = speeds.astype(np.float32)
-    score = np.zeros(speeds.size)
-    for o in lines:
-        score += gain[np.minimum((sf * np.float32(o / df)).astype(np.int32), top)]
-    inner = (score[1:-1] >= score[:-2]) & (score[1:-1] >= score[2:])
-    peaks = np.flatnonzero(inner) + 1
-    peaks = peaks[np.argsort(-score[peaks], kind="stable")[:_PEAKS]]
-    near = np.unique(np.clip((peaks[:, None] + np.arange(-2, 3)).ravel(), 0,
-                             speeds.size - 1))
     orders = np.arange(1.0, max(float(lines.max()), top_hz / float(speeds.min())) + 1.0)
-    shaft = orders[~np.isin(orders, lines)]
-    idx = np.minimum(np.outer(sf[near], (shaft / df).astype(np.float32)).astype(np.int32),
-                     top)
-    g = np.where(shaft[None, :] * speeds[near, None] <= top_hz, gain[idx], np.float32(0.0))
-    score[near] += _SHAFT_WEIGHT * g.sum(axis=1)
-    return score
+    mesh = np.isin(orders, lines)
+    per_bin = (orders / df).astype(np.float32)
+    n_kept = np.minimum(np.floor(top_hz / speeds).astype(np.int64), orders.size)
+    sf = speeds.astype(np.float32)
+    starts = np.arange(0, speeds.size, _CELL)
+    ends = np.minimum(starts + _CELL, speeds.size) - 1
+    width = int(float(np.max(sf[ends] - sf[starts])) * float(per_bin[-1])) + 3
+    pooled = scipy.ndimage.maximum_filter1d(gain, width, mode="nearest")
+    first = np.minimum(np.outer(sf[starts], per_bin).astype(np.int64) + width // 2,
+                       gain.size - 1)
+    g = pooled[first]
+    shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
+    kept = shaft[np.arange(starts.size), np.maximum(n_kept[starts] - 1, 0)]
+    bound = (g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept[starts] > 0, kept, 0.0))
+    bound = bound * (1.0 + 1e-5) + 1e-3  # float32 sums in another order
+    best, best_k = -np.inf, 0
+    for cells in np.array_split(np.argsort(-bound, kind="stable"),
+                                max(1, starts.size // 8)):
+        if bound[cells[0]] < best:
+            break
+        idx = np.concatenate([np.arange(starts[c], ends[c] + 1) for c in cells])
+        score = _comb_rows(gain, sf[idx], per_bin, mesh, n_kept[idx])
+        top = float(score.max())
+        k = int(idx[score == top].min())
+        if top > best or (top == best and k < best_k):
+            best, best_k = top, k
+    return best, best_k
 
 
 def _stage(y: np.ndarray, dt: float, u: np.ndarray, lines: np.ndarray, lo: float, hi: float,
@@ -186,9 +211,8 @@ def _stage(y: np.ndarray, dt: float, u: np.ndarray, lines: np.ndarray, lo: float
         # the comb reads no bin above the top line at the top speed
         level = _levels(power[: int(float(lines.max()) * hi / df) + _MEDIAN_BINS])
         speeds = np.arange(lo, hi, df / float(lines.max()))
-        score = _comb(level, df, lines, speeds, float(lines.max()) * lo)
-        k = int(np.argmax(score))
-        out.append((float(score[k]), float(speeds[k]), float(a)))  # a: the shape a / c_mid
+        score, k = _comb(level, df, lines, speeds, float(lines.max()) * lo)
+        out.append((score, float(speeds[k]), float(a)))  # a: the shape a / c_mid
     return out
 
 

@@ -55,7 +55,8 @@ import numpy as np
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
-from .ridge import SpeedRidge, _speed_range, speed_ridge
+from .ratio_check import RATIOS, whole_order_scores
+from .ridge import SpeedRidge, _orders, _speed_range, speed_ridge
 from .speed_profile import SpeedProfile, _fit
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
@@ -69,6 +70,8 @@ MAX_WANDER = 0.3
 MIN_LINES = 2  # comb lines that must stand out: one lone line may be any tone
 _SETTLED = 0.1  # wander below which a shorter STFT window is not tried
 _AUTO_WINDOWS = (0.125, 0.5)  # s: shortest and default STFT window of the automatic choice
+_RATIO_SWITCH = 1.5  # another ratio's whole orders this much stronger: track it instead
+_RATIO_RANGE = 0.1  # ... within this fraction of it
 
 
 @dataclass(frozen=True)
@@ -228,7 +231,9 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     snr_db = _db(result.snr)
     if snr_db >= min_snr_db and result.wander <= max_wander and \
             result.ridge.n_lines >= min_lines:
-        return _shaft_angle(result, ppr)
+        kw = dict(ridge_kw, window=window, bandwidth=bandwidth, min_snr_db=min_snr_db,
+                  max_wander=max_wander, min_lines=min_lines, pulses_per_rev=ppr, label=label)
+        return _ratio_checked(x, fs, _shaft_angle(result, ppr), kw)
     # the whole-record profile (unrefined where a ratio of it is in the range: refused)
     profile = _fit(x, fs, orders, speed_range, 5, max_rate, guard=True)
     ratio = profile.ambiguous(_speed_range(speed_range), x.size / fs)
@@ -346,3 +351,38 @@ def _shaft_angle(result: _Pass, ppr: int, profile: SpeedProfile | None = None
                       angle_std=sigma_phi / (2 * np.pi * order), wander=result.wander,
                       pulse_times=pulses, pulses_per_rev=ppr, ridge=result.ridge,
                       profile=profile)
+
+
+def _ratio_checked(x: np.ndarray, fs: float, est: ShaftAngle, kw: dict[str, Any]
+                   ) -> ShaftAngle:
+    """``est``, unless a ratio 1/2, 2/3, 3/2 or 2 of its speed also lies in the speed range
+    and puts its whole orders on lines better (:mod:`gearshot.signal.ratio_check`): then
+    the ridge again within 10 % of that speed where the evidence is clear (its whole
+    orders :data:`_RATIO_SWITCH` times as strong) and that ridge passes every check, else
+    a refusal naming both speeds."""
+    lo, hi = _speed_range(kw["speed_range"])
+    slow, fast = float(est.ridge.speed.min()), float(est.ridge.speed.max())
+    alts = tuple(r for r in RATIOS if lo <= r * slow and r * fast <= hi)
+    if not alts:
+        return est
+    top = 2.0 * float(est.order if kw.get("track") is not None else _orders(kw["orders"])[0])
+    scores = whole_order_scores(x, fs, est.times, est.angle, ratios=(1.0, *alts),
+                                top_order=top)
+    r = max(alts, key=lambda k: scores[k])
+    own, other = scores[1.0], scores[r]
+    if other <= own:
+        return est
+    speed = est.mean_speed
+    if other >= _RATIO_SWITCH * own:
+        narrow = (max(lo, (1.0 - _RATIO_RANGE) * r * speed),
+                  min(hi, (1.0 + _RATIO_RANGE) * r * speed))
+        try:
+            return estimate_shaft_angle(x, fs, **dict(kw, speed_range=narrow))
+        except GearshotError:
+            pass
+    raise GearshotError(
+        f"the speed is ambiguous in {kw['label']}: the mesh comb locks at {speed:.4g} rev/s "
+        f"(order {est.order}, {est.snr_db:.1f} dB above the noise in its band), but "
+        f"{r:.3g} times that, {r * speed:.4g} rev/s, is in the speed range too and puts "
+        f"its whole orders on lines better ({other:.1f} against {own:.1f} dB per order in "
+        f"the record's order spectrum); give a narrower speed range or the nominal speed")
