@@ -24,6 +24,7 @@ A line's level is its power over the local floor (a running median of the spectr
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -108,6 +109,14 @@ def _decimated(x: np.ndarray, fs: float, top: float) -> tuple[np.ndarray, float]
     return scipy.signal.resample_poly(x - x.mean(), 1, down), fs / down
 
 
+@functools.lru_cache(maxsize=8)
+def _hann(n: int) -> np.ndarray:
+    """``numpy.hanning(n)``, kept: the rate search reads hundreds of spectra of one length."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
+
+
 def _spectrum(y: np.ndarray, dt: float, u: np.ndarray, shape: tuple[float, float],
               search: bool = False) -> tuple[np.ndarray, float]:
     """Power spectrum of ``y`` (sampled at ``u``) resampled at equal steps of the angle of
@@ -120,7 +129,7 @@ def _spectrum(y: np.ndarray, dt: float, u: np.ndarray, shape: tuple[float, float
     rel = 1.0 + r * u + p * u * u
     step = dt * float(rel.min())
     grid = np.arange(phi[0], phi[-1], step)
-    z = np.interp(grid, phi, y) * np.hanning(grid.size)
+    z = np.interp(grid, phi, y) * _hann(grid.size)
     if search:
         n = scipy.fft.next_fast_len(2 * grid.size, real=True)
         spec = scipy.fft.rfft(z.astype(np.float32), n)
@@ -183,8 +192,9 @@ def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
     bound = (g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept[starts] > 0, kept, 0.0))
     bound = bound * (1.0 + 1e-5) + 1e-3  # float32 sums in another order
     best, best_k = -np.inf, 0
-    for cells in np.array_split(np.argsort(-bound, kind="stable"),
-                                max(1, starts.size // 8)):
+    order = np.argsort(-bound, kind="stable")
+    for g0 in range(0, order.size, 8):
+        cells = order[g0: g0 + 8]
         if bound[cells[0]] < best:
             break
         idx = np.concatenate([np.arange(starts[c], ends[c] + 1) for c in cells])
