@@ -48,13 +48,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
+from .harmonic_phase import _db, _fused, _inner, _Pass, _phase_pass
 from .ratio_check import RATIOS, whole_order_scores
 from .ridge import SpeedRidge, _orders, _speed_range, speed_ridge
 from .speed_profile import SpeedProfile, _fit
@@ -233,6 +234,8 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
             result.ridge.n_lines >= min_lines:
         kw = dict(ridge_kw, window=window, bandwidth=bandwidth, min_snr_db=min_snr_db,
                   max_wander=max_wander, min_lines=min_lines, pulses_per_rev=ppr, label=label)
+        result = _fused(x, fs, result, _own_harmonics(result, ridge_kw, fs), bandwidth,
+                        min_snr_db, max_wander)
         return _ratio_checked(x, fs, _shaft_angle(result, ppr), kw)
     # the whole-record profile (unrefined where a ratio of it is in the range: refused)
     profile = _fit(x, fs, orders, speed_range, 5, max_rate, guard=True)
@@ -242,6 +245,9 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
         if not (_db(fine.snr) >= min_snr_db and fine.wander <= max_wander):
             fine = fine._replace(angle=profile.angle(fine.times),
                                  speed=profile.speed(fine.times))
+        else:
+            fine = _fused(x, fs, fine, _own_harmonics(fine, ridge_kw, fs), bandwidth,
+                          min_snr_db, max_wander)
         return _shaft_angle(fine, ppr, profile)
     ridge = result.ridge
     raise GearshotError(
@@ -256,55 +262,11 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
         f"the vibration (give a tacho, another sensor or a narrower speed range)")
 
 
-class _Pass(NamedTuple):
-    """One ridge (or profile) + phase pass of :func:`estimate_shaft_angle`."""
-
-    ridge: SpeedRidge
-    times: np.ndarray
-    angle: np.ndarray
-    snr: float
-    speed: np.ndarray
-    wander: float
-    band: float
-
-
 def _ambiguity(ratio: float | None, profile: SpeedProfile) -> str:
     if ratio is None:
         return ""
     return (f", at {profile.coef[0]:.4g} rev/s mid-record, but {ratio:.3g} times that is "
             f"in the speed range too")
-
-
-def _db(snr: float) -> float:
-    return 10.0 * math.log10(snr) if snr > 0 else -math.inf
-
-
-def _inner(times: np.ndarray) -> np.ndarray:
-    """The middle 80 % of the record (the zero-phase filters have both sides there)."""
-    span = times[-1] - times[0]
-    return np.asarray((times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span))
-
-
-def _phase_pass(x: np.ndarray, fs: float, ridge: SpeedRidge, bandwidth: float) -> _Pass:
-    """Phase demodulation around ``ridge`` and how much the phase wanders about it."""
-    import scipy.signal  # lazy: a one-record call need not import it
-    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
-                                         ridge_speed=ridge.speed, bandwidth=bandwidth)
-    band = bandwidth * float(ridge.speed.min())
-    speed = np.gradient(angle, times)
-    # how fast the demodulated phase wanders about the (independent) coarse ridge: a
-    # locked line barely moves, noise in the band sweeps it at ~band / sqrt(3)
-    inner = _inner(times)
-    ridge_at = np.interp(times, ridge.times, ridge.speed)
-    # above band/4 only: slow errors of the coarse ridge are not noise (the phase step
-    # corrects them), while noise's frequency wander lies almost all (98 %) up there
-    diff = ridge.order * (speed - ridge_at)
-    if times.size > 30:
-        fs_d = 1.0 / (times[1] - times[0])
-        hp = scipy.signal.butter(2, band / 4, btype="highpass", fs=fs_d, output="sos")
-        diff = scipy.signal.sosfiltfilt(hp, diff)
-    wander = float(np.std(diff[inner]) / band) if inner.any() else 0.0
-    return _Pass(ridge, times, angle, snr, speed, wander, band)
 
 
 def _ridge_pass(x: np.ndarray, fs: float, ridge_kw: dict[str, Any], window: float,
@@ -342,7 +304,7 @@ def _profile_pass(x: np.ndarray, fs: float, profile: SpeedProfile, bandwidth: fl
 
 def _shaft_angle(result: _Pass, ppr: int, profile: SpeedProfile | None = None
                  ) -> ShaftAngle:
-    sigma_phi = math.sqrt(1.0 / (2.0 * result.snr))
+    sigma_phi = math.sqrt(1.0 / (2.0 * (result.snr_eff or result.snr)))
     order = result.ridge.order
     pulses = angle_pulse_times(result.times, result.angle, pulses_per_rev=ppr)
     return ShaftAngle(times=result.times, angle=result.angle, speed=result.speed,
@@ -386,3 +348,13 @@ def _ratio_checked(x: np.ndarray, fs: float, est: ShaftAngle, kw: dict[str, Any]
         f"{r:.3g} times that, {r * speed:.4g} rev/s, is in the speed range too and puts "
         f"its whole orders on lines better ({other:.1f} against {own:.1f} dB per order in "
         f"the record's order spectrum); give a narrower speed range or the nominal speed")
+
+
+def _own_harmonics(result: _Pass, ridge_kw: dict[str, Any], fs: float) -> list[int]:
+    """Harmonics of the shaft's own mesh to fuse (none where ``track`` names the order)."""
+    if ridge_kw.get("track") is not None:
+        return []
+    own = _orders(ridge_kw["orders"])[0]
+    top = float(result.ridge.speed.max())
+    return [h * own for h in range(1, int(ridge_kw["n_harmonics"]) + 1)
+            if h * own * top < 0.45 * fs]
