@@ -7,7 +7,9 @@ is ``σ_φ / (2π o)`` revolutions with ``σ_φ² = 1 / (2 snr)``, so the harmon
 averaged with weights ``snr · o²`` (inverse variances). A harmonic joins when its in-band
 SNR and wander pass the tracker's thresholds and its angle never leaves the first one's
 by half of its own cycle in the middle 80 % of the record (a slipped cycle, or another
-line in its band, would). On the PHM09 records the transmission error of each harmonic
+line in its band, would); over the first and last 5 % of the record the first harmonic
+alone (the zero-phase filters' edge errors grow with the order), with a half-cosine
+over the next 2.5 %. On the PHM09 records the transmission error of each harmonic
 differs, so their average follows the shaft better than any one of them
 (``benchmarks/RESULTS.md``, issue #24, session 8).
 """
@@ -26,6 +28,7 @@ from .ridge import SpeedRidge
 __all__: list[str] = []
 
 _SLIP = 0.5  # cycles of a harmonic its angle may leave the first one's by (a slip: 1)
+_EDGE = 0.05  # the first harmonic alone over this fraction of the record at either end
 
 
 class _Pass(NamedTuple):
@@ -81,8 +84,9 @@ def _fused(x: np.ndarray, fs: float, first: _Pass, harmonics: list[int], bandwid
     shaft's own mesh) that passes the checks (weights ``snr · o²``)."""
     inner = _inner(first.times)
     base = first.angle - first.angle[0]
-    total = first.snr * first.ridge.order ** 2
-    acc = total * base
+    w0 = first.snr * first.ridge.order ** 2
+    total, acc, gained = np.full(base.size, w0), w0 * base, 0.0
+    taper = _taper(first.times)
     for order in harmonics:
         if order == first.ridge.order:
             continue
@@ -95,10 +99,22 @@ def _fused(x: np.ndarray, fs: float, first: _Pass, harmonics: list[int], bandwid
         if np.max(np.abs(diff[inner])) * order >= _SLIP:
             continue
         w = other.snr * order ** 2
-        acc = acc + w * (other.angle - other.angle[0])
-        total += w
-    if total == first.snr * first.ridge.order ** 2:
+        acc = acc + w * taper * (base + diff)  # its angle, aligned with the first's
+        total = total + w * taper
+        gained += w
+    if gained == 0.0:
         return first
     angle = first.angle[0] + acc / total
     return first._replace(angle=angle, speed=np.gradient(angle, first.times),
-                          snr_eff=total / first.ridge.order ** 2)
+                          snr_eff=(w0 + gained) / first.ridge.order ** 2)
+
+
+def _taper(times: np.ndarray) -> np.ndarray:
+    """0 over the first and last :data:`_EDGE` of the record, 1 from 1.5 ``_EDGE`` on, half a
+    cosine between: the higher harmonics join only where their zero-phase filters have
+    both sides (at the ends their angle errors grow with the order; on a synthetic
+    run-up: 0.5, 1.5, 2.1 degrees at most for harmonics 1, 2, 3)."""
+    span = times[-1] - times[0]
+    u = np.minimum(times - times[0], times[-1] - times) / span  # 0 at the ends, 0.5 mid
+    ramp = np.clip((u - _EDGE) / (0.5 * _EDGE), 0.0, 1.0)
+    return np.asarray(0.5 - 0.5 * np.cos(np.pi * ramp))
