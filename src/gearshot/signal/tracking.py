@@ -22,7 +22,11 @@ harmonic gives the speed; its phase divided by the order gives the shaft angle. 
    tracked harmonic and its analytic signal, expressed at baseband. The unwrapped phase of
    what is left, added to the ridge's phase, is the harmonic's phase; divided by ``2π`` and
    the order it is the shaft angle (revolutions), with the ridge's coarse frequency
-   corrected to within the phase noise.
+   corrected to within the phase noise. Every other harmonic of the shaft's own mesh
+   that passes the same checks is averaged in (weights ``snr · o²``,
+   :mod:`gearshot.signal.harmonic_phase`): each carries its own transmission error.
+   Where a ratio 1/2, 2/3, 3/2 or 2 of the tracked speed also lies in the speed range, the
+   record's whole orders decide between them (:mod:`gearshot.signal.ratio_check`).
    Where the ridge path is refused (a run-up smears the lines over many bins of every
    short window), :func:`gearshot.signal.speed_profile.fit_speed_profile` fits a
    quadratic speed profile to the whole record's order spectrum instead (the coherent
@@ -141,7 +145,11 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
 
     :func:`speed_ridge` finds the speed coarsely from all mesh orders of the shaft;
     :func:`demodulate_angle` refines it on the strongest harmonic along the ridge;
-    :func:`angle_pulse_times` turns the angle into virtual tacho pulses. When that path is
+    :func:`angle_pulse_times` turns the angle into virtual tacho pulses; the other
+    harmonics of the shaft's own mesh that pass the checks are averaged into the angle
+    (unless ``track`` names the order), and where a ratio 1/2 … 2 of the speed is in
+    ``speed_range`` too, the whole-order spectrum decides (a ratio 1.5 times as strong:
+    the ridge again around it; stronger but less: refused). When that path is
     refused, a speed profile fitted to the whole record
     (:func:`gearshot.signal.speed_profile.fit_speed_profile`) is tried before refusing:
     it is taken when at least ``min_lines`` whole orders of the shaft (mesh lines
@@ -197,7 +205,10 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     GearshotError
         No mesh harmonic stands out (in-band SNR below ``min_snr_db`` or a phase that
         wanders like noise, and no whole-record profile either; the message states the
-        SNR, the wander and the profile's strongest line), or bad input.
+        SNR, the wander and the profile's strongest line); or the speed is ambiguous (a
+        ratio of the tracked speed in the range puts its whole orders on lines better,
+        but not 1.5 times as well, or its own ridge fails; the message names both
+        speeds); or bad input.
 
     Examples
     --------
