@@ -22,7 +22,7 @@ __all__ = ["dask_client", "WORKER_MALLOC"]
 #: glibc allocator settings of the LocalCluster's workers (set before they start). Dask's
 #: own ``MALLOC_TRIM_THRESHOLD_=65536`` also pins the mmap threshold at 128 KiB: every
 #: array above it (an SA batch, a spectrum) is then mapped afresh and page-faulted in on
-#: each use, which cost a Sec. 4.1 dataset 1.05 s of CPU instead of 0.48 s with these
+#: each use, which cost a Sec. 4.1 dataset 1.18 s of CPU instead of 0.52 s with these
 #: (benchmarks/RESULTS.md, issue #23 session 8). Arrays up to 32 MiB come from the heap,
 #: and up to 128 MiB of freed heap is kept for reuse.
 WORKER_MALLOC = {"MALLOC_TRIM_THRESHOLD_": 128 << 20, "MALLOC_MMAP_THRESHOLD_": 32 << 20}
