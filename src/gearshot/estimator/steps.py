@@ -28,9 +28,9 @@ from numpy.typing import ArrayLike, NDArray
 from sklearn.utils import check_random_state
 
 from .._errors import GearshotError
-from ..features import extract_features
+from ..features import extract_features, spectrum_features
 from ..signal import mean_rms, subtract_healthy
-from ..transfer import estimate_transfer_function, propagate
+from ..transfer import estimate_transfer_function, propagate, propagate_spectrum
 from .knn import KnnModel, fit_knn
 
 __all__ = [
@@ -336,8 +336,13 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
                        mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True, twins: ArrayLike | None = None,
-                       noise: ArrayLike | None = None) -> FloatArray:
+                       noise: ArrayLike | None = None,
+                       noise_spectrum: ArrayLike | None = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
+
+    Steps 4–6 are linear: they run on the one-sided spectra and the features start from
+    the result (:func:`gearshot.features.spectrum_features`; the time-domain steps' numbers
+    to within rounding, two FFTs per signal fewer).
 
     Parameters
     ----------
@@ -357,6 +362,8 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         Residue added to the difference signals (noise matching: :func:`residue_noise`
         of the target's healthy differences' :func:`residue_power`); with twins the
         simulated differences have no residue of their own.
+    noise_spectrum : ndarray of complex (n_signals, n_points // 2 + 1), optional
+        The same given by its ``rfft`` (one draw added to many sets is transformed once).
 
     Returns
     -------
@@ -365,23 +372,29 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         features).
     """
     healthy = np.asarray(healthy_mask, bool)
+    sim_sa = np.asarray(sim_sa, dtype=float)
+    n = sim_sa.shape[-1]
     if twins is None:
-        sim = propagate_simulated(sim_sa, tf)
+        spec = _propagated_spectrum(sim_sa, tf)
         if rms_normalization:
-            sim = normalize_rms(sim, sim[healthy])
-        sim = suppress_harmonics_simulated(sim, healthy)
-    else:
-        # steps 4-6 are linear in the signals: the twin's difference goes through the TF
-        # once (half the propagation), scaled by the propagated healthy SAs' mean RMS
-        sim = propagate_simulated(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
+            spec /= rms_scale(np.fft.irfft(spec[healthy], n=n, axis=-1))
+        spec = spec - spec[int(np.flatnonzero(healthy)[0])]
+    else:  # the twin's difference through the TF, scaled by the propagated healthy SAs
+        spec = _propagated_spectrum(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
         if rms_normalization:
-            sim = normalize_rms(sim, propagate_simulated(np.asarray(sim_sa)[healthy], tf))
+            spec /= rms_scale(propagate_simulated(sim_sa[healthy], tf))
     if noise is not None:
-        sim = sim + np.asarray(noise, dtype=float)
-    feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
-    return feats
+        spec += np.fft.rfft(np.asarray(noise, dtype=float), axis=-1)
+    if noise_spectrum is not None:
+        spec += np.asarray(noise_spectrum)
+    feats = spectrum_features(spec, n, mesh_order, names=names)
+    return np.asarray(feats - feats[healthy].mean(axis=0), dtype=np.float64)
+
+
+def _propagated_spectrum(sim_sa: FloatArray, tf: ArrayLike | None) -> ComplexArray:
+    """One-sided spectrum of :func:`propagate_simulated` ``(sim_sa, tf)``."""
+    return np.fft.rfft(sim_sa, axis=-1) if tf is None else propagate_spectrum(sim_sa, tf)
 
 
 # ---------------------------------------------------------------- step 8
-# fit_knn and KnnModel (imported above from .knn): K-nearest-neighbour regression, K chosen
-# on one validation split.
+# fit_knn and KnnModel (from .knn): K-nearest-neighbour regression, K on one split.
