@@ -11,6 +11,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+import sklearn
 from numpy.typing import ArrayLike, NDArray
 from sklearn.model_selection import ShuffleSplit
 from sklearn.neighbors import KNeighborsRegressor
@@ -19,6 +20,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
 
 from .._errors import GearshotError
+from .._validation import as_signal_array
 
 __all__ = ["KnnModel", "fit_knn"]
 
@@ -63,6 +65,36 @@ def _knn_pipeline(k: int) -> Pipeline:
                      ("knn", KNeighborsRegressor(n_neighbors=k))])
 
 
+def _validation_neighbours(X_train: FloatArray, y_train: FloatArray, X_val: FloatArray,
+                           k: int) -> NDArray[np.intp]:
+    """Indices of the ``k`` nearest training rows of every validation row, nearest first,
+    after scaling by the training std: what the probe pipeline ``_knn_pipeline(k)`` fitted
+    on the training rows answers, by one brute-force distance matrix instead of a tree.
+
+    The squared distances are summed feature by feature as scikit-learn's trees sum them,
+    so the order is the same; where two of the distances that decide it are equal (a tie
+    the tree may break otherwise), the pipeline itself answers.
+    """
+    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
+        scaler = StandardScaler(with_mean=False).fit(X_train)
+    train, val = X_train / scaler.scale_, X_val / scaler.scale_
+    d2 = np.zeros((val.shape[0], train.shape[0]))
+    for j in range(train.shape[1]):
+        step = val[:, j, None] - train[None, :, j]
+        d2 += step * step
+    nearest = (np.argpartition(d2, k, axis=1)[:, : k + 1] if k < d2.shape[1]
+               else np.broadcast_to(np.arange(d2.shape[1]), d2.shape))
+    near_d2 = np.take_along_axis(d2, nearest, axis=1)
+    order = np.take_along_axis(nearest, np.argsort(near_d2, axis=1), axis=1)
+    ranked = np.take_along_axis(d2, order, axis=1)
+    if np.any(ranked[:, 1:] == ranked[:, :-1]):
+        probe = _knn_pipeline(k).fit(X_train, y_train)
+        _, idx = probe.named_steps["knn"].kneighbors(
+            probe.named_steps["scale"].transform(X_val), n_neighbors=k)
+        return np.asarray(idx, dtype=np.intp)
+    return np.asarray(order[:, :k], dtype=np.intp)
+
+
 def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1, 101),
             validation_fraction: float = 0.3,
             random_state: RandomStateLike = None) -> KnnModel:
@@ -88,8 +120,11 @@ def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1,
     -------
     KnnModel
     """
-    X = np.asarray(X, dtype=float)
-    y = np.asarray(y, dtype=float)
+    X = as_signal_array(X, "X", min_ndim=2, max_ndim=2, max_abs=None)
+    y = as_signal_array(y, "y", max_ndim=1, max_abs=None)
+    if y.shape != X.shape[:1]:
+        raise GearshotError(f"y must hold one label per row of X ({X.shape[0]}); got shape "
+                            f"{y.shape}")
     candidates = np.unique(np.asarray(list(n_neighbors), dtype=int))
     if candidates.size == 0 or candidates[0] < 1:
         raise GearshotError(f"n_neighbors must hold positive integers; got {n_neighbors!r}")
@@ -105,14 +140,13 @@ def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1,
     if candidates.size == 0:
         candidates = np.array([1])
     k_max = int(candidates[-1])
-    probe = _knn_pipeline(k_max).fit(X[train], y[train])
-    scaled = probe.named_steps["scale"].transform(X[val])
-    _, idx = probe.named_steps["knn"].kneighbors(scaled, n_neighbors=k_max)
+    idx = _validation_neighbours(X[train], y[train], X[val], k_max)
     neighbour_y = y[train][idx]  # (n_val, k_max), nearest first
     running_mean = np.cumsum(neighbour_y, axis=1) / np.arange(1, k_max + 1)
     mae_all = np.mean(np.abs(running_mean - y[val][:, None]), axis=0)
     mae = mae_all[candidates - 1]
     best = int(candidates[int(np.argmin(mae))])
     residuals = np.abs(running_mean[:, best - 1] - y[val])
-    final = _knn_pipeline(best).fit(X, y)
+    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
+        final = _knn_pipeline(best).fit(X, y)   # checked above: the checks are not redone
     return KnnModel(final, best, mae_all, residuals, y[val], val)
