@@ -42,6 +42,9 @@ __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features
            "spectrum_features", "na4_baseline_variance"]
 
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
+#: Values per block of signals: the features' temporaries of one block (2 MB each) stay in
+#: the cache and are reused, where whole batches would stream through memory every step.
+_CHUNK_ELEMENTS = 1 << 18
 
 
 def _rms(x: FloatArray) -> FloatArray:
@@ -336,6 +339,13 @@ def _features(sa: FloatArray | None, spectrum: ComplexArray | None, n: int,
     n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n)
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
-    parts = _Parts(sa, orders, n_sidebands, baseline_variance, shafts, spectrum=spectrum,
-                   n_points=n)
-    return np.stack([_REGISTRY[name](parts) for name in wanted], axis=-1)
+    lead = (sa if sa is not None else cast(ComplexArray, spectrum)).shape[:-1]
+    flat_sa = None if sa is None else sa.reshape(-1, n)
+    flat_spec = None if spectrum is None else spectrum.reshape(-1, spectrum.shape[-1])
+    rows, out = max(1, _CHUNK_ELEMENTS // n), []
+    for i in range(0, int(np.prod(lead, dtype=int)), rows):  # row blocks that stay in cache
+        parts = _Parts(None if flat_sa is None else flat_sa[i:i + rows], orders, n_sidebands,
+                       baseline_variance, shafts, n_points=n,
+                       spectrum=None if flat_spec is None else flat_spec[i:i + rows])
+        out.append(np.stack([_REGISTRY[name](parts) for name in wanted], axis=-1))
+    return np.concatenate(out).reshape(lead + (len(wanted),))

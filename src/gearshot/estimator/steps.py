@@ -28,9 +28,10 @@ from numpy.typing import ArrayLike, NDArray
 from sklearn.utils import check_random_state
 
 from .._errors import GearshotError
-from ..features import extract_features, spectrum_features
+from ..features import extract_features
 from ..signal import mean_rms, subtract_healthy
-from ..transfer import estimate_transfer_function, propagate, propagate_spectrum
+from ..transfer import estimate_transfer_function, propagate
+from ._simulated import difference_features
 from .knn import KnnModel, fit_knn
 
 __all__ = [
@@ -373,27 +374,21 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
     """
     healthy = np.asarray(healthy_mask, bool)
     sim_sa = np.asarray(sim_sa, dtype=float)
-    n = sim_sa.shape[-1]
     if twins is None:
-        spec = _propagated_spectrum(sim_sa, tf)
-        if rms_normalization:
-            spec /= rms_scale(np.fft.irfft(spec[healthy], n=n, axis=-1))
-        spec = spec - spec[int(np.flatnonzero(healthy)[0])]
-    else:  # the twin's difference through the TF, scaled by the propagated healthy SAs
-        spec = _propagated_spectrum(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
-        if rms_normalization:
-            spec /= rms_scale(propagate_simulated(sim_sa[healthy], tf))
-    if noise is not None:
-        spec += np.fft.rfft(np.asarray(noise, dtype=float), axis=-1)
-    if noise_spectrum is not None:
-        spec += np.asarray(noise_spectrum)
-    feats = spectrum_features(spec, n, mesh_order, names=names)
+        reference = sim_sa[int(np.flatnonzero(healthy)[0])]
+    else:
+        reference = np.asarray(twins, dtype=float)
+        if reference.shape != sim_sa.shape:
+            raise GearshotError(f"twins must have the shape of the simulated SAs "
+                                f"{sim_sa.shape}; got {reference.shape}")
+    scale = (rms_scale(propagate_simulated(sim_sa[healthy], tf)) if rms_normalization
+             else 1.0)
+    feats = difference_features(
+        sim_sa, reference, None if tf is None else np.asarray(tf), scale,
+        mesh_order=mesh_order, names=names,
+        noise=None if noise is None else np.asarray(noise, dtype=float),
+        noise_spectrum=None if noise_spectrum is None else np.asarray(noise_spectrum))
     return np.asarray(feats - feats[healthy].mean(axis=0), dtype=np.float64)
-
-
-def _propagated_spectrum(sim_sa: FloatArray, tf: ArrayLike | None) -> ComplexArray:
-    """One-sided spectrum of :func:`propagate_simulated` ``(sim_sa, tf)``."""
-    return np.fft.rfft(sim_sa, axis=-1) if tf is None else propagate_spectrum(sim_sa, tf)
 
 
 # ---------------------------------------------------------------- step 8

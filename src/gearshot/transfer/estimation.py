@@ -17,6 +17,7 @@ __all__ = [
     "resample_transfer_function",
     "propagate",
     "propagate_spectrum",
+    "one_sided_response",
     "rms",
     "mean_rms",
     "rms_normalize",
@@ -196,11 +197,38 @@ def propagate_spectrum(signals, tf) -> np.ndarray:
     if tf.shape[-1] != signals.shape[-1]:
         raise GearshotError(
             f"tf has {tf.shape[-1]} points but signals have {signals.shape[-1]} per cycle")
-    # real signals: real(IDFT(tf X)) = IDFT of the Hermitian part of tf X, whose positive
-    # half is X_k (tf_k + conj(tf_{-k})) / 2: one real FFT pair instead of complex ones
-    n = signals.shape[-1]
-    half = 0.5 * (tf + np.conj(tf[(-np.arange(n)) % n]))[: n // 2 + 1]
-    return scipy.fft.rfft(signals, axis=-1) * half
+    return scipy.fft.rfft(signals, axis=-1) * one_sided_response(tf)
+
+
+def one_sided_response(tf) -> np.ndarray:
+    """The factor :func:`propagate` multiplies a real signal's ``rfft`` by.
+
+    A real signal through ``tf`` is ``real(IDFT(tf X))``, the inverse DFT of the Hermitian
+    part of ``tf X``, whose positive half is ``X_k (tf_k + conj(tf_{-k})) / 2``: one real
+    FFT pair instead of complex ones.
+
+    Parameters
+    ----------
+    tf : array_like of complex, shape (n,)
+        Frequency response on the ``n``-point DFT grid.
+
+    Returns
+    -------
+    ndarray of complex, shape (n // 2 + 1,)
+
+    Examples
+    --------
+    A Hermitian response (that of a real impulse response) is its own Hermitian part:
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import one_sided_response
+    >>> tf = np.fft.fft([1.0, 0.5, 0.0, 0.0])
+    >>> print(one_sided_response(tf))
+    [1.5+0.j  1. -0.5j 0.5+0.j ]
+    """
+    tf = as_signal_array(tf, "tf", max_ndim=1, allow_complex=True)
+    n = tf.shape[-1]
+    return 0.5 * (tf + np.conj(tf[(-np.arange(n)) % n]))[: n // 2 + 1]
 
 
 def rms_normalize(signals, reference) -> np.ndarray:
