@@ -15,6 +15,7 @@ from sklearn.base import BaseEstimator
 from .._errors import GearshotError
 from . import steps
 from ._inputs import _FitInputs
+from ._simulated import residue_noise_spectrum
 from ._target import _TargetSide, target_features
 from .calibration import resolve_calibration
 from .knn import KnnModel
@@ -91,9 +92,9 @@ def _matched_noise_spectrum(cache: dict[str, Any], power: FloatArray, n_points: 
                             seed: int, n_signals: int) -> NDArray[np.complex128]:
     """The ``rfft`` of :func:`_matched_noise` (what the grade models add), kept in ``cache``."""
     key = f"noise_spectrum/{n_signals}"
-    if key not in cache:
-        cache[key] = np.fft.rfft(_matched_noise(cache, power, n_points, seed, n_signals),
-                                 axis=-1)
+    if key not in cache:   # the same draw as _matched_noise, as its spectrum
+        rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
+        cache[key] = residue_noise_spectrum(power, n_signals, n_points, rng)
     spectrum: NDArray[np.complex128] = cache[key]
     return spectrum
 

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._errors import GearshotError
 from ..features import spectrum_features
 from ..transfer.estimation import one_sided_response
 
@@ -70,3 +71,17 @@ def difference_features(sim_sa: FloatArray, reference: FloatArray, tf: ArrayLike
             spec += noise_spectrum[block]
         out.append(spectrum_features(spec, n, mesh_order, names=names))
     return np.concatenate(out)
+
+
+def residue_noise_spectrum(power: ArrayLike, n_signals: int, n_points: int,
+                           rng: np.random.Generator) -> ComplexArray:
+    """``rfft`` of Gaussian noise signals whose expected power spectrum is ``power``: white
+    noise shaped in the frequency domain (:func:`gearshot.estimator.steps.residue_noise`
+    is its inverse FFT)."""
+    power = np.asarray(power, dtype=float)
+    if power.shape != (n_points // 2 + 1,):
+        raise GearshotError(f"power must have n_points // 2 + 1 = {n_points // 2 + 1} bins; "
+                            f"got shape {power.shape}")
+    white = rng.standard_normal((n_signals, n_points))
+    return np.asarray(np.fft.rfft(white, axis=-1) * np.sqrt(power / n_points),
+                      dtype=np.complex128)

@@ -31,7 +31,7 @@ from .._errors import GearshotError
 from ..features import extract_features
 from ..signal import mean_rms, subtract_healthy
 from ..transfer import estimate_transfer_function, propagate
-from ._simulated import difference_features
+from ._simulated import difference_features, residue_noise_spectrum
 from .knn import KnnModel, fit_knn
 
 __all__ = [
@@ -280,13 +280,9 @@ def residue_power(differences: ArrayLike) -> FloatArray:
 def residue_noise(power: ArrayLike, n_signals: int, n_points: int,
                   rng: np.random.Generator) -> FloatArray:
     """Gaussian noise signals whose expected power spectrum is ``power``
-    (from :func:`residue_power`): white noise shaped in the frequency domain."""
-    power = np.asarray(power, dtype=float)
-    if power.shape != (n_points // 2 + 1,):
-        raise GearshotError(f"power must have n_points // 2 + 1 = {n_points // 2 + 1} bins; "
-                            f"got shape {power.shape}")
-    white = rng.standard_normal((n_signals, n_points))
-    shaped = np.fft.rfft(white, axis=-1) * np.sqrt(power / n_points)
+    (from :func:`residue_power`): white noise shaped in the frequency domain
+    (:func:`~gearshot.estimator._simulated.residue_noise_spectrum`, inverted)."""
+    shaped = residue_noise_spectrum(power, n_signals, n_points, rng)
     return np.asarray(np.fft.irfft(shaped, n=n_points, axis=-1), dtype=np.float64)
 
 
