@@ -42,9 +42,9 @@ __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features
            "spectrum_features", "na4_baseline_variance"]
 
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
-#: Values per block of signals: the features' temporaries of one block (2 MB each) stay in
+#: Values per block of signals: the features' temporaries of one block (1 MB each) stay in
 #: the cache and are reused, where whole batches would stream through memory every step.
-_CHUNK_ELEMENTS = 1 << 18
+_CHUNK_ELEMENTS = 1 << 17
 
 
 def _rms(x: FloatArray) -> FloatArray:

@@ -56,7 +56,19 @@ class KnnModel:
     validation_indices: NDArray[np.intp]
 
     def predict(self, X: ArrayLike) -> FloatArray:
-        """Fault sizes of feature rows ``X`` (n_samples, n_features)."""
+        """Fault sizes of feature rows ``X`` (n_samples, n_features): the pipeline's
+        prediction (by :func:`_nearest` where the pipeline searches a k-d tree)."""
+        knn, scale = self.pipeline.named_steps["knn"], self.pipeline.named_steps["scale"]
+        rows = np.asarray(X)
+        fit_X, fit_y = getattr(knn, "_fit_X", None), getattr(knn, "_y", None)
+        if (rows.dtype == np.float64 and getattr(knn, "_fit_method", None) == "kd_tree"
+                and fit_X is not None
+                and fit_y is not None and rows.ndim == 2 and np.all(np.isfinite(rows))
+                and rows.shape[1] == fit_X.shape[1] and fit_y.ndim == 1):
+            idx = _nearest(fit_X, rows / scale.scale_, int(knn.n_neighbors))
+            if idx is not None:   # sklearn's mean over the neighbours, as it takes it
+                return np.asarray(np.mean(fit_y.reshape(-1, 1)[idx], axis=1).ravel(),
+                                  dtype=float)
         return np.asarray(self.pipeline.predict(X), dtype=float)
 
 
@@ -65,22 +77,17 @@ def _knn_pipeline(k: int) -> Pipeline:
                      ("knn", KNeighborsRegressor(n_neighbors=k))])
 
 
-def _validation_neighbours(X_train: FloatArray, y_train: FloatArray, X_val: FloatArray,
-                           k: int) -> NDArray[np.intp]:
-    """Indices of the ``k`` nearest training rows of every validation row, nearest first,
-    after scaling by the training std: what the probe pipeline ``_knn_pipeline(k)`` fitted
-    on the training rows answers, by one brute-force distance matrix instead of a tree.
+def _nearest(train: FloatArray, query: FloatArray, k: int) -> NDArray[np.intp] | None:
+    """Indices of the ``k`` nearest ``train`` rows of every ``query`` row, nearest first, or
+    None where two of the distances that decide them are equal.
 
-    The squared distances are summed feature by feature as scikit-learn's trees sum them,
-    so the order is the same; where two of the distances that decide it are equal (a tie
-    the tree may break otherwise), the pipeline itself answers.
+    One brute-force matrix of squared distances, summed feature by feature as
+    scikit-learn's k-d tree sums them: the same order wherever no two distances tie (a
+    tie the tree may break otherwise: the caller asks the tree then).
     """
-    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
-        scaler = StandardScaler(with_mean=False).fit(X_train)
-    train, val = X_train / scaler.scale_, X_val / scaler.scale_
-    d2 = np.zeros((val.shape[0], train.shape[0]))
+    d2 = np.zeros((query.shape[0], train.shape[0]))
     for j in range(train.shape[1]):
-        step = val[:, j, None] - train[None, :, j]
+        step = query[:, j, None] - train[None, :, j]
         d2 += step * step
     nearest = (np.argpartition(d2, k, axis=1)[:, : k + 1] if k < d2.shape[1]
                else np.broadcast_to(np.arange(d2.shape[1]), d2.shape))
@@ -88,11 +95,28 @@ def _validation_neighbours(X_train: FloatArray, y_train: FloatArray, X_val: Floa
     order = np.take_along_axis(nearest, np.argsort(near_d2, axis=1), axis=1)
     ranked = np.take_along_axis(d2, order, axis=1)
     if np.any(ranked[:, 1:] == ranked[:, :-1]):
-        probe = _knn_pipeline(k).fit(X_train, y_train)
-        _, idx = probe.named_steps["knn"].kneighbors(
-            probe.named_steps["scale"].transform(X_val), n_neighbors=k)
-        return np.asarray(idx, dtype=np.intp)
+        return None
     return np.asarray(order[:, :k], dtype=np.intp)
+
+
+def _validation_neighbours(X_train: FloatArray, y_train: FloatArray, X_val: FloatArray,
+                           k: int) -> NDArray[np.intp]:
+    """Indices of the ``k`` nearest training rows of every validation row, nearest first,
+    after scaling by the training std: what the probe pipeline ``_knn_pipeline(k)`` fitted
+    on the training rows answers (:func:`_nearest` where that pipeline searches a k-d
+    tree: fewer than 16 features and ``k`` below half the rows; else the pipeline itself).
+    """
+    idx = None
+    if X_train.shape[1] <= 15 and k < X_train.shape[0] // 2:
+        with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
+            scaler = StandardScaler(with_mean=False).fit(X_train)
+        idx = _nearest(X_train / scaler.scale_, X_val / scaler.scale_, k)
+    if idx is None:
+        probe = _knn_pipeline(k).fit(X_train, y_train)
+        _, found = probe.named_steps["knn"].kneighbors(
+            probe.named_steps["scale"].transform(X_val), n_neighbors=k)
+        idx = np.asarray(found, dtype=np.intp)
+    return idx
 
 
 def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1, 101),
