@@ -172,5 +172,9 @@ def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1,
     best = int(candidates[int(np.argmin(mae))])
     residuals = np.abs(running_mean[:, best - 1] - y[val])
     with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
-        final = _knn_pipeline(best).fit(X, y)   # checked above: the checks are not redone
+        # what _knn_pipeline(best).fit(X, y) fits, step by step (checked above: the
+        # checks are not redone)
+        scaler = StandardScaler(with_mean=False).fit(X)
+        knn = KNeighborsRegressor(n_neighbors=best).fit(X / scaler.scale_, y)
+    final = Pipeline([("scale", scaler), ("knn", knn)])
     return KnnModel(final, best, mae_all, residuals, y[val], val)
