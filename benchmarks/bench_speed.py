@@ -234,9 +234,11 @@ def bench_estimator(args):
             if r:                                   # the first run warms the caches
                 times.append(time.perf_counter() - t0)
                 cpus.append(time.process_time() - c0)
+        ref_c = fft_ref()[1]
         print(f"fit + predict, rig dataset 15 rps / 10 N m, {db.sizes['signal']} SAs "
               f"{'+ twins' if paired else '(unpaired)'}, {ds.test_sa.shape[0]} test SAs: "
               f"median {np.median(times):.3f} s wall, {np.median(cpus):.3f} s CPU "
+              f"= {np.median(cpus) / ref_c:.0f} fft_ref (fft_ref {1e3 * ref_c:.1f} ms CPU) "
               f"(best {min(times):.3f} s); MAE {100 * np.mean(np.abs(pred - ds.test_size)):.2f} "
               f"%; load avg {load_avg()}; {peak_mb()}")
 
