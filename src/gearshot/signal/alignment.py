@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 from typing import Literal, cast, overload
 
 import numpy as np
@@ -12,6 +11,7 @@ from .._errors import GearshotError
 from .._typing import ComplexArray, FloatArray, IntArray
 from .._validation import as_signal_array, check_int, describe, finite_result
 from . import _fft
+from ._lag_search import _LagSearch, contenders, roots
 
 __all__ = ["fractional_shift", "subtract_with_lags", "subtract_healthy"]
 
@@ -81,87 +81,12 @@ def fractional_shift(x: ArrayLike, delay: ArrayLike) -> FloatArray:
     return _fft.ifft(spectrum, axis=-1).real
 
 
-class _LagSearch:
-    """Argmax of a circular cross-correlation on a grid of ``1/upsample`` sample.
-
-    The correlation is band-limited, so its maximum on the fine grid lies next to the
-    maximum of a ×4 over-sampled version: that coarse curve (a short inverse FFT) picks a few
-    candidate peaks, and the fine grid is evaluated only around them (a small matrix
-    product), instead of one inverse FFT of ``n * upsample`` points per pair. The values are
-    those of frequency-domain ×``upsample`` interpolation with the Nyquist bin split evenly
-    (MATLAB ``interpft``), whose first maximum the reference implementation takes.
-    """
-
-    n_candidates = 3
-
-    def __init__(self, n: int, upsample: int):
-        self.n, self.upsample = n, upsample
-        self.coarse = 4 if upsample % 4 == 0 else (2 if upsample % 2 == 0 else 1)
-        self.step = upsample // self.coarse  # fine points per coarse point
-        self.k = np.arange(n // 2 + 1)
-        weights = np.full(self.k.size, 2.0)
-        weights[0] = 1.0
-        if n % 2 == 0:
-            weights[-1] = 0.5  # the two split Nyquist halves multiply to 1/4, twice
-        self.weights = weights
-        offsets = np.arange(-self.step, self.step + 1)
-        # Re(b · exp(iθko)) = Re b · cos θko − Im b · sin θko: cosines are even in the
-        # offset o, sines odd, so the products over o ≥ 0 give every offset
-        phase = np.exp(2j * np.pi * np.outer(self.k, offsets[self.step:]) / (n * upsample))
-        self.cos, self.sin = phase.real.copy(), phase.imag[:, 1:].copy()
-        self.offsets = offsets
-
-    def best(self, cross: ComplexArray) -> IntArray:
-        """Fine-grid index (0 … n·upsample−1) of the first maximum for each row of ``cross``."""
-        n, n_fine = self.n, self.n * self.upsample
-        half = cross[:, : n // 2 + 1] * self.weights
-        padded = np.zeros((cross.shape[0], n * self.coarse // 2 + 1), dtype=complex)
-        padded[:, : half.shape[1]] = half
-        padded[:, 1:] *= 0.5  # irfft doubles these bins itself
-        coarse = np.fft.irfft(padded, n=n * self.coarse, axis=-1)
-        n_cand = min(self.n_candidates, coarse.shape[-1])
-        cand = _top_indices(coarse, n_cand)  # overwrites coarse, not used after
-        centres = cand * self.step  # (rows, n_candidates) on the fine grid
-        # exp(2πi·centre·k/n_fine) = w^(cand·k mod n·coarse), w = exp(2πi/(n·coarse))
-        turns = (cand[:, :, None] * self.k) % (n * self.coarse)
-        base = _roots(n * self.coarse)[turns] * half[:, None, :]
-        even = base.real @ self.cos  # (rows, n_candidates, step + 1): offsets 0 … step
-        odd = base.imag @ self.sin  # offsets 1 … step
-        values = np.concatenate([(even[..., 1:] + odd)[..., ::-1], even[..., :1],
-                                 even[..., 1:] - odd], axis=-1)
-        fine = (centres[:, :, None] + self.offsets) % n_fine
-        values = values.reshape(len(values), -1)
-        fine = fine.reshape(len(fine), -1)
-        top = values == values.max(axis=-1, keepdims=True)
-        return cast(IntArray, np.where(top, fine, n_fine).min(axis=-1))  # first max., as argmax
-
-
-def _top_indices(work: FloatArray, count: int) -> IntArray:
-    """Column indices of the ``count`` largest values of each row, ascending: ``count``
-    row-wise argmax passes (each found maximum masked in place: ``work`` is overwritten),
-    cheaper than ``argpartition``."""
-    rows = np.arange(len(work))
-    found = np.empty((len(work), count), dtype=np.intp)
-    for i in range(count):
-        found[:, i] = np.argmax(work, axis=-1)
-        work[rows, found[:, i]] = -np.inf
-    return cast(IntArray, np.sort(found, axis=-1))
-
-
-@functools.lru_cache(maxsize=8)
-def _roots(m: int) -> ComplexArray:
-    """The ``m`` roots of unity ``exp(2πi·j/m)``, j = 0 … m−1 (a lookup table; read-only)."""
-    table = np.exp(2j * np.pi * np.arange(m) / m)
-    table.flags.writeable = False
-    return cast(ComplexArray, table)
-
-
 def _grid_shift_factors(n: int, steps: IntArray, upsample: int) -> ComplexArray:
     """:func:`_shift_factors` for delays ``steps / upsample`` samples with integer ``steps``:
     ``exp(2πi·k·steps/(n·upsample))`` looked up in a table of the ``n·upsample`` roots of
     unity (the argument reduced exactly; equal to the direct ``exp`` to ~1e-12)."""
     k = np.fft.fftfreq(n, 1.0 / n).astype(np.int64)
-    factors = _roots(n * upsample)[np.multiply.outer(steps, k) % (n * upsample)]
+    factors = roots(n * upsample)[np.multiply.outer(steps, k) % (n * upsample)]
     if n % 2 == 0:
         factors[..., n // 2] = np.cos(np.pi * (steps / upsample))
     return cast(ComplexArray, factors)
@@ -241,7 +166,8 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
     if refs.shape[-1] != n:
         raise GearshotError(
             f"healthy_refs have {refs.shape[-1]} points per cycle but signals have {n}")
-    residual, ref_index, delays, _ = _subtract(signals.reshape(-1, n), refs, upsample)
+    residual, ref_index, delays, _ = _subtract(signals.reshape(-1, n), refs, upsample,
+                                               prune=True)
     residual = residual.reshape(signals.shape)
     if return_details:
         batch_shape = signals.shape[:-1]
@@ -250,11 +176,13 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
 
 
 def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
-              lags: IntArray | None = None
+              lags: IntArray | None = None, *, prune: bool = False
               ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
     """:func:`subtract_healthy` on rows ``flat`` (c, n): residual, chosen reference, its
     delay (samples) and every reference's lag (c, n_refs; 1/upsample samples), found here
-    or given as ``lags``."""
+    or given as ``lags``. With ``prune``, references that cannot be chosen
+    (:func:`~gearshot.signal._lag_search.contenders`) are not searched: their lag is −1
+    (the residual, reference and delay are the same)."""
     n = flat.shape[-1]
     spec_x = _fft.fft(flat, axis=-1)
     spec_r = _fft.fft(refs, axis=-1)
@@ -269,7 +197,7 @@ def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
         part = slice(start, start + chunk)
         (residual[part], ref_index[part], delays[part],
          all_lags[part]) = _best_residuals(spec_x[part], spec_r, search, upsample,
-                                           None if lags is None else lags[part])
+                                           None if lags is None else lags[part], prune)
     return residual, ref_index, delays, all_lags
 
 
@@ -336,24 +264,35 @@ def subtract_with_lags(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample:
 
 
 def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch | None,
-                    upsample: int, steps: IntArray | None = None
+                    upsample: int, steps: IntArray | None = None, prune: bool = False
                     ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
     """For each signal spectrum in ``sx`` (c, n): the residual after subtracting the
     delay-aligned reference that leaves the least energy, that reference's index, its
     delay in samples and every reference's lag (c, n_refs; ``steps`` if given, else found
-    by ``search``)."""
+    by ``search``; with ``prune`` only for the references that may be chosen, −1 for the
+    others)."""
     n, n_refs = sx.shape[-1], spec_r.shape[0]
+    keep = np.ones((len(sx), n_refs), dtype=bool)
     if steps is None:
         assert search is not None
         m = n // 2 + 1  # the lag search reads the non-negative frequencies only
         cross = (sx[:, None, :m] * np.conj(spec_r[:, :m])[None]).reshape(-1, m)
-        steps = search.best(cross).reshape(-1, n_refs)  # delays, 1/upsample samples
-    tau = steps / upsample  # delays, samples
-    advance = _grid_shift_factors(n, steps, upsample)  # (c, n_refs, n)
-    res_spec = sx[:, None, :] * advance - spec_r[None]
-    energy = np.sum(res_spec.real ** 2 + res_spec.imag ** 2, axis=-1)
+        half, curve = search.coarse_curve(cross)
+        first = np.argmax(curve, axis=-1)
+        if prune and n_refs > 1:
+            peak = curve[np.arange(len(curve)), first].reshape(-1, n_refs)
+            keep = contenders(sx, spec_r, peak, search)
+            rows = keep.ravel()
+            half, curve, first = half[rows], curve[rows], first[rows]
+        steps = np.full(keep.shape, -1, dtype=np.int64)
+        steps[keep] = search.fine(half, curve, first)  # delays, 1/upsample samples
+    sig, ref = np.nonzero(keep)  # the pairs searched, by signal then reference
+    advance = _grid_shift_factors(n, steps[sig, ref], upsample)  # (pairs, n)
+    res_spec = sx[sig] * advance - spec_r[ref]
+    energy = np.full(keep.shape, np.inf)
+    energy[sig, ref] = np.sum(res_spec.real ** 2 + res_spec.imag ** 2, axis=-1)
     best = np.argmin(energy, axis=-1)
     rows = np.arange(len(sx))
-    back = res_spec[rows, best] * np.conj(advance[rows, best])
-    return _fft.ifft(back, axis=-1).real, best, tau[rows, best], steps
-
+    pair = np.cumsum(keep.ravel()).reshape(keep.shape)[rows, best] - 1
+    back = res_spec[pair] * np.conj(advance[pair])
+    return _fft.ifft(back, axis=-1).real, best, steps[rows, best] / upsample, steps
