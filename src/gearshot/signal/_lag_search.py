@@ -43,6 +43,7 @@ class _LagSearch:
         phase = np.exp(2j * np.pi * np.outer(self.k, offsets[self.step:]) / (n * upsample))
         self.cos, self.sin = phase.real.copy(), phase.imag[:, 1:].copy()
         self.offsets = offsets
+        self._padded = np.zeros((0, n * self.coarse // 2 + 1), dtype=complex)
 
     def best(self, cross: ComplexArray) -> IntArray:
         """Fine-grid index (0 … n·upsample−1) of the first maximum for each row of ``cross``."""
@@ -55,7 +56,10 @@ class _LagSearch:
         :meth:`fine`'s curve there)."""
         n, m = self.n, self.n // 2 + 1
         half = cross[:, :m] * self.weights
-        padded = np.zeros((cross.shape[0], n * self.coarse // 2 + 1), dtype=complex)
+        width = n * self.coarse // 2 + 1
+        if len(self._padded) < len(cross):  # zero beyond column m, kept between calls
+            self._padded = np.zeros((len(cross), width), dtype=complex)
+        padded = self._padded[: len(cross)]
         padded[:, :m] = half
         padded[:, 1:m] *= 0.5  # irfft doubles these bins itself
         return half, np.fft.irfft(padded, n=n * self.coarse, axis=-1)
