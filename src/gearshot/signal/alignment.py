@@ -282,8 +282,8 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch |
         if prune and n_refs > 1:
             peak = curve[np.arange(len(curve)), first].reshape(-1, n_refs)
             keep = contenders(sx, spec_r, peak, search)
-            rows = keep.ravel()
-            half, curve, first = half[rows], curve[rows], first[rows]
+            searched = keep.ravel()
+            half, curve, first = half[searched], curve[searched], first[searched]
         steps = np.full(keep.shape, -1, dtype=np.int64)
         steps[keep] = search.fine(half, curve, first)  # delays, 1/upsample samples
     sig, ref = np.nonzero(keep)  # the pairs searched, by signal then reference
