@@ -164,7 +164,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                     None if twins is None else twins[grade],
                     None if twins is None else _matched_noise_spectrum(
                         cache, target.residue_power, inputs.n_points, noise_seed,
-                        sa.shape[0]))
+                        sa.shape[0]), cache)
             return models[grade]
 
         def example_features() -> FloatArray:
@@ -178,18 +178,20 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
     def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
                          names: tuple[str, ...], cols: list[int], seed: int,
                          twins: FloatArray | None = None,
-                         noise_spectrum: NDArray[np.complex128] | None = None) -> KnnModel:
+                         noise_spectrum: NDArray[np.complex128] | None = None,
+                         kept: dict[str, Any] | None = None) -> KnnModel:
         """Steps 4–8 for one grade: its simulated features with the target healthy, KNN.
 
         With twins (``simulated_reference="twin"``), step 6 subtracts each signal's twin
-        and the target's residue (``noise_spectrum``: its ``rfft``) is added."""
+        and the target's residue (``noise_spectrum``: its ``rfft``) is added; ``kept``: the
+        fit's cache (the residue-only rows' features, the same in every grade)."""
         sa, y = grade_data
         selected = [names[c] for c in cols]   # the unselected features are not computed
         X_sim = steps.simulated_features(
             sa, y == 0, target.transfer_function, mesh_order=self._mesh_orders(),
             names=selected,
             rms_normalization=self.rms_normalization, twins=twins,
-            noise_spectrum=noise_spectrum)
+            noise_spectrum=noise_spectrum, kept=kept)
         X = np.vstack([X_sim, target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
         opts = self._options()

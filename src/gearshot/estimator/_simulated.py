@@ -11,6 +11,7 @@ temporary in the cache.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -29,7 +30,8 @@ _BLOCK_ELEMENTS = 1 << 17
 def difference_features(sim_sa: FloatArray, reference: FloatArray, tf: ArrayLike | None,
                         scale: float, *, mesh_order: int | Sequence[int],
                         names: Sequence[str], noise: FloatArray | None = None,
-                        noise_spectrum: ComplexArray | None = None) -> FloatArray:
+                        noise_spectrum: ComplexArray | None = None,
+                        rows: NDArray[np.intp] | None = None) -> FloatArray:
     """Features of ``(sim_sa - reference)`` through ``tf``, divided by ``scale``, plus noise.
 
     Parameters
@@ -42,6 +44,8 @@ def difference_features(sim_sa: FloatArray, reference: FloatArray, tf: ArrayLike
         Step 5's scale (1 without it).
     noise, noise_spectrum : ndarray, optional
         Residue added to the differences, as signals or as their ``rfft``.
+    rows : ndarray of int, optional
+        Only these signals (rows of ``sim_sa`` and of the per-signal arrays); default all.
 
     Returns
     -------
@@ -51,14 +55,16 @@ def difference_features(sim_sa: FloatArray, reference: FloatArray, tf: ArrayLike
     n = sim_sa.shape[-1]
     factor: ComplexArray = np.asarray(1.0 / scale if tf is None
                                       else one_sided_response(tf) / scale, dtype=np.complex128)
-    rows = max(1, _BLOCK_ELEMENTS // n)
+    step = max(1, _BLOCK_ELEMENTS // n)
     per_signal = reference.ndim == sim_sa.ndim
     common: ComplexArray = (np.zeros(0, np.complex128) if per_signal
                             else np.fft.rfft(reference, axis=-1) * factor)
-    spec = np.empty(sim_sa.shape[:-1] + (n // 2 + 1,), dtype=np.complex128)
-    for i in range(0, sim_sa.shape[0], rows):
-        block = slice(i, i + rows)
-        out = spec[block]
+    count = sim_sa.shape[0] if rows is None else len(rows)
+    spec = np.empty((count, n // 2 + 1), dtype=np.complex128)
+    for i in range(0, count, step):
+        out = spec[i:i + step]
+        block: slice | NDArray[np.intp] = (slice(i, i + step) if rows is None
+                                           else rows[i:i + step])
         if per_signal:
             np.fft.rfft(sim_sa[block] - reference[block], axis=-1, out=out)
         else:
@@ -85,3 +91,37 @@ def residue_noise_spectrum(power: ArrayLike, n_signals: int, n_points: int,
     white = rng.standard_normal((n_signals, n_points))
     return np.asarray(np.fft.rfft(white, axis=-1) * np.sqrt(power / n_points),
                       dtype=np.complex128)
+
+
+def twin_difference_features(sim_sa: FloatArray, twins: FloatArray, healthy: NDArray[np.bool_],
+                             tf: ArrayLike | None, scale: float, *,
+                             mesh_order: int | Sequence[int], names: Sequence[str],
+                             noise_spectrum: ComplexArray,
+                             kept: dict[str, Any]) -> FloatArray:
+    """:func:`difference_features` with per-signal twins and a residue spectrum, where the
+    healthy rows equal to their twin (a paired database's healthy SAs) take their features
+    from ``kept``.
+
+    Such a row's difference is exactly zero, so its spectrum is the residue's row alone
+    (whatever ``tf`` and ``scale``): its features depend only on the residue draw, the row
+    positions and the features asked for, and a fit's grades (the same draw, the same
+    positions) compute them once. ``kept`` holds them (with the draw, against a reuse
+    with another one); the numbers are those of :func:`difference_features`.
+    """
+    same = healthy.copy()
+    same[healthy] = np.all(sim_sa[healthy] == twins[healthy], axis=-1)
+    if not same.any():
+        return difference_features(sim_sa, twins, tf, scale, mesh_order=mesh_order,
+                                   names=names, noise_spectrum=noise_spectrum)
+    rows = np.flatnonzero(same)
+    key = f"noise-only features/{rows.tobytes().hex()}/{tuple(names)}/{mesh_order}"
+    if key not in kept or kept[key][0] is not noise_spectrum:
+        kept[key] = (noise_spectrum, spectrum_features(noise_spectrum[rows], sim_sa.shape[-1],
+                                                       mesh_order, names=names))
+    feats = np.empty((len(sim_sa), len(names)))
+    feats[rows] = kept[key][1]
+    others = np.flatnonzero(~same)
+    feats[others] = difference_features(sim_sa, twins, tf, scale, mesh_order=mesh_order,
+                                        names=names, noise_spectrum=noise_spectrum,
+                                        rows=others)
+    return feats

@@ -31,7 +31,7 @@ from .._errors import GearshotError
 from ..features import extract_features
 from ..signal import mean_rms, subtract_healthy
 from ..transfer import estimate_transfer_function, propagate
-from ._simulated import difference_features, residue_noise_spectrum
+from ._simulated import difference_features, residue_noise_spectrum, twin_difference_features
 from .knn import KnnModel, fit_knn
 
 __all__ = [
@@ -334,7 +334,8 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
                        mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True, twins: ArrayLike | None = None,
                        noise: ArrayLike | None = None,
-                       noise_spectrum: ArrayLike | None = None) -> FloatArray:
+                       noise_spectrum: ArrayLike | None = None,
+                       kept: dict[str, Any] | None = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
 
     Steps 4–6 are linear: they run on the one-sided spectra and the features start from
@@ -361,6 +362,9 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         simulated differences have no residue of their own.
     noise_spectrum : ndarray of complex (n_signals, n_points // 2 + 1), optional
         The same given by its ``rfft`` (one draw added to many sets is transformed once).
+    kept : dict, optional
+        With twins and ``noise_spectrum``: where the features of healthy rows equal to
+        their twin are kept across sets (:func:`._simulated.twin_difference_features`).
 
     Returns
     -------
@@ -379,11 +383,16 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
                                 f"{sim_sa.shape}; got {reference.shape}")
     scale = (rms_scale(propagate_simulated(sim_sa[healthy], tf)) if rms_normalization
              else 1.0)
-    feats = difference_features(
-        sim_sa, reference, None if tf is None else np.asarray(tf), scale,
-        mesh_order=mesh_order, names=names,
-        noise=None if noise is None else np.asarray(noise, dtype=float),
-        noise_spectrum=None if noise_spectrum is None else np.asarray(noise_spectrum))
+    tf = None if tf is None else np.asarray(tf)
+    if kept is not None and twins is not None and noise_spectrum is not None and noise is None:
+        feats = twin_difference_features(sim_sa, reference, healthy, tf, scale,
+                                         mesh_order=mesh_order, names=names,
+                                         noise_spectrum=np.asarray(noise_spectrum), kept=kept)
+    else:
+        feats = difference_features(
+            sim_sa, reference, tf, scale, mesh_order=mesh_order, names=names,
+            noise=None if noise is None else np.asarray(noise, dtype=float),
+            noise_spectrum=None if noise_spectrum is None else np.asarray(noise_spectrum))
     return np.asarray(feats - feats[healthy].mean(axis=0), dtype=np.float64)
 
 
