@@ -53,8 +53,15 @@ def amplitude_spectrum(x: ArrayLike, *, nfft: int = 2**15) -> FloatArray:
         raise GearshotError(
             f"x has {x.shape[-1]} samples, fewer than one segment of nfft={nfft}")
     segs = x[..., : n_seg * nfft].reshape(*x.shape[:-1], n_seg, nfft)
-    power = np.abs(_fft.fft(segs, axis=-1)) ** 2
-    return cast(FloatArray, np.sqrt(power.sum(axis=-2) / (n_seg * nfft)))
+    if np.iscomplexobj(segs):
+        power = (np.abs(_fft.fft(segs, axis=-1)) ** 2).sum(axis=-2)
+    else:  # |X_{n-k}| = |conj X_k| = |X_k|: the one-sided half, mirrored
+        half = (np.abs(np.fft.rfft(segs, axis=-1)) ** 2).sum(axis=-2)
+        power = np.empty(half.shape[:-1] + (nfft,))
+        k = half.shape[-1]
+        power[..., :k] = half
+        power[..., k:] = half[..., 1:nfft - k + 1][..., ::-1]
+    return cast(FloatArray, np.sqrt(power / (n_seg * nfft)))
 
 
 @finite_result
