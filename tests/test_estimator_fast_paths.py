@@ -194,3 +194,29 @@ def test_fit_knn_refuses_bad_shapes_and_values():
     bad[3, 1] = np.inf
     with pytest.raises(GearshotError, match="X must be finite"):
         steps.fit_knn(bad, np.ones(20))
+
+
+def test_kept_residue_only_rows_give_the_same_features_bit_for_bit(paired):
+    """A paired set's healthy rows equal their twins: their features (the residue's alone)
+    are computed once and reused across sets, with the numbers of the full computation."""
+    sa, twins, y = paired
+    healthy = y == 0
+    assert_array_equal(sa[healthy], twins[healthy])   # the premise: a paired database
+    names = available_features()[:4]
+    rng = np.random.default_rng(7)
+    power = np.abs(np.fft.rfft(rng.normal(size=N))) ** 2 * 1e-4
+    spectra = [np.fft.rfft(steps.residue_noise(power, sa.shape[0], N,
+                                               np.random.default_rng(s))) for s in (1, 2)]
+    kept: dict = {}
+    for tf in (estimator_data.tf_pair()[0], None):   # another TF: another scale
+        for spec in spectra:   # another draw is not served the kept features
+            kw = dict(mesh_order=MESH, names=names, twins=twins, noise_spectrum=spec)
+            want = steps.simulated_features(sa, healthy, tf, **kw)
+            assert_array_equal(steps.simulated_features(sa, healthy, tf, kept=kept, **kw), want)
+    assert len(kept) == 1
+    unequal = twins.copy()
+    unequal[0] += 1e-3   # a healthy row unlike its twin is computed, not looked up
+    kw = dict(mesh_order=MESH, names=names, twins=unequal, noise_spectrum=spectra[0])
+    assert_array_equal(steps.simulated_features(sa, healthy, None, kept=kept, **kw),
+                       steps.simulated_features(sa, healthy, None, **kw))
+    assert len(kept) == 2
