@@ -47,32 +47,31 @@ class _LagSearch:
 
     def best(self, cross: ComplexArray) -> IntArray:
         """Fine-grid index (0 … n·upsample−1) of the first maximum for each row of ``cross``."""
-        half, curve = self.coarse_curve(cross)
-        return self.fine(half, curve, np.argmax(curve, axis=-1))
+        curve = self.coarse_curve(cross)
+        return self.fine(cross, curve, np.argmax(curve, axis=-1))
 
-    def coarse_curve(self, cross: ComplexArray) -> tuple[ComplexArray, FloatArray]:
-        """The weighted half spectra of ``cross`` (rows, ≥ n//2+1) and their correlations
-        on the coarse grid (``n·coarse`` points; ``n·coarse`` times the values of
-        :meth:`fine`'s curve there)."""
+    def coarse_curve(self, cross: ComplexArray) -> FloatArray:
+        """The correlations of the rows of ``cross`` (≥ n//2+1 columns) on the coarse grid
+        (``n·coarse`` points; ``n·coarse`` times the values of :meth:`fine`'s curve)."""
         n, m = self.n, self.n // 2 + 1
-        half = cross[:, :m] * self.weights
         width = n * self.coarse // 2 + 1
         if len(self._padded) < len(cross):  # zero beyond column m, kept between calls
             self._padded = np.zeros((len(cross), width), dtype=complex)
         padded = self._padded[: len(cross)]
-        padded[:, :m] = half
+        np.multiply(cross[:, :m], self.weights, out=padded[:, :m])
         padded[:, 1:m] *= 0.5  # irfft doubles these bins itself
-        return half, np.fft.irfft(padded, n=n * self.coarse, axis=-1)
+        return np.fft.irfft(padded, n=n * self.coarse, axis=-1)
 
-    def fine(self, half: ComplexArray, curve: FloatArray, first: IntArray) -> IntArray:
-        """:meth:`best` from :meth:`coarse_curve`'s output (``curve`` is overwritten) and
-        the curve's row-wise argmax ``first``."""
+    def fine(self, cross: ComplexArray, curve: FloatArray, first: IntArray) -> IntArray:
+        """:meth:`best` from :meth:`coarse_curve`'s ``curve`` of the same rows of ``cross``
+        (overwritten) and its row-wise argmax ``first``."""
         n, n_fine = self.n, self.n * self.upsample
         n_cand = min(self.n_candidates, curve.shape[-1])
         cand = _top_indices(curve, n_cand, first)
         centres = cand * self.step  # (rows, n_candidates) on the fine grid
         # exp(2πi·centre·k/n_fine) = w^(cand·k mod n·coarse), w = exp(2πi/(n·coarse))
         turns = (cand[:, :, None] * self.k) % (n * self.coarse)
+        half = cross[:, : n // 2 + 1] * self.weights
         base = roots(n * self.coarse)[turns] * half[:, None, :]
         even = base.real @ self.cos  # (rows, n_candidates, step + 1): offsets 0 … step
         odd = base.imag @ self.sin  # offsets 1 … step

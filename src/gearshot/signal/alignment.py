@@ -277,15 +277,15 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch |
         assert search is not None
         m = n // 2 + 1  # the lag search reads the non-negative frequencies only
         cross = (sx[:, None, :m] * np.conj(spec_r[:, :m])[None]).reshape(-1, m)
-        half, curve = search.coarse_curve(cross)
+        curve = search.coarse_curve(cross)
         first = np.argmax(curve, axis=-1)
         if prune and n_refs > 1:
             peak = curve[np.arange(len(curve)), first].reshape(-1, n_refs)
             keep = contenders(sx, spec_r, peak, search)
             searched = keep.ravel()
-            half, curve, first = half[searched], curve[searched], first[searched]
+            cross, curve, first = cross[searched], curve[searched], first[searched]
         steps = np.full(keep.shape, -1, dtype=np.int64)
-        steps[keep] = search.fine(half, curve, first)  # delays, 1/upsample samples
+        steps[keep] = search.fine(cross, curve, first)  # delays, 1/upsample samples
     sig, ref = np.nonzero(keep)  # the pairs searched, by signal then reference
     advance = _grid_shift_factors(n, steps[sig, ref], upsample)  # (pairs, n)
     res_spec = sx[sig] * advance - spec_r[ref]
