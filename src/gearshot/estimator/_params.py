@@ -132,8 +132,10 @@ class IntegerSequence(Constraint):
     def accepts(self, value: Any) -> bool:
         if not _is_collection(value):
             return False
-        items = list(value)
         item = Interval(int, self.low, self.high)
+        if isinstance(value, range):  # integers: in [low, high] when its ends are
+            return len(value) > 0 and item.accepts(min(value)) and item.accepts(max(value))
+        items = list(value)
         return bool(items) and all(item.accepts(v) for v in items)
 
     def __str__(self) -> str:
