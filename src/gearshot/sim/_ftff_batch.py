@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 
 import numba as nb
 import numpy as np
@@ -111,7 +112,7 @@ def _retreat(pair: GearPair, u, r, ang):
                     pair.center_distance, rb1, ra1)
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, nogil=True, parallel=True)
 def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot.
 
@@ -211,7 +212,7 @@ def _interp_walk(x, xp, fp, j):
     return slope * (x - xp[j]) + fp[j], j
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, nogil=True, parallel=True)
 def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab,
                E, G, L):
     """Bending + shear + axial compliance: the Simpson sums of ``_tooth_compliance``
@@ -257,6 +258,7 @@ def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs
 _RETREAT_CHUNK = 8          # faults per numpy evaluation of the bridge (memory bound)
 _CACHE: dict = {}           # (pair, fault) -> (k, ef), insertion-ordered
 _CACHE_SIZE = 4096
+_LOCK = threading.Lock()     # guards _CACHE
 
 
 def ftff_tables(pair: GearPair, faults):
@@ -301,7 +303,7 @@ def _interp_point(x, xp, fp, lo, hi):
     return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _segment_points(knots, contact, s0s, s1s, s, g_lo, g_hi, n_seg):
     """The smooth segments of every fault's compliance (``stiffness._segments`` between
     the cut's start, load switch, end and the tip) and the gear roll (m) at their
@@ -350,7 +352,7 @@ def _in_segment(x, a, b):
     return x >= a and (x <= b if b == 1.0 else x < b)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _holds_point(s, a, b):
     for x in s:
         if _in_segment(x, a, b):
@@ -358,7 +360,7 @@ def _holds_point(s, a, b):
     return False
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s, trans):
     """The faulty gear tooth's compliance ``inv`` (interpolated from each segment's
     points, healthy elsewhere) and the displacement excitation ``ef``
@@ -379,14 +381,19 @@ def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s,
 
 def ftff_cached(pair: GearPair, faults):
     """``[(k, ef), ...]`` of non-healthy FTFFs (read-only arrays), the missing ones
-    computed in one :func:`ftff_tables` call and kept (the last 4096)."""
-    missing = [f for f in dict.fromkeys(faults) if (pair, f) not in _CACHE]
+    computed in one :func:`ftff_tables` call and kept (the last 4096). Safe to call from
+    several threads (an in-process build runs blocks side by side)."""
+    with _LOCK:
+        found = {f: _CACHE.get((pair, f)) for f in dict.fromkeys(faults)}
+    missing = [f for f, v in found.items() if v is None]
     if missing:
         k, ef = ftff_tables(pair, missing)
         for f, kr, er in zip(missing, k, ef, strict=True):
             kr.setflags(write=False)
             er.setflags(write=False)
-            _CACHE[(pair, f)] = (kr, er)
-        while len(_CACHE) > _CACHE_SIZE:
-            del _CACHE[next(iter(_CACHE))]
-    return [_CACHE[(pair, f)] for f in faults]
+            found[f] = (kr, er)
+        with _LOCK:
+            _CACHE.update(((pair, f), found[f]) for f in missing)
+            while len(_CACHE) > _CACHE_SIZE:
+                del _CACHE[next(iter(_CACHE))]
+    return [found[f] for f in faults]
