@@ -75,5 +75,5 @@ def run_blocks(build: Callable[..., object], tasks: Sequence[tuple], n_threads: 
                     for other in pending:
                         other.cancel()
                     wait(pending)
-                    raise fut.exception()
+                    fut.result()             # raises the failure
                 done()

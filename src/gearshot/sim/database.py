@@ -34,7 +34,7 @@ import shutil
 import sys
 import time
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -328,8 +328,9 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     code = fault_type_record(fault_type).code
     n = n_healthy + n_faulty
     sizes, sig_seeds = block_draws(seed, i, j, k, code, n_healthy, n_faulty)
-    kw = dict(speed=speed, load=load, grade=grade, fault_sizes=sizes, n_points=n_points,
-              rng=[int(s) for s in sig_seeds], fault_type=fault_type)
+    kw: dict[str, Any] = dict(speed=speed, load=load, grade=grade, fault_sizes=sizes,
+                              n_points=n_points, rng=[int(s) for s in sig_seeds],
+                              fault_type=fault_type)
     sa, twins = simulate_sa_paired(pair, **kw) if paired else (simulate_sa(pair, **kw), None)
     data = {"sa": (("signal", "angle"), sa,
                    {"units": "g", "long_name": "vertical acceleration SA"})}
