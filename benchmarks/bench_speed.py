@@ -151,6 +151,7 @@ def bench_machine(args):
                   f"thread: {wall:.1f} s wall (+ {start:.1f} s cluster start), workers' CPU "
                   f"{workers_cpu:.1f} s (/2 = {workers_cpu / 2:.1f} s on 2 free cores); load "
                   f"avg before {l0}, after {load_avg()}; {peak_mb()}")
+    print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
 def bench_condition(args):
@@ -163,7 +164,7 @@ def bench_condition(args):
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), None,
                                          paired=paired, **kw)
             print(f"one condition (15 rps, 10 N m) x 12 grades x 800 "
-                  f"{'+ twins' if paired else '(unpaired)'}, in-process (2 numba threads): "
+                  f"{'+ twins' if paired else '(unpaired)'}, in-process (client=None): "
                   f"{wall:.1f} s wall, {cpu:.1f} s CPU; load avg before {l0}, after "
                   f"{load_avg()}; {peak_mb()}")
         k0 = children_cpu()
@@ -179,6 +180,7 @@ def bench_condition(args):
               f"{wall:.1f} s wall, workers' CPU {workers_cpu:.1f} s (/2 = "
               f"{workers_cpu / 2:.1f} s on 2 free cores); load avg before {l0}, after "
               f"{load_avg()}; {peak_mb()}")
+    print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
 def bench_scheduler(args):
@@ -197,12 +199,12 @@ def bench_scheduler(args):
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
             wall = time.perf_counter() - t0
-        print(f"gearshot simulate --paired --scheduler {cluster.scheduler_address} (a "
-              f"LocalCluster of 2 x 1 thread started apart), one condition x 12 grades x "
-              f"800 + twins: {wall:.1f} s wall incl. the CLI's start; load avg before {l0}, "
-              f"after {load_avg()}")
     finally:
         cluster.close()
+    print(f"gearshot simulate --paired --scheduler ADDRESS (a LocalCluster of 2 x 1 thread "
+          f"started apart), one condition x 12 grades x 800 + twins: {wall:.1f} s wall "
+          f"incl. the CLI's start; load avg before {l0}, after {load_avg()}; {peak_mb()} "
+          f"(children: the CLI and, once closed, the workers)")
 
 
 def bench_estimator(args):
@@ -314,10 +316,13 @@ def bench_breakdown(args):
     import numba
 
     import gearshot.sim._system as system
+    import gearshot.sim.database as database
     import gearshot.sim.dynamics as dyn
     from gearshot.sim import GearPair, build_database
 
     numba.set_num_threads(1)
+    if hasattr(database, "block_threads"):        # blocks one after another, timed apart
+        database.block_threads = lambda n: 1
     acc: dict = {}
 
     def wrap(owner, name, key):
@@ -353,6 +358,7 @@ def bench_breakdown(args):
     for key, v in sorted(acc.items(), key=lambda kv: -kv[1]):
         print(f"  {key:28s} {v:6.2f} s  {100 * v / total:5.1f} %")
     print(f"  {'rest (zarr, checksums, ...)':28s} {total - sum(acc.values()):6.2f} s")
+    print(f"  {peak_mb()}")
 
 
 def main():
