@@ -13,7 +13,8 @@
 Prints numbers (no asserts). The box is shared, so every timing is printed with the load
 average and, for the simulator, as a ratio to a fixed numpy FFT workload timed in the same
 run (``fft_ref``: 10 real FFTs of a 64 x 8192 array, best of 3, one thread). Peak memory:
-the process's maximum resident set (and its child processes', e.g. Dask workers).
+the process's maximum resident set, its largest finished child process's (e.g. the CLI of
+``scheduler``) and, where a Dask cluster runs, its largest worker's (asked before closing).
 """
 
 from __future__ import annotations
@@ -44,6 +45,19 @@ def peak_mb() -> str:
     own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     return f"peak RSS {own:.0f} MB (largest child process {kids:.0f} MB)"
+
+
+def _own_peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def workers_peak(client) -> str:
+    """The largest peak RSS of the client's workers (asked before the cluster closes)."""
+    try:
+        peaks = client.run(_own_peak_mb).values()
+    except Exception as exc:                    # a worker gone: say so, keep the timing
+        return f"workers' peak RSS unknown ({type(exc).__name__})"
+    return f"largest worker's peak RSS {max(peaks):.0f} MB"
 
 
 def fft_ref() -> tuple[float, float]:
@@ -142,6 +156,7 @@ def bench_machine(args):
             try:
                 wall, cpu, l0 = _timed_build(Path(tmp) / "db", pair, client, paired=paired,
                                              **kw)
+                wpeak = workers_peak(client)
             finally:
                 client.close()
                 cluster.close()
@@ -150,7 +165,7 @@ def bench_machine(args):
                   f"{'+ twins' if paired else '(unpaired)'} = {n} signals, LocalCluster 2 x 1 "
                   f"thread: {wall:.1f} s wall (+ {start:.1f} s cluster start), workers' CPU "
                   f"{workers_cpu:.1f} s (/2 = {workers_cpu / 2:.1f} s on 2 free cores); load "
-                  f"avg before {l0}, after {load_avg()}; {peak_mb()}")
+                  f"avg before {l0}, after {load_avg()}; {peak_mb()}; {wpeak}")
     print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
@@ -172,6 +187,7 @@ def bench_condition(args):
         try:
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), client,
                                          paired=True, **kw)
+            wpeak = workers_peak(client)
         finally:
             client.close()
             cluster.close()
@@ -179,13 +195,13 @@ def bench_condition(args):
         print(f"  + twins on a LocalCluster (2 x 1 thread, started before timing): "
               f"{wall:.1f} s wall, workers' CPU {workers_cpu:.1f} s (/2 = "
               f"{workers_cpu / 2:.1f} s on 2 free cores); load avg before {l0}, after "
-              f"{load_avg()}; {peak_mb()}")
+              f"{load_avg()}; {peak_mb()}; {wpeak}")
     print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
 def bench_scheduler(args):
     """``gearshot simulate --scheduler ADDRESS`` against a cluster started apart."""
-    from dask.distributed import LocalCluster
+    from dask.distributed import Client, LocalCluster
 
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                            dashboard_address=":0")
@@ -199,12 +215,14 @@ def bench_scheduler(args):
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
             wall = time.perf_counter() - t0
+        with Client(cluster) as client:
+            wpeak = workers_peak(client)
     finally:
         cluster.close()
     print(f"gearshot simulate --paired --scheduler ADDRESS (a LocalCluster of 2 x 1 thread "
           f"started apart), one condition x 12 grades x 800 + twins: {wall:.1f} s wall "
           f"incl. the CLI's start; load avg before {l0}, after {load_avg()}; {peak_mb()} "
-          f"(children: the CLI and, once closed, the workers)")
+          f"(largest child: the CLI); {wpeak}")
 
 
 def bench_estimator(args):

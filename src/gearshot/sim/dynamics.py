@@ -33,6 +33,7 @@ from ._inputs import (
     resolve_faults,
 )
 from ._system import integrator, make_batch, system_matrices, warmup_time
+from .faults import ToothFault
 from .geometry import GearPair
 
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
@@ -138,7 +139,7 @@ def simulate_sa_paired(pair: GearPair, *, speed: float, load: float, grade: int,
     twins = np.array(sa, dtype=np.float64, copy=True)
     faulty = np.flatnonzero(sizes > 0)
     if faulty.size:
-        healthy = resolve_faults(np.zeros(faulty.size), None, 0.5, 0.5, "ftff")
+        healthy = [ToothFault()] * faulty.size      # what a size-0 fault of any type is
         twins[faulty] = run.sas(healthy, [ge[i] for i in faulty], [pe[i] for i in faulty])
     return sa, twins
 
