@@ -13,8 +13,9 @@
 Prints numbers (no asserts). The box is shared, so every timing is printed with the load
 average and, for the simulator, as a ratio to a fixed numpy FFT workload timed in the same
 run (``fft_ref``: 10 real FFTs of a 64 x 8192 array, best of 3, one thread). Peak memory:
-the process's maximum resident set, its largest finished child process's (e.g. the CLI of
-``scheduler``) and, where a Dask cluster runs, its largest worker's (asked before closing).
+the process's maximum resident set, its largest finished child process's (an upper bound:
+a child started after the driver grew reports at least the driver's size then) and, where
+a Dask cluster runs, its largest worker's own peak (VmHWM, asked before closing).
 """
 
 from __future__ import annotations
@@ -48,11 +49,20 @@ def peak_mb() -> str:
 
 
 def _own_peak_mb() -> float:
+    """This process's peak resident set (VmHWM), MB. Not ``ru_maxrss``: a spawned
+    process's ``ru_maxrss`` keeps the parent's resident set at the fork (Linux carries it
+    over ``exec``), so a Dask worker started after an in-process build would report the
+    builder's peak."""
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def workers_peak(client) -> str:
-    """The largest peak RSS of the client's workers (asked before the cluster closes)."""
+    """The largest peak RSS of the client's workers (asked before the cluster closes;
+    their own, see :func:`_own_peak_mb`)."""
     try:
         peaks = client.run(_own_peak_mb).values()
     except Exception as exc:                    # a worker gone: say so, keep the timing
