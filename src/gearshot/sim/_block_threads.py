@@ -55,8 +55,9 @@ def block_threads(n_blocks: int) -> int:
 def run_blocks(build: Callable[..., object], tasks: Sequence[tuple], n_threads: int,
                done: Callable[[], None]) -> None:
     """``build(*task)`` for every task on ``n_threads`` threads (each with one numba
-    thread), ``done()`` after each; the first failure cancels the blocks not started
-    and is raised once the running ones have finished (their temporaries removed)."""
+    thread), ``done()`` after each; a failure cancels the blocks not started and, once
+    the running ones have finished (their temporaries removed), the failure of the
+    first failed task in task order is raised."""
 
     def one(task):
         nb.set_num_threads(1)        # thread-local: the caller's setting is kept
@@ -67,13 +68,17 @@ def run_blocks(build: Callable[..., object], tasks: Sequence[tuple], n_threads: 
     # threaded BLAS under the other's products (their sums would change in the last bits)
     with threadpool_limits(1, user_api="blas"), ThreadPoolExecutor(
             max_workers=n_threads, thread_name_prefix="gearshot-block") as pool:
-        pending = {pool.submit(one, t) for t in tasks}
+        futures = [pool.submit(one, t) for t in tasks]
+        pending = set(futures)
         while pending:
             finished, pending = wait(pending, return_when=FIRST_EXCEPTION)
-            for fut in finished:
-                if fut.exception() is not None:
-                    for other in pending:
-                        other.cancel()
-                    wait(pending)
-                    fut.result()             # raises the failure
+            if any(f.exception() is not None for f in finished):
+                for other in pending:
+                    other.cancel()
+                wait(pending)
+                break
+            for _ in finished:
                 done()
+    for fut in futures:      # the first failed block in task order (as one by one)
+        if not fut.cancelled() and fut.exception() is not None:
+            fut.result()
