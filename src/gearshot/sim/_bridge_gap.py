@@ -87,18 +87,22 @@ def _gap_bound(cth, sth, rk, o2x, rb1, pp, lo2, hi2, circ, half, marg):
     return t - half - marg
 
 
+@nb.njit(cache=True, inline="always")
+def _search_setup(cc, r, rb1, ra1):
+    """Sizes, outputs, the base circle's circumference and half of it, and the pinion
+    flank's radius range (its ends count within a relative 1e-12)."""
+    n, n_u = cc.shape
+    circ = 2.0 * math.pi * rb1
+    return (n, n_u, r.shape[1], np.empty((n, n_u)), np.empty((n, n_u)), circ,
+            math.pi * rb1, rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12))
+
+
 @nb.njit(cache=True, nogil=True, parallel=True)
 def min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot
     (``cc, sc``: cos/sin of the knot's rotation ``centre``; ``ca, sa``: of the points'
     angles ``ang``); equal to :func:`min_gap_plain`."""
-    n, n_u = cc.shape
-    n_pts = r.shape[1]
-    ret = np.empty((n, n_u))
-    rad = np.empty((n, n_u))
-    circ = 2.0 * math.pi * rb1
-    half = math.pi * rb1
-    lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
+    n, n_u, n_pts, ret, rad, circ, half, lo_r, hi_r = _search_setup(cc, r, rb1, ra1)
     lo2, hi2 = (lo_r * (1.0 - 1e-9)) ** 2, (hi_r * (1.0 + 1e-9)) ** 2   # surely outside
     marg = rb1 * _ANGLE_MARGIN + 1e-9 * circ
     for f in nb.prange(n):
@@ -147,13 +151,7 @@ def min_gap_plain(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
     ``sqrt(1 - c^2) / c``, c = rb1/|P|; the gap is wrapped to one base pitch circle as in
     :meth:`FullToothFaceFault._retreat` (equal up to rounding). Points on the pinion's
     flank ends (base and tip circle) count within a relative 1e-12."""
-    n, n_u = cc.shape
-    n_pts = r.shape[1]
-    ret = np.empty((n, n_u))
-    rad = np.empty((n, n_u))
-    circ = 2.0 * math.pi * rb1
-    half = math.pi * rb1
-    lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
+    n, n_u, n_pts, ret, rad, circ, half, lo_r, hi_r = _search_setup(cc, r, rb1, ra1)
     for fm in nb.prange(n * n_u):          # every knot of every fault on its own
         f, m = fm // n_u, fm % n_u
         best = np.inf
