@@ -232,7 +232,7 @@ def bench_scheduler(args):
     print(f"gearshot simulate --paired --scheduler ADDRESS (a LocalCluster of 2 x 1 thread "
           f"started apart), one condition x 12 grades x 800 + twins: {wall:.1f} s wall "
           f"incl. the CLI's start; load avg before {l0}, after {load_avg()}; {peak_mb()} "
-          f"(largest child: the CLI); {wpeak}")
+          f"(children: the CLI and the closed workers); {wpeak}")
 
 
 def bench_estimator(args):
