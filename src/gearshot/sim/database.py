@@ -20,8 +20,8 @@ than the FTFF, ``code`` the type's fixed code in :mod:`gearshot.fault_registry`)
 signal's from the block's, so contents do not depend on order or interruption. A build of
 FTFFs only keeps the layout and manifest of stores built before fault types existed.
 
-The pieces: this module builds (:func:`build_database`, one block per task, in-process or
-on a Dask client); :mod:`._db_manifest` writes, checks and restores the manifest;
+The pieces: this module builds (:func:`build_database`, one block per task, in-process
+(:mod:`._block_threads`: one block per core side by side) or on a Dask client); :mod:`._db_manifest` writes, checks and restores the manifest;
 :mod:`._db_checksums` writes and checks each block's record; :mod:`._db_load` loads a
 condition (:func:`load_database`); :mod:`._integrity` holds the store's lock and the
 blocks' draws; :mod:`._block_read` reads a block once, checked.
