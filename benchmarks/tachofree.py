@@ -90,15 +90,19 @@ def part_a(data: Path, files: list[Path], *, nominal_prior: bool = False
         rv = Recording.read(path, machine=mv, metadata=meta)
         recs[path.name] = (rt, rv, mt, mv)
         shaft = "input" if kind == "spur" else "idler"
+        c0 = time.process_time()
         try:
             est = rv.vibration_angle()
         except GearshotError as exc:
             msg = str(exc)
-            rows.append({"file": path.name,
+            rows.append({"file": path.name, "path": "refused",
+                         "cpu_s": time.process_time() - c0,
                          "refused": msg[msg.find("order "):msg.find("; the speed")]})
             continue
+        cpu = time.process_time() - c0
         sp_t, sp_v = rt.shaft_speed(), rv.shaft_speed()
-        row = {"file": path.name, "order": est.order, "snr_db": est.snr_db,
+        row = {"file": path.name, "path": "ridge" if est.profile is None else "profile",
+               "cpu_s": cpu, "order": est.order, "snr_db": est.snr_db,
                "speed_tacho": sp_t, "speed_vib": sp_v,
                "speed_err_pct": 100 * (sp_v / sp_t - 1),
                "speed_std_hz": est.speed_std, "refused": ""}
@@ -334,7 +338,7 @@ def main() -> None:
     a2.to_csv(args.out / "tachofree_phm09_nominal.csv", index=False, float_format="%.6g")
     ok2 = a2.dropna(subset=["speed_err_pct"])
     print("A2. the same with the nominal speed ±10 % as the search range (no range_hz)\n"
-          + markdown(a2[[c for c in a2.columns if c in ("file", "order", "snr_db",
+          + markdown(a2[[c for c in a2.columns if c in ("file", "path", "cpu_s", "order", "snr_db",
                                                           "speed_err_pct", "refused",
                                                           "sa_diff_acc_input",
                                                           "angle_diff_rms_deg")]]) + "\n")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import subprocess
 import sys
 from fractions import Fraction
@@ -300,7 +301,7 @@ def test_a_machine_less_run_up_gives_gear_cycles_from_the_vibration():
 # --------------------------------------------------------------------------- PHM09
 @needs_phm09
 @pytest.mark.parametrize("name", ["spur2_30hz_High_1", "spur3_40hz_Low_1",
-                                  "helical2_40hz_High_1"])
+                                  "helical2_40hz_High_1", "spur2_40hz_High_1"])
 def test_phm09_speed_from_the_vibration_within_0p2_percent_of_the_tacho(name):
     kind = "spur" if name.startswith("spur") else "helical"
     path = PHM09 / f"{name}.zip"
@@ -374,3 +375,141 @@ def test_phm09_predict_segments_say_where_the_speed_came_from():
         assert info["speed_source"] == source and sa.shape == (11, 2048)
         assert (info["speed_uncertainty_hz"] is None) == (source == "tacho")
         assert speed == pytest.approx(29.92, rel=0.002)
+
+
+# ------------------------------------------------- session 8: ratio locks, cheap search
+def test_the_comb_search_finds_the_same_maximum_as_scoring_every_speed():
+    """Branch and bound over cells of candidate speeds: the same best score and the same
+    (first) speed as the exact comb of every candidate."""
+    from gearshot.signal import speed_profile as sp
+    rng = np.random.default_rng(24)
+    for trial in range(6):
+        level = 20.0 * rng.random(40_000) ** 6 + rng.normal(0, 2, 40_000)
+        level[rng.integers(0, 40_000, 300)] += 25.0  # lines
+        lines = np.array([17.0, 34.0, 51.0]) if trial % 2 else np.array([16.0, 32.0, 48.0])
+        df = 0.05
+        speeds = np.arange(10.0, 19.0, df / lines.max())
+        best, k = sp._comb(level, df, lines, speeds, float(lines.max()) * 10.0)
+        gain = np.clip(level - sp._FLOOR_DB, 0.0, sp._CAP_DB).astype(np.float32)
+        gain = np.maximum(gain[:-1], gain[1:])
+        orders = np.arange(1.0, max(lines.max(), lines.max() * 10.0 / speeds.min()) + 1.0)
+        n_kept = np.minimum(np.floor(lines.max() * 10.0 / speeds).astype(np.int64),
+                            orders.size)
+        every = sp._comb_rows(gain, speeds.astype(np.float32), (orders / df).astype(np.float32),
+                              np.isin(orders, lines), n_kept)
+        assert best == every.max() and k == int(np.argmax(every))
+
+
+@needs_phm09
+def test_phm09_the_ridges_3_2_lock_on_the_helical_train_is_detected():
+    """helical1 30 Hz Low with the machine range [26, 52]: the mesh comb locks at 1.5 times
+    the speed (order 16 of 44.15 rev/s = order 24 of 29.43, a second-stage harmonic). The
+    whole orders of 2/3 of that speed stand out twice as much: the tracker follows that
+    speed (within 0.2 % of the tacho); without the switch it refuses naming both."""
+    from gearshot.signal import tracking
+    from gearshot.signal.ratio_check import whole_order_scores
+
+    path = PHM09 / "helical1_30hz_Low_1.zip"
+    rt = Recording.read(path, machine=MACHINES / "phm09_helical.toml")
+    rv = Recording.read(path, machine=MACHINES / "phm09_helical_notacho.toml")
+    x = rv.acceleration[0]
+    assert rv.shaft_speed() == pytest.approx(rt.shaft_speed(), rel=0.002)
+    wrong = estimate_shaft_angle(x, rv.fs, orders=[16, 8], speed_range=(40, 48),
+                                 bandwidth=0.1)
+    assert wrong.mean_speed == pytest.approx(1.5 * rt.shaft_speed(), rel=0.002)
+    s = whole_order_scores(x, rv.fs, wrong.times, wrong.angle, ratios=(1.0, 2 / 3),
+                           top_order=32)
+    assert s[2 / 3] > 1.5 * s[1.0]
+    right = estimate_shaft_angle(x, rv.fs, orders=[16, 8], speed_range=(26, 33),
+                                 bandwidth=0.1)
+    s = whole_order_scores(x, rv.fs, right.times, right.angle, ratios=(1.0, 1.5),
+                           top_order=32)
+    assert s[1.5] < 0.7 * s[1.0]
+    old = tracking._RATIO_SWITCH
+    tracking._RATIO_SWITCH = math.inf
+    try:
+        with pytest.raises(GearshotError, match=r"speed is ambiguous.*locks at 44\.1\d rev/s"
+                                                r".*0\.667 times that, 29\.4\d rev/s") as info:
+            estimate_shaft_angle(x, rv.fs, orders=[16, 8], speed_range=(26, 52),
+                                 bandwidth=0.1)
+    finally:
+        tracking._RATIO_SWITCH = old
+    assert "\n" not in str(info.value)
+
+
+@needs_phm09
+def test_phm09_a_ridge_refusal_is_tracked_by_the_profile_with_the_nominal_speed():
+    """spur2 40 Hz Low: the ridge path is refused; with the nominal speed (±10 %) the
+    whole-record profile tracks it within 0.2 % of the tacho; with the machine range
+    [26, 52] the profile locks at 2/3 of the speed (the idler's harmonics are whole
+    orders of it), 1.5 times that is in the range too, and it is refused."""
+    path = PHM09 / "spur2_40hz_Low_1.zip"
+    rt = Recording.read(path, machine=MACHINES / "phm09_spur.toml")
+    rv = Recording.read(path, machine=MACHINES / "phm09_spur_notacho.toml")
+    nominal = Recording.read(path, machine=dataclasses.replace(
+        rv.machine, vibration_speed=dataclasses.replace(rv.machine.vibration_speed,
+                                                        speed_range=None)),
+        metadata={"speed": 40})
+    est = nominal.vibration_angle()
+    assert est.profile is not None
+    assert nominal.shaft_speed() == pytest.approx(rt.shaft_speed(), rel=0.002)
+    with pytest.raises(GearshotError, match=r"at 26\.\d+ rev/s mid-record, but 1\.5 times "
+                                              r"that is in the speed range too"):
+        rv.vibration_angle()
+
+
+def _fusion_signal(drift_cycles=0.0, seed=4):
+    """Three harmonics of a 16-tooth mesh at 20 rev/s, each with its own slow phase
+    error (transmission error differs per harmonic), white noise; the third harmonic's
+    line optionally drifting ``drift_cycles`` over the record (another line, a slip)."""
+    fs, s = 20_000.0, 20.0
+    t = np.arange(int(4 * fs)) / fs
+    rng = np.random.default_rng(seed)
+    x = 0.3 * rng.standard_normal(t.size)
+    slow = np.arange(1, 9) / 4.0  # 0.25 ... 2 Hz: inside the band (0.25 orders, 5 Hz)
+    for h in (1, 2, 3):
+        e = np.cos(2 * np.pi * np.outer(t, slow) + rng.uniform(0, 2 * np.pi, slow.size))
+        e = e @ rng.standard_normal(slow.size)
+        e *= 0.002 / np.std(e)  # 0.7 degrees of shaft angle, RMS
+        drift = drift_cycles * t / t[-1] if h == 3 else 0.0
+        x += np.cos(2 * np.pi * (h * 16 * (s * t + e) + drift) + h)
+    return x, fs, s * t
+
+
+def _angle_error_deg(est, truth_rate):
+    inner = (est.times > 0.4) & (est.times < 3.6)
+    err = est.angle[inner] - truth_rate * est.times[inner]
+    return float(np.std(err - err.mean()) * 360)
+
+
+def test_the_angle_fuses_the_meshs_harmonics_and_leaves_out_a_slipping_one():
+    """Each harmonic's phase carries its own error: their inverse-variance average is
+    closer to the shaft than one harmonic (``track`` keeps one); a harmonic whose line
+    drifts away by cycles is left out rather than averaged in."""
+    x, fs, _ = _fusion_signal()
+    one = estimate_shaft_angle(x, fs, orders=[16], speed_range=(15, 25), track=16)
+    fused = estimate_shaft_angle(x, fs, orders=[16], speed_range=(15, 25))
+    e1, ef = _angle_error_deg(one, 20.0), _angle_error_deg(fused, 20.0)
+    assert 0.3 < e1 < 1.5 and ef < 0.85 * e1
+    assert fused.angle_std < one.angle_std  # the stated uncertainty follows
+    x, fs, _ = _fusion_signal(drift_cycles=3.0)
+    slipping = estimate_shaft_angle(x, fs, orders=[16], speed_range=(15, 25))
+    # in: the 3rd harmonic would pull the angle by up to 3/48 rev (22 degrees)
+    assert _angle_error_deg(slipping, 20.0) < 1.2 * e1
+
+
+@needs_phm09
+def test_phm09_fused_harmonics_bring_the_helical_sa_near_the_tacho_sa():
+    """helical1 40 Hz Low (SNR 22 dB): the idler SA from the vibration angle within 8 % RMS
+    of the tacho-based SA (fused harmonics: 5.2 %; one harmonic: 14 %; the tacho's own
+    angle low-passed to the tracker's band: 0.7 %)."""
+    from gearshot.signal import fractional_shift
+
+    path = PHM09 / "helical1_40hz_Low_1.zip"
+    rt = Recording.read(path, machine=MACHINES / "phm09_helical.toml")
+    rv = Recording.read(path, machine=MACHINES / "phm09_helical_notacho.toml")
+    a = rt.to_sa_segments(shaft="idler", sensor="acc_input", cycles_per_segment=None)[0]
+    b = rv.to_sa_segments(shaft="idler", sensor="acc_input", cycles_per_segment=None)[0]
+    c = np.fft.irfft(np.fft.rfft(a) * np.conj(np.fft.rfft(b)), n=16 * a.size)
+    e = fractional_shift(b, np.argmax(c) / 16.0) - a
+    assert np.sqrt(np.mean(e ** 2) / np.mean(a ** 2)) < 0.08

@@ -24,6 +24,7 @@ A line's level is its power over the local floor (a running median of the spectr
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -42,7 +43,8 @@ _SHAFT_WEIGHT = 0.5  # a whole order that is no mesh line counts half (f / j fit
 _RATIOS = (1 / 2, 2 / 3, 3 / 2, 2)  # speed ratios a comb of whole orders cannot tell
 _RATES = 160  # rates searched on the first span at most
 _KEEP = 6  # rate candidates carried from one stage to the next
-_PEAKS = 16  # mesh-comb peaks rescored with every whole order
+_KEEP_LAST = 3  # ... into the whole record's stage (the half record has sorted them)
+_CELL = 16  # neighbouring candidate speeds bounded together by the comb's search
 _MEDIAN_BINS = 129  # local floor: running median over this many spectrum bins
 
 
@@ -107,16 +109,31 @@ def _decimated(x: np.ndarray, fs: float, top: float) -> tuple[np.ndarray, float]
     return scipy.signal.resample_poly(x - x.mean(), 1, down), fs / down
 
 
-def _spectrum(y: np.ndarray, dt: float, u: np.ndarray, shape: tuple[float, float]
-              ) -> tuple[np.ndarray, float]:
+@functools.lru_cache(maxsize=8)
+def _hann(n: int) -> np.ndarray:
+    """``numpy.hanning(n)``, kept: the rate search reads hundreds of spectra of one length."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
+
+
+def _spectrum(y: np.ndarray, dt: float, u: np.ndarray, shape: tuple[float, float],
+              search: bool = False) -> tuple[np.ndarray, float]:
     """Power spectrum of ``y`` (sampled at ``u``) resampled at equal steps of the angle of
-    the unit-speed profile ``1 + r u + p u^2``; returns (power, bin width in orders × c)."""
+    the unit-speed profile ``1 + r u + p u^2``; returns (power, bin width in orders × c).
+    ``search``: single precision and a fast FFT length about twice the samples (the rate
+    search reads hundreds of these; the final line levels use a power of two)."""
+    import scipy.fft
     r, p = shape
     phi = _angle(u, (1.0, r, p))
     rel = 1.0 + r * u + p * u * u
     step = dt * float(rel.min())
     grid = np.arange(phi[0], phi[-1], step)
-    z = np.interp(grid, phi, y) * np.hanning(grid.size)
+    z = np.interp(grid, phi, y) * _hann(grid.size)
+    if search:
+        n = scipy.fft.next_fast_len(2 * grid.size, real=True)
+        spec = scipy.fft.rfft(z.astype(np.float32), n)
+        return np.asarray(spec.real ** 2 + spec.imag ** 2), 1.0 / (n * step)
     n = 1 << int(math.ceil(math.log2(2 * grid.size)))
     return np.abs(np.fft.rfft(z, n)) ** 2, 1.0 / (n * step)
 
@@ -128,31 +145,65 @@ def _levels(power: np.ndarray) -> np.ndarray:
     blocks = power[: nb * _MEDIAN_BINS].reshape(nb, -1)
     centres = (np.arange(nb) + 0.5) * blocks.shape[1]
     floor = np.interp(np.arange(power.size), centres, np.median(blocks, axis=1))
+    if power.dtype == np.float32:
+        tiny = np.float32(1e-30)
+        return np.asarray(10.0 * np.log10(power / (floor.astype(np.float32) + tiny) + tiny))
     return np.asarray(10.0 * np.log10(power / (floor + 1e-300) + 1e-30))
 
 
+def _comb_rows(gain: np.ndarray, rows: np.ndarray, per_bin: np.ndarray, mesh: np.ndarray,
+               n_kept: np.ndarray) -> np.ndarray:
+    """The comb score of the speeds ``rows`` (float32) as :func:`_comb` defines it."""
+    g = gain[np.minimum(np.outer(rows, per_bin).astype(np.int32), gain.size - 1)]
+    shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
+    kept = shaft[np.arange(rows.size), np.maximum(n_kept - 1, 0)]
+    return np.asarray(g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept > 0, kept, 0.0))
+
+
 def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
-          top_hz: float) -> np.ndarray:
-    """Comb score of every candidate speed: the levels above the floor summed over the
-    mesh ``lines`` and, at half weight, every other whole order below ``top_hz`` (Hz, the
-    same for every candidate, so that twice the speed, which meets only the even orders,
-    loses; half weight, since some whole order ``j`` meets any line at the speed
-    ``f / j``)."""
+          top_hz: float) -> tuple[float, int]:
+    """Best comb score over the candidate speeds and its index (the first of equals). The
+    score sums the levels above the floor over the mesh ``lines`` and, at half weight,
+    every other whole order below ``top_hz`` (Hz, the same for every candidate, so that
+    twice the speed, which meets only the even orders, loses; half weight, since some
+    whole order ``j`` meets any line at the speed ``f / j``).
+
+    Branch and bound: for cells of :data:`_CELL` neighbouring speeds an upper bound (each
+    order's largest gain over the bins the cell's speeds reach, every order the cell's
+    slowest speed keeps) orders the cells; exact scores are computed cell by cell until
+    no bound is above the best — the same maximum as scoring every speed."""
+    import scipy.ndimage
     gain = np.clip(level - _FLOOR_DB, 0.0, _CAP_DB).astype(np.float32)
     gain = np.maximum(gain[:-1], gain[1:])  # the line between two bins: the larger
     orders = np.arange(1.0, max(float(lines.max()), top_hz / float(speeds.min())) + 1.0)
     mesh = np.isin(orders, lines)
     per_bin = (orders / df).astype(np.float32)
     n_kept = np.minimum(np.floor(top_hz / speeds).astype(np.int64), orders.size)
-    score = np.zeros(speeds.size)
-    for chunk in np.array_split(np.arange(speeds.size), max(1, speeds.size // 2048)):
-        g = gain[np.minimum(np.outer(speeds[chunk].astype(np.float32), per_bin)
-                            .astype(np.int32), gain.size - 1)]
-        shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
-        kept = shaft[np.arange(chunk.size), np.maximum(n_kept[chunk] - 1, 0)]
-        score[chunk] = g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept[chunk] > 0,
-                                                                          kept, 0.0)
-    return score
+    sf = speeds.astype(np.float32)
+    starts = np.arange(0, speeds.size, _CELL)
+    ends = np.minimum(starts + _CELL, speeds.size) - 1
+    width = int(float(np.max(sf[ends] - sf[starts])) * float(per_bin[-1])) + 3
+    pooled = scipy.ndimage.maximum_filter1d(gain, width, mode="nearest")
+    first = np.minimum(np.outer(sf[starts], per_bin).astype(np.int64) + width // 2,
+                       gain.size - 1)
+    g = pooled[first]
+    shaft = np.cumsum(np.where(mesh, np.float32(0.0), g), axis=1, dtype=np.float32)
+    kept = shaft[np.arange(starts.size), np.maximum(n_kept[starts] - 1, 0)]
+    bound = (g[:, mesh].sum(axis=1) + _SHAFT_WEIGHT * np.where(n_kept[starts] > 0, kept, 0.0))
+    bound = bound * (1.0 + 1e-5) + 1e-3  # float32 sums in another order
+    best, best_k = -np.inf, 0
+    order = np.argsort(-bound, kind="stable")
+    for g0 in range(0, order.size, 8):
+        cells = order[g0: g0 + 8]
+        if bound[cells[0]] < best:
+            break
+        idx = np.concatenate([np.arange(starts[c], ends[c] + 1) for c in cells])
+        score = _comb_rows(gain, sf[idx], per_bin, mesh, n_kept[idx])
+        top = float(score.max())
+        k = int(idx[score == top].min())
+        if top > best or (top == best and k < best_k):
+            best, best_k = top, k
+    return best, best_k
 
 
 def _stage(y: np.ndarray, dt: float, u: np.ndarray, lines: np.ndarray, lo: float, hi: float,
@@ -166,37 +217,40 @@ def _stage(y: np.ndarray, dt: float, u: np.ndarray, lines: np.ndarray, lo: float
     c_mid = 0.5 * (lo + hi)
     out = []
     for a in rates:
-        power, df = _spectrum(y, dt, u, (a / c_mid, 0.0))
-        level = _levels(power)
+        power, df = _spectrum(y, dt, u, (a / c_mid, 0.0), search=True)
+        # the comb reads no bin above the top line at the top speed
+        level = _levels(power[: int(float(lines.max()) * hi / df) + _MEDIAN_BINS])
         speeds = np.arange(lo, hi, df / float(lines.max()))
-        score = _comb(level, df, lines, speeds, float(lines.max()) * lo)
-        k = int(np.argmax(score))
-        out.append((float(score[k]), float(speeds[k]), float(a)))  # a: the shape a / c_mid
+        score, k = _comb(level, df, lines, speeds, float(lines.max()) * lo)
+        out.append((score, float(speeds[k]), float(a)))  # a: the shape a / c_mid
     return out
 
 
 def _search(y: np.ndarray, fs: float, lines: np.ndarray, lo: float, hi: float,
             max_rate: float) -> tuple[float, float]:
-    """Coarse-to-fine (c, a) on the middle quarter, half and whole record."""
+    """Coarse-to-fine (c, a) on the middle quarter (twice: the capped grid of rates, then
+    the step the quarter resolves), half and whole record."""
     n = y.size
     t = np.arange(n) / fs
     mid = 0.5 * t[-1]
     top = float(lines.max())
     best: list[tuple[float, float, float]] = []
     prev = 0.0
-    for frac in (0.25, 0.5, 1.0):
+    for frac in (0.25, 0.25, 0.5, 1.0):  # the quarter twice: coarse rates, then its own
         half = 0.5 * frac * t[-1]
         sel = np.abs(t - mid) <= half
         step = 0.5 / (top * half * half)
         if not best:  # at most _RATES rates on the first span (the later ones refine)
             step = max(step, 2.0 * max_rate / _RATES)
             rates = np.arange(-max_rate, max_rate + 0.5 * step, step)
+        elif prev <= step:
+            continue  # the first grid was already as fine as this span resolves
         else:
             k = max(1, int(math.ceil(prev / step)))
             rates = np.unique(np.concatenate([a + step * np.arange(-k, k + 1)
                                               for _, _, a in best]))
         found = _stage(y[sel], 1.0 / fs, t[sel] - mid, lines, lo, hi, rates)
-        best = sorted(found, reverse=True)[:_KEEP]
+        best = sorted(found, reverse=True)[:_KEEP if frac < 0.5 else _KEEP_LAST]
         prev = step
     c = best[0][1]
     return c, best[0][2] * c / (0.5 * (lo + hi))  # the grid's rate is for the shape a / c_mid
@@ -285,6 +339,15 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     >>> print(f"{c:.2f} rev/s at mid-record, {a:.2f} rev/s per s;", p.n_lines, "lines")
     14.00 rev/s at mid-record, 1.00 rev/s per s; 2 lines
     """
+    return _fit(x, fs, orders, speed_range, n_harmonics, max_rate)
+
+
+def _fit(x: np.ndarray, fs: float, orders: object, speed_range: object, n_harmonics: int,
+         max_rate: float | None, guard: bool = False) -> SpeedProfile:
+    """:func:`fit_speed_profile`; ``guard``: return the unrefined profile of the rate
+    search where a ratio of it (1/2 … 2) lies well inside ``speed_range`` (1 % from its
+    ends): the tracker refuses such a profile, and the refinement (Nelder–Mead) moves
+    the speed by far less than that."""
     x = as_signal_array(x, "x", max_ndim=1, min_length=64)
     fs = check_positive(fs, "fs")
     order_list = _orders(orders)
@@ -303,6 +366,10 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
     top_hz = float(lines.max()) * (hi + max_rate * duration / 2)
     y, fs_d = _decimated(x, fs, top_hz)
     c, a = _search(y, fs_d, lines, lo, hi, max_rate)
+    if guard:
+        coarse = _profile(y, fs_d, lines, (c, a, 0.0))
+        if coarse.ambiguous((1.01 * lo, 0.99 * hi), duration) is not None:
+            return coarse
     level = _line_levels(y, fs_d, (c, a, 0.0), lines)
     strong = lines[np.argsort(-level)[:3]]
     chain = (c, a, 0.0)
@@ -311,6 +378,12 @@ def fit_speed_profile(x: np.ndarray, fs: float, *, orders: object,
         chain = _refine(y[m0: y.size - m0], fs_d, chain, strong)
     direct = _refine(y, fs_d, (c, a, 0.0), strong)  # a short span may mislead the chain
     coef = max((direct, chain), key=lambda k: float(_line_levels(y, fs_d, k, strong).sum()))
+    return _profile(y, fs_d, lines, coef)
+
+
+def _profile(y: np.ndarray, fs_d: float, lines: np.ndarray,
+             coef: tuple[float, float, float]) -> SpeedProfile:
+    """The :class:`SpeedProfile` of ``coef``: its lines' levels and whole orders counted."""
     level = _line_levels(y, fs_d, coef, lines)
     whole = np.arange(1.0, float(lines.max()) + 1.0)
     n_lines = int(np.sum(_line_levels(y, fs_d, coef, whole) >= _LINE_DB))

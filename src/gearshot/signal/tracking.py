@@ -22,7 +22,11 @@ harmonic gives the speed; its phase divided by the order gives the shaft angle. 
    tracked harmonic and its analytic signal, expressed at baseband. The unwrapped phase of
    what is left, added to the ridge's phase, is the harmonic's phase; divided by ``2π`` and
    the order it is the shaft angle (revolutions), with the ridge's coarse frequency
-   corrected to within the phase noise.
+   corrected to within the phase noise. Every other harmonic of the shaft's own mesh
+   that passes the same checks is averaged in (weights ``snr · o²``,
+   :mod:`gearshot.signal.harmonic_phase`): each carries its own transmission error.
+   Where a ratio 1/2, 2/3, 3/2 or 2 of the tracked speed also lies in the speed range, the
+   record's whole orders decide between them (:mod:`gearshot.signal.ratio_check`).
    Where the ridge path is refused (a run-up smears the lines over many bins of every
    short window), :func:`gearshot.signal.speed_profile.fit_speed_profile` fits a
    quadratic speed profile to the whole record's order spectrum instead (the coherent
@@ -48,15 +52,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
-from .ridge import SpeedRidge, _speed_range, speed_ridge
-from .speed_profile import SpeedProfile, fit_speed_profile
+from .harmonic_phase import _db, _fused, _inner, _Pass, _phase_pass
+from .ratio_check import RATIOS, whole_order_scores
+from .ridge import SpeedRidge, _orders, _speed_range, speed_ridge
+from .speed_profile import SpeedProfile, _fit
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
            "estimate_shaft_angle", "MIN_SNR_DB", "MAX_WANDER", "MIN_LINES"]
@@ -69,6 +75,8 @@ MAX_WANDER = 0.3
 MIN_LINES = 2  # comb lines that must stand out: one lone line may be any tone
 _SETTLED = 0.1  # wander below which a shorter STFT window is not tried
 _AUTO_WINDOWS = (0.125, 0.5)  # s: shortest and default STFT window of the automatic choice
+_RATIO_SWITCH = 1.5  # another ratio's whole orders this much stronger: track it instead
+_RATIO_RANGE = 0.1  # ... within this fraction of it
 
 
 @dataclass(frozen=True)
@@ -137,7 +145,11 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
 
     :func:`speed_ridge` finds the speed coarsely from all mesh orders of the shaft;
     :func:`demodulate_angle` refines it on the strongest harmonic along the ridge;
-    :func:`angle_pulse_times` turns the angle into virtual tacho pulses. When that path is
+    :func:`angle_pulse_times` turns the angle into virtual tacho pulses; the other
+    harmonics of the shaft's own mesh that pass the checks are averaged into the angle
+    (unless ``track`` names the order), and where a ratio 1/2 … 2 of the speed is in
+    ``speed_range`` too, the whole-order spectrum decides (a ratio 1.5 times as strong:
+    the ridge again around it; stronger but less: refused). When that path is
     refused, a speed profile fitted to the whole record
     (:func:`gearshot.signal.speed_profile.fit_speed_profile`) is tried before refusing:
     it is taken when at least ``min_lines`` whole orders of the shaft (mesh lines
@@ -193,7 +205,10 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     GearshotError
         No mesh harmonic stands out (in-band SNR below ``min_snr_db`` or a phase that
         wanders like noise, and no whole-record profile either; the message states the
-        SNR, the wander and the profile's strongest line), or bad input.
+        SNR, the wander and the profile's strongest line); or the speed is ambiguous (a
+        ratio of the tracked speed in the range puts its whole orders on lines better,
+        but not 1.5 times as well, or its own ridge fails; the message names both
+        speeds); or bad input.
 
     Examples
     --------
@@ -228,15 +243,22 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
     snr_db = _db(result.snr)
     if snr_db >= min_snr_db and result.wander <= max_wander and \
             result.ridge.n_lines >= min_lines:
-        return _shaft_angle(result, ppr)
-    profile = fit_speed_profile(x, fs, orders=orders, speed_range=speed_range,
-                                max_rate=max_rate)
+        kw = dict(ridge_kw, window=window, bandwidth=bandwidth, min_snr_db=min_snr_db,
+                  max_wander=max_wander, min_lines=min_lines, pulses_per_rev=ppr, label=label)
+        result = _fused(x, fs, result, _own_harmonics(result, ridge_kw, fs), bandwidth,
+                        min_snr_db, max_wander)
+        return _ratio_checked(x, fs, _shaft_angle(result, ppr), kw)
+    # the whole-record profile (unrefined where a ratio of it is in the range: refused)
+    profile = _fit(x, fs, orders, speed_range, 5, max_rate, guard=True)
     ratio = profile.ambiguous(_speed_range(speed_range), x.size / fs)
     if profile.n_lines >= max(min_lines, 1) and ratio is None:
         fine = _profile_pass(x, fs, profile, bandwidth, track)
         if not (_db(fine.snr) >= min_snr_db and fine.wander <= max_wander):
             fine = fine._replace(angle=profile.angle(fine.times),
                                  speed=profile.speed(fine.times))
+        else:
+            fine = _fused(x, fs, fine, _own_harmonics(fine, ridge_kw, fs), bandwidth,
+                          min_snr_db, max_wander)
         return _shaft_angle(fine, ppr, profile)
     ridge = result.ridge
     raise GearshotError(
@@ -251,55 +273,11 @@ def estimate_shaft_angle(x: np.ndarray, fs: float, *, orders: object, speed_rang
         f"the vibration (give a tacho, another sensor or a narrower speed range)")
 
 
-class _Pass(NamedTuple):
-    """One ridge (or profile) + phase pass of :func:`estimate_shaft_angle`."""
-
-    ridge: SpeedRidge
-    times: np.ndarray
-    angle: np.ndarray
-    snr: float
-    speed: np.ndarray
-    wander: float
-    band: float
-
-
 def _ambiguity(ratio: float | None, profile: SpeedProfile) -> str:
     if ratio is None:
         return ""
     return (f", at {profile.coef[0]:.4g} rev/s mid-record, but {ratio:.3g} times that is "
             f"in the speed range too")
-
-
-def _db(snr: float) -> float:
-    return 10.0 * math.log10(snr) if snr > 0 else -math.inf
-
-
-def _inner(times: np.ndarray) -> np.ndarray:
-    """The middle 80 % of the record (the zero-phase filters have both sides there)."""
-    span = times[-1] - times[0]
-    return np.asarray((times > times[0] + 0.1 * span) & (times < times[-1] - 0.1 * span))
-
-
-def _phase_pass(x: np.ndarray, fs: float, ridge: SpeedRidge, bandwidth: float) -> _Pass:
-    """Phase demodulation around ``ridge`` and how much the phase wanders about it."""
-    import scipy.signal  # lazy: a one-record call need not import it
-    times, angle, snr = demodulate_angle(x, fs, order=ridge.order, ridge_times=ridge.times,
-                                         ridge_speed=ridge.speed, bandwidth=bandwidth)
-    band = bandwidth * float(ridge.speed.min())
-    speed = np.gradient(angle, times)
-    # how fast the demodulated phase wanders about the (independent) coarse ridge: a
-    # locked line barely moves, noise in the band sweeps it at ~band / sqrt(3)
-    inner = _inner(times)
-    ridge_at = np.interp(times, ridge.times, ridge.speed)
-    # above band/4 only: slow errors of the coarse ridge are not noise (the phase step
-    # corrects them), while noise's frequency wander lies almost all (98 %) up there
-    diff = ridge.order * (speed - ridge_at)
-    if times.size > 30:
-        fs_d = 1.0 / (times[1] - times[0])
-        hp = scipy.signal.butter(2, band / 4, btype="highpass", fs=fs_d, output="sos")
-        diff = scipy.signal.sosfiltfilt(hp, diff)
-    wander = float(np.std(diff[inner]) / band) if inner.any() else 0.0
-    return _Pass(ridge, times, angle, snr, speed, wander, band)
 
 
 def _ridge_pass(x: np.ndarray, fs: float, ridge_kw: dict[str, Any], window: float,
@@ -337,7 +315,7 @@ def _profile_pass(x: np.ndarray, fs: float, profile: SpeedProfile, bandwidth: fl
 
 def _shaft_angle(result: _Pass, ppr: int, profile: SpeedProfile | None = None
                  ) -> ShaftAngle:
-    sigma_phi = math.sqrt(1.0 / (2.0 * result.snr))
+    sigma_phi = math.sqrt(1.0 / (2.0 * (result.snr_eff or result.snr)))
     order = result.ridge.order
     pulses = angle_pulse_times(result.times, result.angle, pulses_per_rev=ppr)
     return ShaftAngle(times=result.times, angle=result.angle, speed=result.speed,
@@ -346,3 +324,48 @@ def _shaft_angle(result: _Pass, ppr: int, profile: SpeedProfile | None = None
                       angle_std=sigma_phi / (2 * np.pi * order), wander=result.wander,
                       pulse_times=pulses, pulses_per_rev=ppr, ridge=result.ridge,
                       profile=profile)
+
+
+def _ratio_checked(x: np.ndarray, fs: float, est: ShaftAngle, kw: dict[str, Any]
+                   ) -> ShaftAngle:
+    """``est``, unless a ratio 1/2, 2/3, 3/2 or 2 of its speed also lies in the speed range
+    and puts its whole orders on lines better (:mod:`gearshot.signal.ratio_check`): then
+    the ridge again within 10 % of that speed where the evidence is clear (its whole
+    orders :data:`_RATIO_SWITCH` times as strong) and that ridge passes every check, else
+    a refusal naming both speeds."""
+    lo, hi = _speed_range(kw["speed_range"])
+    slow, fast = float(est.ridge.speed.min()), float(est.ridge.speed.max())
+    alts = tuple(r for r in RATIOS if lo <= r * slow and r * fast <= hi)
+    if not alts:
+        return est
+    top = 2.0 * float(est.order if kw.get("track") is not None else _orders(kw["orders"])[0])
+    scores = whole_order_scores(x, fs, est.times, est.angle, ratios=(1.0, *alts),
+                                top_order=top)
+    r = max(alts, key=lambda k: scores[k])
+    own, other = scores[1.0], scores[r]
+    if other <= own:
+        return est
+    speed = est.mean_speed
+    if other >= _RATIO_SWITCH * own:
+        narrow = (max(lo, (1.0 - _RATIO_RANGE) * r * speed),
+                  min(hi, (1.0 + _RATIO_RANGE) * r * speed))
+        try:
+            return estimate_shaft_angle(x, fs, **dict(kw, speed_range=narrow))
+        except GearshotError:
+            pass
+    raise GearshotError(
+        f"the speed is ambiguous in {kw['label']}: the mesh comb locks at {speed:.4g} rev/s "
+        f"(order {est.order}, {est.snr_db:.1f} dB above the noise in its band), but "
+        f"{r:.3g} times that, {r * speed:.4g} rev/s, is in the speed range too and puts "
+        f"its whole orders on lines better ({other:.1f} against {own:.1f} dB per order in "
+        f"the record's order spectrum); give a narrower speed range or the nominal speed")
+
+
+def _own_harmonics(result: _Pass, ridge_kw: dict[str, Any], fs: float) -> list[int]:
+    """Harmonics of the shaft's own mesh to fuse (none where ``track`` names the order)."""
+    if ridge_kw.get("track") is not None:
+        return []
+    own = _orders(ridge_kw["orders"])[0]
+    top = float(result.ridge.speed.max())
+    return [h * own for h in range(1, int(ridge_kw["n_harmonics"]) + 1)
+            if h * own * top < 0.45 * fs]
