@@ -21,10 +21,11 @@ signal's from the block's, so contents do not depend on order or interruption. A
 FTFFs only keeps the layout and manifest of stores built before fault types existed.
 
 The pieces: this module builds (:func:`build_database`, one block per task, in-process
-(:mod:`._block_threads`: one block per core side by side) or on a Dask client); :mod:`._db_manifest` writes, checks and restores the manifest;
-:mod:`._db_checksums` writes and checks each block's record; :mod:`._db_load` loads a
-condition (:func:`load_database`); :mod:`._integrity` holds the store's lock and the
-blocks' draws; :mod:`._block_read` reads a block once, checked.
+(:mod:`._block_threads`: one block per core side by side) or on a Dask client);
+:mod:`._db_manifest` writes, checks and restores the manifest; :mod:`._db_checksums`
+writes and checks each block's record; :mod:`._db_load` loads a condition
+(:func:`load_database`); :mod:`._integrity` holds the store's lock and the blocks' draws;
+:mod:`._block_read` reads a block once, checked.
 """
 
 from __future__ import annotations
