@@ -17,7 +17,15 @@ from typing import Any
 
 from ._errors import GearshotError
 
-__all__ = ["dask_client"]
+__all__ = ["dask_client", "WORKER_MALLOC"]
+
+#: glibc allocator settings of the LocalCluster's workers (set before they start). Dask's
+#: own ``MALLOC_TRIM_THRESHOLD_=65536`` also pins the mmap threshold at 128 KiB: every
+#: array above it (an SA batch, a spectrum) is then mapped afresh and page-faulted in on
+#: each use, which cost a Sec. 4.1 dataset 1.18 s of CPU instead of 0.52 s with these
+#: (benchmarks/RESULTS.md, issue #23 session 8). Arrays up to 32 MiB come from the heap,
+#: and up to 128 MiB of freed heap is kept for reuse.
+WORKER_MALLOC = {"MALLOC_TRIM_THRESHOLD_": 128 << 20, "MALLOC_MMAP_THRESHOLD_": 32 << 20}
 
 
 @contextmanager
@@ -28,7 +36,10 @@ def dask_client(scheduler: str | None = None, workers: int = 2, *,
     Parameters
     ----------
     scheduler : str, optional
-        Address of a running Dask scheduler (``--scheduler``); it is left running.
+        Address of a running Dask scheduler (``--scheduler``); it is left running. Its
+        workers keep the environment they were started with: start them with
+        :data:`WORKER_MALLOC` in it (``MALLOC_TRIM_THRESHOLD_=134217728
+        MALLOC_MMAP_THRESHOLD_=33554432 dask worker ADDRESS``) for the LocalCluster's speed.
     workers : int
         Workers of the LocalCluster started when no ``scheduler`` is given (one thread
         each); with 1 worker no cluster is started and the client is None (in-process).
@@ -67,8 +78,12 @@ def _start(scheduler: str | None, workers: int, *, needed: bool) -> tuple[Any, A
             raise GearshotError(f"cannot reach the Dask scheduler at --scheduler "
                                 f"{scheduler!r}: {exc}") from None
     if needed and workers > 1:
+        import dask
         from dask.distributed import Client, LocalCluster
 
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=":0")
+        key = "distributed.nanny.pre-spawn-environ"
+        with dask.config.set({key: {**dask.config.get(key), **WORKER_MALLOC}}):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                   dashboard_address=":0")
         return Client(cluster), cluster
     return None, None

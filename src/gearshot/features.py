@@ -26,7 +26,6 @@ Moment ratios of signals whose RMS is below ``1e-10`` are 0 (the reference's con
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from functools import cached_property
 from types import MappingProxyType
 from typing import cast
 
@@ -34,122 +33,24 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._errors import GearshotError
-from ._typing import ComplexArray, FloatArray, IntArray
+from ._feature_parts import _SHAFT_ORDERS, _TINY_RMS, _moment_ratio, _Parts
+from ._typing import ComplexArray, FloatArray
 from ._validation import as_signal_array, check_int, check_positive, describe, finite_result
-from .signal.level import rms as _rms
-from .signal.orders import MeshOrders, check_mesh_orders, mesh_band_orders
+from .signal.orders import MeshOrders, check_mesh_orders
 
 __all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features",
-           "na4_baseline_variance"]
+           "spectrum_features", "na4_baseline_variance"]
 
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
-_TINY_RMS = 1e-10
-_SHAFT_ORDERS = (1, 2)
+#: Values per block of signals: the features' temporaries of one block (1 MB each) stay in
+#: the cache and are reused, where whole batches would stream through memory every step.
+_CHUNK_ELEMENTS = 1 << 17
 
 
-class _Parts:
-    """Lazily computed decompositions of a batch of SAs, shared between features."""
-
-    def __init__(self, sa: FloatArray, mesh_order: int | tuple[int, ...], n_sidebands: int,
-                 baseline_variance: float | None,
-                 shaft_orders: Sequence[int] = _SHAFT_ORDERS) -> None:
-        self.sa = sa
-        self.n = sa.shape[-1]
-        self.mesh_orders = tuple(mesh_order) if isinstance(mesh_order, tuple) else (mesh_order,)
-        self.mesh_order: int | tuple[int, ...] = (self.mesh_orders if len(self.mesh_orders) > 1
-                                                  else self.mesh_orders[0])
-        self.n_sidebands = n_sidebands
-        self.baseline_variance = baseline_variance
-        self.shaft_orders = tuple(shaft_orders)
-
-    @cached_property
-    def spectrum(self) -> ComplexArray:
-        return np.fft.rfft(self.sa, axis=-1)
-
-    def _keep(self, orders: IntArray, *, invert: bool = False) -> FloatArray:
-        mask = np.zeros(self.n // 2 + 1, dtype=bool)
-        mask[orders] = True
-        if invert:
-            mask = ~mask
-        return np.fft.irfft(self.spectrum * mask, n=self.n, axis=-1)
-
-    def _mesh(self, n_sidebands: int) -> IntArray:
-        return mesh_band_orders(self.n, self.mesh_order, n_sidebands)
-
-    @cached_property
-    def diff_spectrum(self) -> ComplexArray:
-        out = self.spectrum.copy()
-        out[..., self._mesh(self.n_sidebands)] = 0.0
-        return out
-
-    @cached_property
-    def diff(self) -> FloatArray:
-        return np.fft.irfft(self.diff_spectrum, n=self.n, axis=-1)
-
-    @cached_property
-    def rms_diff(self) -> FloatArray:
-        return cast(FloatArray, np.sqrt(np.mean(self.diff ** 2, axis=-1)))
-
-    @cached_property
-    def envelope(self) -> FloatArray:
-        # |analytic signal| (as scipy.signal.hilbert): its real part is the difference
-        # signal, its imaginary part the Hilbert transform, the real inverse FFT of
-        # -i X_k over 0 < k < n/2 (DC and Nyquist give no imaginary part)
-        n, half = self.n, self.diff_spectrum
-        quad = -1j * half
-        quad[..., 0] = 0.0
-        if n % 2 == 0:
-            quad[..., n // 2] = 0.0
-        hilb = np.fft.irfft(quad, n=n, axis=-1)
-        return _centred_modulus(self.diff, hilb)
-
-    @cached_property
-    def regular_mesh(self) -> FloatArray:
-        return self._keep(self._mesh(1))
-
-    @cached_property
-    def zakrajsek_diff(self) -> FloatArray:
-        orders = np.union1d(self._mesh(1), [0, *self.shaft_orders])
-        return self._keep(orders, invert=True)
-
-    @cached_property
-    def residual(self) -> FloatArray:
-        orders = np.union1d(self._mesh(0), [0, *self.shaft_orders])
-        return self._keep(orders, invert=True)
-
-
-def _centred_modulus(re: FloatArray, im: FloatArray) -> FloatArray:
-    """``|re + i·im|`` minus its mean along the last axis.
-
-    ``sqrt(re² + im²)`` in place (within an ulp of ``np.hypot``, five times faster);
-    ``np.hypot`` for rows whose squares could overflow or underflow.
-    """
-    env = re * re
-    env += im * im
-    peak = env.max(axis=-1, initial=0.0)
-    odd = ~((peak < 1e300) & ((peak > 1e-280) | (peak == 0.0)))
-    np.sqrt(env, out=env)
-    if np.any(odd):
-        env[odd] = np.hypot(re[odd], im[odd])
-    env -= env.mean(axis=-1, keepdims=True)
-    return env
-
-
-def _moment_ratio(x: FloatArray, order: int, *,
-                  variance: float | FloatArray | None = None) -> FloatArray:
-    """Biased normalized central moment ``mean(m^order) / var^(order/2)``; 0 if RMS tiny."""
-    centred = x - x.mean(axis=-1, keepdims=True)
-    square = centred * centred
-    own_var = np.mean(square, axis=-1)
-    var = own_var if variance is None else np.broadcast_to(variance, own_var.shape)
-    power = centred if order % 2 else square  # integer powers by multiplication: fast
-    for _ in range(order // 2 - (0 if order % 2 else 1)):
-        power = power * square
-    num = np.mean(power, axis=-1)
-    small = np.sqrt(own_var) < _TINY_RMS
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = num / var ** (order / 2)
-    return cast(FloatArray, np.where(small, 0.0, out))
+def _rms(x: FloatArray) -> FloatArray:
+    """Root mean square along the last axis (:func:`gearshot.signal.rms` without the checks
+    of an outside input)."""
+    return cast(FloatArray, np.sqrt(np.mean(x * x, axis=-1)))
 
 
 _Feature = Callable[[_Parts], FloatArray]
@@ -372,12 +273,79 @@ def extract_features(sa: ArrayLike, mesh_order: MeshOrders, *,
     >>> print(f"{fm0:.3f} {er:.3f}")
     1.954 0.030
     """
-    wanted = _check_names(names)
     x = as_signal_array(sa, "sa", min_length=4)
-    orders = _mesh_arg(mesh_order, x.shape[-1])
-    shafts = _check_shaft_orders(shaft_orders, x.shape[-1])
-    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=x.shape[-1])
+    return _features(x, None, x.shape[-1], mesh_order, names, n_sidebands, baseline_variance,
+                     shaft_orders)
+
+
+@finite_result
+def spectrum_features(spectrum: ArrayLike, n_points: int, mesh_order: MeshOrders, *,
+                      names: str | Iterable[str] | None = None, n_sidebands: int = 2,
+                      baseline_variance: float | None = None,
+                      shaft_orders: Sequence[int] = _SHAFT_ORDERS) -> FloatArray:
+    """Condition indicators of synchronous averages given by their one-sided spectra.
+
+    :func:`extract_features` of ``np.fft.irfft(spectrum, n_points)``, to within rounding,
+    without that inverse FFT and the forward one the features would take again: for
+    signals built in the frequency domain (the estimator's simulated side propagates,
+    scales and subtracts there).
+
+    Parameters
+    ----------
+    spectrum : array_like of complex, shape (..., n_points // 2 + 1)
+        ``rfft`` of the SAs along the last axis (the imaginary parts at DC and, for even
+        ``n_points``, at Nyquist are ignored, as ``irfft`` ignores them).
+    n_points : int
+        Points per cycle of the SAs.
+    mesh_order, names, n_sidebands, baseline_variance, shaft_orders
+        As for :func:`extract_features`.
+
+    Returns
+    -------
+    ndarray, shape (..., n_features)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.features import extract_features, spectrum_features
+    >>> theta = np.arange(2048) / 2048
+    >>> sa = np.cos(2 * np.pi * 38 * theta) + 0.1 * np.cos(2 * np.pi * 7 * theta) ** 9
+    >>> a = spectrum_features(np.fft.rfft(sa), 2048, 38)
+    >>> b = extract_features(sa, 38)
+    >>> bool(np.allclose(a, b, rtol=1e-12, atol=0))
+    True
+    """
+    n = check_int(n_points, "n_points", minimum=4)
+    spec = np.asarray(spectrum)
+    if not np.iscomplexobj(spec):
+        raise GearshotError(f"spectrum must be complex (an rfft); got dtype {spec.dtype}")
+    spec = np.ascontiguousarray(spec, dtype=np.complex128)
+    if spec.ndim == 0 or spec.shape[-1] != n // 2 + 1:
+        raise GearshotError(f"spectrum must have n_points // 2 + 1 = {n // 2 + 1} bins along "
+                            f"its last axis; got shape {spec.shape}")
+    as_signal_array(spec.view(np.float64), "spectrum")   # finite and bounded: cheap on a view
+    return _features(None, spec, n, mesh_order, names, n_sidebands, baseline_variance,
+                     shaft_orders)
+
+
+def _features(sa: FloatArray | None, spectrum: ComplexArray | None, n: int,
+              mesh_order: MeshOrders, names: str | Iterable[str] | None, n_sidebands: int,
+              baseline_variance: float | None, shaft_orders: Sequence[int]) -> FloatArray:
+    """The features of checked SAs or spectra (the parameters of :func:`extract_features`
+    checked here)."""
+    wanted = _check_names(names)
+    orders = _mesh_arg(mesh_order, n)
+    shafts = _check_shaft_orders(shaft_orders, n)
+    n_sidebands = check_int(n_sidebands, "n_sidebands", minimum=0, maximum=n)
     if baseline_variance is not None:
         baseline_variance = check_positive(baseline_variance, "baseline_variance")
-    parts = _Parts(x, orders, n_sidebands, baseline_variance, shafts)
-    return np.stack([_REGISTRY[name](parts) for name in wanted], axis=-1)
+    lead = (sa if sa is not None else cast(ComplexArray, spectrum)).shape[:-1]
+    flat_sa = None if sa is None else sa.reshape(-1, n)
+    flat_spec = None if spectrum is None else spectrum.reshape(-1, spectrum.shape[-1])
+    rows, out = max(1, _CHUNK_ELEMENTS // n), []
+    for i in range(0, int(np.prod(lead, dtype=int)), rows):  # row blocks that stay in cache
+        parts = _Parts(None if flat_sa is None else flat_sa[i:i + rows], orders, n_sidebands,
+                       baseline_variance, shafts, n_points=n,
+                       spectrum=None if flat_spec is None else flat_spec[i:i + rows])
+        out.append(np.stack([_REGISTRY[name](parts) for name in wanted], axis=-1))
+    return np.concatenate(out).reshape(lead + (len(wanted),))

@@ -66,8 +66,17 @@ def _database_by_grade(database: Any,
         if not np.any(sizes[m] == 0):
             raise GearshotError(f"database holds no healthy signal (fault_size == 0) for "
                                 f"grade {g}; the simulated side needs healthy references")
-        out[int(g)] = (sa[m], sizes[m])
+        out[int(g)] = (_rows(sa, m), sizes[m])
     return out
+
+
+def _rows(arr: FloatArray, mask: NDArray[np.bool_]) -> FloatArray:
+    """``arr[mask]``; a view (no copy of the signals) when the rows are one block, as the
+    grades of a database built grade by grade are."""
+    rows = np.flatnonzero(mask)
+    if rows.size and rows[-1] - rows[0] + 1 == rows.size:
+        return arr[rows[0]:rows[-1] + 1]
+    return arr[mask]
 
 
 def _has_twins(database: Any) -> bool:
@@ -92,7 +101,7 @@ def _database_twins(database: Any, by_grade: Mapping[int, tuple[FloatArray, Floa
         grades = np.full(twins.shape[0], int(grades))
     out = {}
     for g, (sa, _) in by_grade.items():
-        tw = twins[grades == g]
+        tw = _rows(twins, grades == g)
         if tw.shape != sa.shape:
             raise GearshotError(f"database['sa_twin'] of grade {g} has shape {tw.shape}; "
                                 f"the SAs have {sa.shape}")

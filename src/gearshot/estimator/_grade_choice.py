@@ -15,6 +15,7 @@ from sklearn.base import BaseEstimator
 from .._errors import GearshotError
 from . import steps
 from ._inputs import _FitInputs
+from ._simulated import residue_noise_spectrum
 from ._target import _TargetSide, target_features
 from .calibration import resolve_calibration
 from .knn import KnnModel
@@ -87,6 +88,17 @@ def _matched_noise(cache: dict[str, Any], power: FloatArray, n_points: int, seed
     return noise
 
 
+def _matched_noise_spectrum(cache: dict[str, Any], power: FloatArray, n_points: int,
+                            seed: int, n_signals: int) -> NDArray[np.complex128]:
+    """The ``rfft`` of :func:`_matched_noise` (what the grade models add), kept in ``cache``."""
+    key = f"noise_spectrum/{n_signals}"
+    if key not in cache:   # the same draw as _matched_noise, as its spectrum
+        rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
+        cache[key] = residue_noise_spectrum(power, n_signals, n_points, rng)
+    spectrum: NDArray[np.complex128] = cache[key]
+    return spectrum
+
+
 # scikit-learn ships no type information: its classes are Any to mypy
 class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
     """The grade-choice part of :class:`~gearshot.estimator.OneFaultShotEstimator`."""
@@ -150,7 +162,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                 models[grade] = self._fit_grade_model(
                     by_grade[grade], target, names, cols, seed,
                     None if twins is None else twins[grade],
-                    None if twins is None else _matched_noise(
+                    None if twins is None else _matched_noise_spectrum(
                         cache, target.residue_power, inputs.n_points, noise_seed,
                         sa.shape[0]))
             return models[grade]
@@ -166,18 +178,18 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
     def _fit_grade_model(self, grade_data: tuple[FloatArray, FloatArray], target: _TargetSide,
                          names: tuple[str, ...], cols: list[int], seed: int,
                          twins: FloatArray | None = None,
-                         noise: FloatArray | None = None) -> KnnModel:
+                         noise_spectrum: NDArray[np.complex128] | None = None) -> KnnModel:
         """Steps 4–8 for one grade: its simulated features with the target healthy, KNN.
 
         With twins (``simulated_reference="twin"``), step 6 subtracts each signal's twin
-        and ``noise`` (the target's residue) is added."""
+        and the target's residue (``noise_spectrum``: its ``rfft``) is added."""
         sa, y = grade_data
         selected = [names[c] for c in cols]   # the unselected features are not computed
         X_sim = steps.simulated_features(
             sa, y == 0, target.transfer_function, mesh_order=self._mesh_orders(),
             names=selected,
             rms_normalization=self.rms_normalization, twins=twins,
-            noise=noise)
+            noise_spectrum=noise_spectrum)
         X = np.vstack([X_sim, target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
         opts = self._options()

@@ -18,6 +18,7 @@ estimator as it was. The parts live beside this module, named after what they do
 ``_database``          the database split by fault type and grade, with its twins
 ``_target``            the target side (steps 3, 5–7 on the target's SAs)
 ``_grade_choice``      step 1 on the nominal grade, the grade models, the strategies
+``_simulated``         steps 4–6 of the simulated side as spectra, block by block
 ``_joint``             the joint calibration (``calibration="joint"``)
 ``_prediction``        predict, intervals, comparability, score, save/load
 =====================  ==============================================================

@@ -8,12 +8,38 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..signal.alignment import subtract_with_lags
 from . import steps
 from ._inputs import _FitInputs, _on_grid
+from ._shared_work import keep, kept, shared, sharing
 from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
+
+
+def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int,
+                      unscaled: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
+    """Step 6 on target SAs (:func:`steps.suppress_harmonics_target`), shared inside a
+    :func:`shared_target_work` block.
+
+    ``unscaled``: the same SAs and references before a common scale was divided out
+    (``signals == unscaled[0] / s``, ``references == unscaled[1] / s``). The lag search
+    does not depend on that scale, so the lags found for the unscaled arrays serve the
+    scaled ones (and the other way round); the residual is computed as without them.
+    """
+    def compute() -> FloatArray:
+        if not sharing():
+            return steps.suppress_harmonics_target(signals, references, upsample=upsample)
+        on = (*(unscaled or (signals, references)), int(upsample))
+        lags = kept("lags", on)
+        residual, found = subtract_with_lags(signals, references, upsample=upsample,
+                                             lags=lags)
+        if lags is None:
+            keep("lags", on, found)
+        return residual
+
+    return shared("suppress", (signals, references, int(upsample)), compute)
 
 
 @dataclass(frozen=True)
@@ -37,8 +63,11 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _Ta
     scaled = steps.normalize_rms(inputs.target_healthy, scale=scale) \
         if est.rms_normalization else inputs.target_healthy
     train_h, references = steps.split_target_healthy(scaled)
-    sub_h = steps.suppress_harmonics_target(train_h, references,
-                                            upsample=est._options().upsample)
+    unscaled = None
+    if est.rms_normalization:  # the unscaled arrays' lags serve (shared_target_work)
+        unscaled = steps.split_target_healthy(inputs.target_healthy)
+        keep("unscaled references", (references, float(scale)), unscaled[1])
+    sub_h = suppressed_target(train_h, references, est._options().upsample, unscaled)
     feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
@@ -60,11 +89,21 @@ def target_tf(est: Any, healthy_long: FloatArray | None,
 
 def target_features(est: Any, sa: ArrayLike | None, scale: float, references: FloatArray,
                     healthy_mean: FloatArray, names: tuple[str, ...]) -> FloatArray:
-    """Steps 5–7 on target SAs with the target side's scale, references and mean."""
+    """Steps 5–7 on target SAs with the target side's scale, references and mean
+    (shared inside a :func:`shared_target_work` block)."""
     x = np.atleast_2d(np.asarray(sa, dtype=float))
-    if est.rms_normalization:
-        x = steps.normalize_rms(x, scale=scale)
-    sub = steps.suppress_harmonics_target(x, references, upsample=est._options().upsample)
-    feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=est._mesh_orders(),
-                                      names=names)
-    return feats
+    upsample, orders = est._options().upsample, est._mesh_orders()
+
+    def compute() -> FloatArray:
+        y, unscaled = x, None
+        if est.rms_normalization:
+            y = steps.normalize_rms(x, scale=scale)
+            raw_refs = kept("unscaled references", (references, float(scale)))
+            unscaled = None if raw_refs is None else (x, raw_refs)
+        sub = suppressed_target(y, references, upsample, unscaled)
+        feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
+        return feats
+
+    return shared("features", (x, bool(est.rms_normalization), float(scale), references,
+                                np.asarray(healthy_mean, dtype=float), tuple(names),
+                                orders, int(upsample)), compute)

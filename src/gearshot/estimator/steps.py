@@ -31,6 +31,7 @@ from .._errors import GearshotError
 from ..features import extract_features
 from ..signal import mean_rms, subtract_healthy
 from ..transfer import estimate_transfer_function, propagate
+from ._simulated import difference_features, residue_noise_spectrum
 from .knn import KnnModel, fit_knn
 
 __all__ = [
@@ -279,13 +280,9 @@ def residue_power(differences: ArrayLike) -> FloatArray:
 def residue_noise(power: ArrayLike, n_signals: int, n_points: int,
                   rng: np.random.Generator) -> FloatArray:
     """Gaussian noise signals whose expected power spectrum is ``power``
-    (from :func:`residue_power`): white noise shaped in the frequency domain."""
-    power = np.asarray(power, dtype=float)
-    if power.shape != (n_points // 2 + 1,):
-        raise GearshotError(f"power must have n_points // 2 + 1 = {n_points // 2 + 1} bins; "
-                            f"got shape {power.shape}")
-    white = rng.standard_normal((n_signals, n_points))
-    shaped = np.fft.rfft(white, axis=-1) * np.sqrt(power / n_points)
+    (from :func:`residue_power`): white noise shaped in the frequency domain
+    (:func:`~gearshot.estimator._simulated.residue_noise_spectrum`, inverted)."""
+    shaped = residue_noise_spectrum(power, n_signals, n_points, rng)
     return np.asarray(np.fft.irfft(shaped, n=n_points, axis=-1), dtype=np.float64)
 
 
@@ -336,8 +333,13 @@ def centred_features(sa: ArrayLike, healthy_mean: ArrayLike | None = None, *,
 def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike | None, *,
                        mesh_order: int | Sequence[int], names: Sequence[str],
                        rms_normalization: bool = True, twins: ArrayLike | None = None,
-                       noise: ArrayLike | None = None) -> FloatArray:
+                       noise: ArrayLike | None = None,
+                       noise_spectrum: ArrayLike | None = None) -> FloatArray:
     """Steps 4–7 on one set of simulated SAs: propagate, normalize, suppress, centre.
+
+    Steps 4–6 are linear: they run on the one-sided spectra and the features start from
+    the result (:func:`gearshot.features.spectrum_features`; the time-domain steps' numbers
+    to within rounding, two FFTs per signal fewer).
 
     Parameters
     ----------
@@ -357,6 +359,8 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         Residue added to the difference signals (noise matching: :func:`residue_noise`
         of the target's healthy differences' :func:`residue_power`); with twins the
         simulated differences have no residue of their own.
+    noise_spectrum : ndarray of complex (n_signals, n_points // 2 + 1), optional
+        The same given by its ``rfft`` (one draw added to many sets is transformed once).
 
     Returns
     -------
@@ -365,23 +369,23 @@ def simulated_features(sim_sa: ArrayLike, healthy_mask: ArrayLike, tf: ArrayLike
         features).
     """
     healthy = np.asarray(healthy_mask, bool)
+    sim_sa = np.asarray(sim_sa, dtype=float)
     if twins is None:
-        sim = propagate_simulated(sim_sa, tf)
-        if rms_normalization:
-            sim = normalize_rms(sim, sim[healthy])
-        sim = suppress_harmonics_simulated(sim, healthy)
+        reference = sim_sa[int(np.flatnonzero(healthy)[0])]
     else:
-        # steps 4-6 are linear in the signals: the twin's difference goes through the TF
-        # once (half the propagation), scaled by the propagated healthy SAs' mean RMS
-        sim = propagate_simulated(suppress_harmonics_simulated(sim_sa, healthy, twins), tf)
-        if rms_normalization:
-            sim = normalize_rms(sim, propagate_simulated(np.asarray(sim_sa)[healthy], tf))
-    if noise is not None:
-        sim = sim + np.asarray(noise, dtype=float)
-    feats, _ = centred_features(sim, mesh_order=mesh_order, names=names, healthy_mask=healthy)
-    return feats
+        reference = np.asarray(twins, dtype=float)
+        if reference.shape != sim_sa.shape:
+            raise GearshotError(f"twins must have the shape of the simulated SAs "
+                                f"{sim_sa.shape}; got {reference.shape}")
+    scale = (rms_scale(propagate_simulated(sim_sa[healthy], tf)) if rms_normalization
+             else 1.0)
+    feats = difference_features(
+        sim_sa, reference, None if tf is None else np.asarray(tf), scale,
+        mesh_order=mesh_order, names=names,
+        noise=None if noise is None else np.asarray(noise, dtype=float),
+        noise_spectrum=None if noise_spectrum is None else np.asarray(noise_spectrum))
+    return np.asarray(feats - feats[healthy].mean(axis=0), dtype=np.float64)
 
 
 # ---------------------------------------------------------------- step 8
-# fit_knn and KnnModel (imported above from .knn): K-nearest-neighbour regression, K chosen
-# on one validation split.
+# fit_knn and KnnModel (from .knn): K-nearest-neighbour regression, K on one split.

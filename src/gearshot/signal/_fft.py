@@ -45,7 +45,7 @@ def _real_to_full(half: ComplexArray, n: int) -> ComplexArray:
     out = np.empty(half.shape[:-1] + (n,), dtype=half.dtype)
     k = half.shape[-1]
     out[..., :k] = half
-    out[..., k:] = np.conj(half[..., 1:n - k + 1][..., ::-1])
+    np.conjugate(half[..., 1:n - k + 1][..., ::-1], out=out[..., k:])
     return out
 
 

@@ -13,7 +13,7 @@ from .._typing import ComplexArray, FloatArray, IntArray
 from .._validation import as_signal_array, check_int, describe, finite_result
 from . import _fft
 
-__all__ = ["fractional_shift", "subtract_healthy"]
+__all__ = ["fractional_shift", "subtract_with_lags", "subtract_healthy"]
 
 
 def _shift_factors(n: int, tau: FloatArray) -> ComplexArray:
@@ -241,35 +241,113 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
     if refs.shape[-1] != n:
         raise GearshotError(
             f"healthy_refs have {refs.shape[-1]} points per cycle but signals have {n}")
-    batch_shape = signals.shape[:-1]
-    flat = signals.reshape(-1, n)
-    spec_x = _fft.fft(flat, axis=-1)
-    spec_r = _fft.fft(refs, axis=-1)
-    search = _LagSearch(n, upsample)
-
-    residual = np.empty_like(flat)
-    ref_index = np.empty(flat.shape[0], dtype=int)
-    delays = np.empty(flat.shape[0])
-    chunk = max(1, 256 // refs.shape[0])
-    for start in range(0, flat.shape[0], chunk):
-        part = slice(start, start + chunk)
-        residual[part], ref_index[part], delays[part] = _best_residuals(
-            spec_x[part], spec_r, search, upsample)
+    residual, ref_index, delays, _ = _subtract(signals.reshape(-1, n), refs, upsample)
     residual = residual.reshape(signals.shape)
     if return_details:
+        batch_shape = signals.shape[:-1]
         return residual, ref_index.reshape(batch_shape), delays.reshape(batch_shape)
     return residual
 
 
-def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch,
-                    upsample: int) -> tuple[FloatArray, IntArray, FloatArray]:
+def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
+              lags: IntArray | None = None
+              ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
+    """:func:`subtract_healthy` on rows ``flat`` (c, n): residual, chosen reference, its
+    delay (samples) and every reference's lag (c, n_refs; 1/upsample samples), found here
+    or given as ``lags``."""
+    n = flat.shape[-1]
+    spec_x = _fft.fft(flat, axis=-1)
+    spec_r = _fft.fft(refs, axis=-1)
+    search = _LagSearch(n, upsample) if lags is None else None
+
+    residual = np.empty_like(flat)
+    ref_index = np.empty(flat.shape[0], dtype=int)
+    delays = np.empty(flat.shape[0])
+    all_lags = np.empty((flat.shape[0], refs.shape[0]), dtype=np.int64)
+    chunk = max(1, 256 // refs.shape[0])
+    for start in range(0, flat.shape[0], chunk):
+        part = slice(start, start + chunk)
+        (residual[part], ref_index[part], delays[part],
+         all_lags[part]) = _best_residuals(spec_x[part], spec_r, search, upsample,
+                                           None if lags is None else lags[part])
+    return residual, ref_index, delays, all_lags
+
+
+def subtract_with_lags(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: int = 100,
+             lags: ArrayLike | None = None) -> tuple[FloatArray, IntArray]:
+    """:func:`subtract_healthy`'s residual and its lag search's result, or the residual
+    for lags found before.
+
+    The lag search (the cross-correlation maximum of every signal with every reference on
+    the grid of ``1/upsample`` sample) is most of :func:`subtract_healthy`'s cost and does
+    not depend on a common scale of ``signals`` and ``healthy_refs``: the lags found on
+    one scale serve another (the estimator variants with and without RMS normalization
+    share them, :func:`gearshot.estimator._target.shared_target_work`). With ``lags``
+    given, the residual is computed exactly as :func:`subtract_healthy` computes it after
+    its search (the same operations on the same shapes), so for the lags it would find the
+    residual is its residual, bit for bit.
+
+    Parameters
+    ----------
+    signals : array_like, shape (c, n)
+    healthy_refs : array_like, shape (n_refs, n) or (n,)
+    upsample : int, default 100
+    lags : array_like of int, shape (c, n_refs), optional
+        Lags in ``1/upsample`` samples (as returned here); default: search them.
+
+    Returns
+    -------
+    residual : ndarray, shape (c, n)
+    lags : ndarray of int, shape (c, n_refs)
+
+    Examples
+    --------
+    The lags found on signals and references serve the same arrays at another scale:
+
+    >>> import numpy as np
+    >>> from gearshot.signal import fractional_shift, subtract_healthy
+    >>> from gearshot.signal.alignment import subtract_with_lags
+    >>> theta = np.arange(64) / 64
+    >>> refs = np.vstack([np.cos(2 * np.pi * 7 * theta), np.cos(2 * np.pi * 5 * theta)])
+    >>> signals = np.vstack([fractional_shift(refs[1], 2.25), fractional_shift(refs[0], 1.5)])
+    >>> residual, lags = subtract_with_lags(signals, refs)
+    >>> print(lags[0, 1], lags[1, 0])          # delays in 1/100 sample
+    225 150
+    >>> half, _ = subtract_with_lags(signals / 2, refs / 2, lags=lags)
+    >>> bool(np.array_equal(half, subtract_healthy(signals / 2, refs / 2)))
+    True
+    """
+    x = as_signal_array(signals, "signals", max_ndim=2, min_length=2)
+    flat = np.atleast_2d(x)
+    refs = np.atleast_2d(as_signal_array(healthy_refs, "healthy_refs", max_ndim=2,
+                                         min_length=2))
+    upsample = check_int(upsample, "upsample", minimum=1, maximum=10_000)
+    if refs.shape[-1] != flat.shape[-1]:
+        raise GearshotError(f"healthy_refs have {refs.shape[-1]} points per cycle but "
+                            f"signals have {flat.shape[-1]}")
+    given = None
+    if lags is not None:
+        given = np.asarray(lags)
+        if given.shape != (flat.shape[0], refs.shape[0]) or given.dtype.kind not in "iu":
+            raise GearshotError(f"lags must be integers of shape {(flat.shape[0], refs.shape[0])}"
+                                f" (signals x references); got {describe(lags)}")
+    residual, _, _, found = _subtract(flat, refs, upsample, given)
+    return residual.reshape(x.shape), found
+
+
+def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch | None,
+                    upsample: int, steps: IntArray | None = None
+                    ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
     """For each signal spectrum in ``sx`` (c, n): the residual after subtracting the
-    delay-aligned reference that leaves the least energy, that reference's index and its
-    delay in samples."""
+    delay-aligned reference that leaves the least energy, that reference's index, its
+    delay in samples and every reference's lag (c, n_refs; ``steps`` if given, else found
+    by ``search``)."""
     n, n_refs = sx.shape[-1], spec_r.shape[0]
-    m = n // 2 + 1  # the lag search reads the non-negative frequencies only
-    cross = (sx[:, None, :m] * np.conj(spec_r[:, :m])[None]).reshape(-1, m)
-    steps = search.best(cross).reshape(-1, n_refs)  # delays, 1/upsample samples
+    if steps is None:
+        assert search is not None
+        m = n // 2 + 1  # the lag search reads the non-negative frequencies only
+        cross = (sx[:, None, :m] * np.conj(spec_r[:, :m])[None]).reshape(-1, m)
+        steps = search.best(cross).reshape(-1, n_refs)  # delays, 1/upsample samples
     tau = steps / upsample  # delays, samples
     advance = _grid_shift_factors(n, steps, upsample)  # (c, n_refs, n)
     res_spec = sx[:, None, :] * advance - spec_r[None]
@@ -277,4 +355,5 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch,
     best = np.argmin(energy, axis=-1)
     rows = np.arange(len(sx))
     back = res_spec[rows, best] * np.conj(advance[rows, best])
-    return _fft.ifft(back, axis=-1).real, best, tau[rows, best]
+    return _fft.ifft(back, axis=-1).real, best, tau[rows, best], steps
+

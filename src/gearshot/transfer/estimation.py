@@ -16,6 +16,8 @@ __all__ = [
     "estimate_transfer_function",
     "resample_transfer_function",
     "propagate",
+    "propagate_spectrum",
+    "one_sided_response",
     "rms",
     "mean_rms",
     "rms_normalize",
@@ -158,16 +160,75 @@ def propagate(signals, tf) -> np.ndarray:
     >>> print(np.round(propagate(np.arange(8.0), np.exp(-2j * np.pi * k / 8)), 3) + 0.0)
     [7. 0. 1. 2. 3. 4. 5. 6.]
     """
+    spectrum = propagate_spectrum(signals, tf)
+    n = np.shape(signals)[-1]
+    return scipy.fft.irfft(spectrum, n=n, axis=-1)
+
+
+def propagate_spectrum(signals, tf) -> np.ndarray:
+    """One-sided spectrum (``rfft``) of :func:`propagate` ``(signals, tf)``.
+
+    For work that goes on in the frequency domain (the features start from a spectrum):
+    ``propagate(x, tf)`` is ``irfft(propagate_spectrum(x, tf), n)`` bit for bit.
+
+    Parameters
+    ----------
+    signals : array_like, shape (..., n)
+    tf : array_like of complex, shape (n,)
+
+    Returns
+    -------
+    ndarray of complex, shape (..., n // 2 + 1)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gearshot.transfer import propagate, propagate_spectrum
+    >>> x = np.random.default_rng(0).standard_normal((2, 16))
+    >>> tf = np.fft.fft(np.r_[1.0, 0.5, np.zeros(14)])     # y[t] = x[t] + x[t - 1] / 2
+    >>> y = np.fft.irfft(propagate_spectrum(x, tf), n=16)
+    >>> bool(np.array_equal(y, propagate(x, tf)))
+    True
+    >>> bool(np.allclose(y, x + 0.5 * np.roll(x, 1, axis=-1)))
+    True
+    """
     signals = as_signal_array(signals, "signals", min_length=2)
     tf = as_signal_array(tf, "tf", max_ndim=1, allow_complex=True)
     if tf.shape[-1] != signals.shape[-1]:
         raise GearshotError(
             f"tf has {tf.shape[-1]} points but signals have {signals.shape[-1]} per cycle")
-    # real signals: real(IDFT(tf X)) = IDFT of the Hermitian part of tf X, whose positive
-    # half is X_k (tf_k + conj(tf_{-k})) / 2: one real FFT pair instead of complex ones
-    n = signals.shape[-1]
-    half = 0.5 * (tf + np.conj(tf[(-np.arange(n)) % n]))[: n // 2 + 1]
-    return scipy.fft.irfft(scipy.fft.rfft(signals, axis=-1) * half, n=n, axis=-1)
+    return scipy.fft.rfft(signals, axis=-1) * one_sided_response(tf)
+
+
+def one_sided_response(tf) -> np.ndarray:
+    """The factor :func:`propagate` multiplies a real signal's ``rfft`` by.
+
+    A real signal through ``tf`` is ``real(IDFT(tf X))``, the inverse DFT of the Hermitian
+    part of ``tf X``, whose positive half is ``X_k (tf_k + conj(tf_{-k})) / 2``: one real
+    FFT pair instead of complex ones.
+
+    Parameters
+    ----------
+    tf : array_like of complex, shape (n,)
+        Frequency response on the ``n``-point DFT grid.
+
+    Returns
+    -------
+    ndarray of complex, shape (n // 2 + 1,)
+
+    Examples
+    --------
+    A Hermitian response (that of a real impulse response) is its own Hermitian part:
+
+    >>> import numpy as np
+    >>> from gearshot.transfer import one_sided_response
+    >>> tf = np.fft.fft([1.0, 0.5, 0.0, 0.0])
+    >>> print(one_sided_response(tf))
+    [1.5+0.j  1. -0.5j 0.5+0.j ]
+    """
+    tf = as_signal_array(tf, "tf", max_ndim=1, allow_complex=True)
+    n = tf.shape[-1]
+    return 0.5 * (tf + np.conj(tf[(-np.arange(n)) % n]))[: n // 2 + 1]
 
 
 def rms_normalize(signals, reference) -> np.ndarray:
