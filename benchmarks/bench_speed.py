@@ -142,10 +142,19 @@ def children_cpu() -> float:
 
 
 def _local_client(workers=2):
+    """The LocalCluster ``gearshot simulate`` starts (``gearshot._cluster``: one thread per
+    worker, its workers' allocator settings; none with an older tree's code)."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=":0")
+    try:
+        from gearshot._cluster import WORKER_MALLOC
+    except ImportError:
+        WORKER_MALLOC = {}
+    key = "distributed.nanny.pre-spawn-environ"
+    with dask.config.set({key: {**dask.config.get(key), **WORKER_MALLOC}}):
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0")
     return Client(cluster), cluster
 
 
