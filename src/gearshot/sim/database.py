@@ -40,7 +40,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .._atomic import atomic_dir, check_writable, remove_tree
-from .._cluster import dask_client
+from .._cluster import IN_PROCESS_BLOCKS, dask_client
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, check_load, check_speed, describe
@@ -57,7 +57,7 @@ from .geometry import GearPair
 __all__ = ["build_database", "load_database", "default_database_path", "pair_attrs",
            "PAIR_ATTRS"]
 
-_SMALL_BUILD = 16  # blocks; larger builds start a LocalCluster when no client is given
+_SMALL_BUILD = IN_PROCESS_BLOCKS  # larger builds start a LocalCluster when no client is given
 _MAX_POINTS = 1 << 20          # SA length bound (a block row is 8 MiB at this length)
 _MAX_SIGNALS = 1_000_000       # signals per block
 
