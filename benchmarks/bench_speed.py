@@ -14,7 +14,9 @@
 Prints numbers (no asserts). The box is shared, so every timing is printed with the load
 average and, for the simulator, as a ratio to a fixed numpy FFT workload timed in the same
 run (``fft_ref``: 10 real FFTs of a 64 x 8192 array, best of 3, one thread). Peak memory:
-the process's maximum resident set (and its child processes', e.g. Dask workers).
+the process's maximum resident set, its largest finished child process's (an upper bound:
+a child started after the driver grew reports at least the driver's size then) and, where
+a Dask cluster runs, its largest worker's own peak (VmHWM, asked before closing).
 """
 
 from __future__ import annotations
@@ -45,6 +47,28 @@ def peak_mb() -> str:
     own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     return f"peak RSS {own:.0f} MB (largest child process {kids:.0f} MB)"
+
+
+def _own_peak_mb() -> float:
+    """This process's peak resident set (VmHWM), MB. Not ``ru_maxrss``: a spawned
+    process's ``ru_maxrss`` keeps the parent's resident set at the fork (Linux carries it
+    over ``exec``), so a Dask worker started after an in-process build would report the
+    builder's peak."""
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def workers_peak(client) -> str:
+    """The largest peak RSS of the client's workers (asked before the cluster closes;
+    their own, see :func:`_own_peak_mb`)."""
+    try:
+        peaks = client.run(_own_peak_mb).values()
+    except Exception as exc:                    # a worker gone: say so, keep the timing
+        return f"workers' peak RSS unknown ({type(exc).__name__})"
+    return f"largest worker's peak RSS {max(peaks):.0f} MB"
 
 
 def fft_ref() -> tuple[float, float]:
@@ -118,10 +142,19 @@ def children_cpu() -> float:
 
 
 def _local_client(workers=2):
+    """The LocalCluster ``gearshot simulate`` starts (``gearshot._cluster``: one thread per
+    worker, its workers' allocator settings; none with an older tree's code)."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=":0")
+    try:
+        from gearshot._cluster import WORKER_MALLOC
+    except ImportError:
+        WORKER_MALLOC = {}
+    key = "distributed.nanny.pre-spawn-environ"
+    with dask.config.set({key: {**dask.config.get(key), **WORKER_MALLOC}}):
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0")
     return Client(cluster), cluster
 
 
@@ -143,6 +176,7 @@ def bench_machine(args):
             try:
                 wall, cpu, l0 = _timed_build(Path(tmp) / "db", pair, client, paired=paired,
                                              **kw)
+                wpeak = workers_peak(client)
             finally:
                 client.close()
                 cluster.close()
@@ -151,7 +185,8 @@ def bench_machine(args):
                   f"{'+ twins' if paired else '(unpaired)'} = {n} signals, LocalCluster 2 x 1 "
                   f"thread: {wall:.1f} s wall (+ {start:.1f} s cluster start), workers' CPU "
                   f"{workers_cpu:.1f} s (/2 = {workers_cpu / 2:.1f} s on 2 free cores); load "
-                  f"avg before {l0}, after {load_avg()}; {peak_mb()}")
+                  f"avg before {l0}, after {load_avg()}; {peak_mb()}; {wpeak}")
+    print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
 def bench_condition(args):
@@ -164,7 +199,7 @@ def bench_condition(args):
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), None,
                                          paired=paired, **kw)
             print(f"one condition (15 rps, 10 N m) x 12 grades x 800 "
-                  f"{'+ twins' if paired else '(unpaired)'}, in-process (2 numba threads): "
+                  f"{'+ twins' if paired else '(unpaired)'}, in-process (client=None): "
                   f"{wall:.1f} s wall, {cpu:.1f} s CPU; load avg before {l0}, after "
                   f"{load_avg()}; {peak_mb()}")
         k0 = children_cpu()
@@ -172,6 +207,7 @@ def bench_condition(args):
         try:
             wall, cpu, l0 = _timed_build(Path(tmp) / "db", GearPair.paper(), client,
                                          paired=True, **kw)
+            wpeak = workers_peak(client)
         finally:
             client.close()
             cluster.close()
@@ -179,12 +215,13 @@ def bench_condition(args):
         print(f"  + twins on a LocalCluster (2 x 1 thread, started before timing): "
               f"{wall:.1f} s wall, workers' CPU {workers_cpu:.1f} s (/2 = "
               f"{workers_cpu / 2:.1f} s on 2 free cores); load avg before {l0}, after "
-              f"{load_avg()}; {peak_mb()}")
+              f"{load_avg()}; {peak_mb()}; {wpeak}")
+    print(f"fft_ref {1e3 * fft_ref()[1]:.1f} ms CPU")
 
 
 def bench_scheduler(args):
     """``gearshot simulate --scheduler ADDRESS`` against a cluster started apart."""
-    from dask.distributed import LocalCluster
+    from dask.distributed import Client, LocalCluster
 
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                            dashboard_address=":0")
@@ -198,12 +235,14 @@ def bench_scheduler(args):
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
             wall = time.perf_counter() - t0
-        print(f"gearshot simulate --paired --scheduler {cluster.scheduler_address} (a "
-              f"LocalCluster of 2 x 1 thread started apart), one condition x 12 grades x "
-              f"800 + twins: {wall:.1f} s wall incl. the CLI's start; load avg before {l0}, "
-              f"after {load_avg()}")
+        with Client(cluster) as client:
+            wpeak = workers_peak(client)
     finally:
         cluster.close()
+    print(f"gearshot simulate --paired --scheduler ADDRESS (a LocalCluster of 2 x 1 thread "
+          f"started apart), one condition x 12 grades x 800 + twins: {wall:.1f} s wall "
+          f"incl. the CLI's start; load avg before {l0}, after {load_avg()}; {peak_mb()} "
+          f"(children: the CLI and the closed workers); {wpeak}")
 
 
 def bench_estimator(args):
@@ -341,10 +380,13 @@ def bench_breakdown(args):
     import numba
 
     import gearshot.sim._system as system
+    import gearshot.sim.database as database
     import gearshot.sim.dynamics as dyn
     from gearshot.sim import GearPair, build_database
 
     numba.set_num_threads(1)
+    if hasattr(database, "block_threads"):        # blocks one after another, timed apart
+        database.block_threads = lambda n: 1
     acc: dict = {}
 
     def wrap(owner, name, key):
@@ -380,6 +422,7 @@ def bench_breakdown(args):
     for key, v in sorted(acc.items(), key=lambda kv: -kv[1]):
         print(f"  {key:28s} {v:6.2f} s  {100 * v / total:5.1f} %")
     print(f"  {'rest (zarr, checksums, ...)':28s} {total - sum(acc.values()):6.2f} s")
+    print(f"  {peak_mb()}")
 
 
 def main():

@@ -5,7 +5,8 @@
 
 Cases: spur and helical (20 deg) pairs, the four fault types, grades 4 / 7 / 12, speeds
 10 / 15 / 35 rev/s, fresh fault sizes (fixed seeds), ``simulate_sa`` SAs and one
-``simulate`` time signal with a speed ramp, and the rig surrogate's TE tables. Prints, per
+``simulate`` time signal with a speed ramp, the rig surrogate's TE tables, and the SAs and
+healthy twins of small paired stores. Prints, per
 case, the largest |new - old| / max|old| (0 = bit-identical).
 """
 
@@ -40,6 +41,31 @@ def cases():
         geom, compl = eng.tables(fault_size=size, reality=None,
                                  rng=np.random.default_rng(5))
         out[f"surrogate/{size}"] = np.stack([geom, compl])
+    out.update(database_cases())
+    return out
+
+
+def database_cases():
+    """``sa`` and ``sa_twin`` of small paired stores (spur FTFF and breakage, helical
+    FTFF; two grades) built in-process, read back with ``load_database``."""
+    import tempfile
+    from pathlib import Path
+
+    from gearshot.sim import GearPair, build_database, load_database
+
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for pname, pair, types in (("spur", GearPair.paper(), ("ftff", "breakage")),
+                                   ("helical", GearPair.helical(np.radians(20.0)),
+                                    ("ftff",))):
+            store = Path(tmp) / pname
+            build_database(store, pair, speeds=[15.0], loads=[10.0], grades=[4, 9],
+                           n_healthy=3, n_faulty=37, seed=5, paired=True,
+                           fault_types=types, client=False, progress=False)
+            for ft in types:
+                db = load_database(store, speed=15.0, load=10.0, fault_type=ft)
+                out[f"db/{pname}/{ft}/sa"] = np.asarray(db["sa"])
+                out[f"db/{pname}/{ft}/sa_twin"] = np.asarray(db["sa_twin"])
     return out
 
 

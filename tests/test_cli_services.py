@@ -125,3 +125,29 @@ def test_folder_digest_follows_names_and_bytes(tmp_path):
     assert folder_digest(tmp_path) == first
     (tmp_path / "a.csv").rename(tmp_path / "b.csv")
     assert folder_digest(tmp_path) != first
+
+
+def test_small_builds_run_in_process_large_ones_on_a_cluster(monkeypatch, tmp_path):
+    """`gearshot simulate`: up to IN_PROCESS_BLOCKS blocks in-process (no LocalCluster
+    start-up), more on the cluster; the build gets the client dask_client yields."""
+    from contextlib import contextmanager
+
+    import gearshot.app.simulate as service
+    import gearshot.sim
+    from gearshot._cluster import IN_PROCESS_BLOCKS
+
+    asked, given = [], []
+
+    @contextmanager
+    def fake_client(scheduler, workers, *, needed):
+        asked.append(needed)
+        yield "client" if needed else None
+
+    monkeypatch.setattr(service, "dask_client", fake_client)
+    monkeypatch.setattr(gearshot.sim, "build_database",
+                        lambda store, pair, **kw: given.append(kw["client"]))
+    kw = dict(loads=[10.0], n_healthy=2, n_faulty=2, seed=0)
+    service.simulate_database(tmp_path / "a", speeds=[15.0], grades=range(1, 13), **kw)
+    assert 12 <= IN_PROCESS_BLOCKS
+    service.simulate_database(tmp_path / "b", speeds=[10.0, 15.0], grades=range(1, 13), **kw)
+    assert asked == [False, True] and given == [None, "client"]

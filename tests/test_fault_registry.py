@@ -101,6 +101,7 @@ def test_a_store_built_before_the_registry_loads_and_matches(tmp_path, monkeypat
         raise AssertionError("a block of the old store was rebuilt")
 
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", no_simulation)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired", no_simulation)
     build_database(store, GearPair.paper(), speeds=[15.0], loads=[10.0], grades=[7],
                    n_healthy=1, n_faulty=1, seed=11, n_points=16, client=False,
                    progress=False, fault_types=list(OLD_CODES), paired=True)

@@ -142,6 +142,8 @@ def _fake_simulate_sa(pair, *, speed, load, grade, fault_sizes, n_points, rng,
 @pytest.fixture(autouse=True)
 def fast_simulator(monkeypatch):
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
+                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
 
 
 KW = dict(speeds=[15, 20], loads=[10], grades=[7, 8], n_healthy=1, n_faulty=2, seed=3,

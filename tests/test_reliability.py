@@ -175,9 +175,16 @@ def _fake_simulate_sa(pair, *, speed, load, grade, fault_sizes, n_points, rng,
     return np.stack([np.random.default_rng(s).standard_normal(n_points) for s in rng])
 
 
+def _fake_simulate_sa_paired(pair, **kw):
+    """The stand-in's SAs and twins (a faulty signal's twin: its SA with the sign flipped)."""
+    sa = _fake_simulate_sa(pair, **kw)
+    return sa, np.where((kw["fault_sizes"] > 0)[:, None], -sa, sa)
+
+
 @pytest.fixture(autouse=True)
 def fast_simulator(monkeypatch):
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired", _fake_simulate_sa_paired)
 
 
 @pytest.fixture(scope="module")
@@ -187,6 +194,7 @@ def small_db(tmp_path_factory):
     store = tmp_path_factory.mktemp("db") / "db"
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+        mp.setattr("gearshot.sim.database.simulate_sa_paired", _fake_simulate_sa_paired)
         build_database(store, **DB_KW)
     return store, load_database(store, speed=15, load=10).sa.values
 

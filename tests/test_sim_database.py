@@ -177,3 +177,54 @@ def test_paired_store_holds_each_signals_healthy_twin(tmp_path):
     with pytest.raises(GearshotError, match="paired must be True or False; got 'yes'"):
         build_database(tmp_path / "other", client=False, progress=False, paired="yes",
                        **PAIR_KW)
+
+
+THREAD_KW = dict(speeds=[15], loads=[10], grades=[4, 9, 11], n_healthy=1, n_faulty=4, seed=2,
+                 n_points=256, paired=True, client=False, progress=False)
+
+
+@pytest.mark.parametrize("helix", [0.0, 20.0])
+def test_blocks_side_by_side_equal_blocks_one_by_one(tmp_path, monkeypatch, helix):
+    """An in-process build runs its blocks on threads (one per core): the same numbers,
+    bit for bit, as one block after another on numba threads; the twins equal
+    simulate_sa of the faulty signals' seeds without the fault, bit for bit."""
+    import gearshot.sim.database as database
+    from gearshot.sim import GearPair, simulate_sa
+
+    pair = GearPair.helical(np.radians(helix)) if helix else GearPair.paper()
+    stores = {}
+    for n_threads in (1, 3):
+        monkeypatch.setattr(database, "block_threads", lambda n, k=n_threads: k)
+        stores[n_threads] = load_database(
+            build_database(tmp_path / f"t{n_threads}", pair, **THREAD_KW), speed=15, load=10)
+    for name in ("sa", "sa_twin", "fault_size", "seed"):
+        np.testing.assert_array_equal(stores[1][name].values, stores[3][name].values)
+    ds = stores[3]
+    faulty = np.flatnonzero((ds.fault_size.values > 0) & (ds.grade.values == 9))
+    twins = simulate_sa(pair, speed=15, load=10, grade=9, n_points=256,
+                        fault_sizes=np.zeros(faulty.size),
+                        rng=[int(s) for s in ds.seed.values[faulty]])
+    np.testing.assert_array_equal(ds.sa_twin.values[faulty], twins)
+    assert not np.array_equal(ds.sa.values[faulty], twins)
+
+
+def test_failed_block_on_a_thread_is_raised_and_leaves_no_temporaries(tmp_path, monkeypatch):
+    import gearshot.sim.database as database
+
+    real = database.simulate_sa_paired
+
+    def fails_for_grade_9(pair, **kw):
+        if kw["grade"] == 9:
+            raise OSError(28, "No space left on device")
+        return real(pair, **kw)
+
+    monkeypatch.setattr(database, "block_threads", lambda n: 2)
+    monkeypatch.setattr(database, "simulate_sa_paired", fails_for_grade_9)
+    with pytest.raises(OSError, match="No space left"):
+        build_database(tmp_path / "db", **THREAD_KW)
+    blocks = tmp_path / "db" / "blocks"
+    assert not list(blocks.glob(".*tmp*")) and not list((tmp_path / "db").glob(".*.tmp*"))
+    assert not (blocks / "s0_l0_g1.zarr").exists()
+    monkeypatch.setattr(database, "simulate_sa_paired", real)     # the next build finishes
+    build_database(tmp_path / "db", **THREAD_KW)
+    assert load_database(tmp_path / "db", speed=15, load=10).sa.shape == (15, 256)

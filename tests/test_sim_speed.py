@@ -82,6 +82,8 @@ def store(tmp_path, monkeypatch):
     from gearshot.sim import build_database
 
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
+                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
     return build_database(tmp_path / "db", **KW)
 
 
@@ -120,6 +122,8 @@ def test_resume_reads_no_chunk(store, monkeypatch):
 
     counts = _count_reads(monkeypatch)
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
+                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
     build_database(store, **KW)
     assert counts == {}
 
@@ -136,6 +140,8 @@ def test_same_size_damage_is_caught_on_load(store, monkeypatch):
     chunk.write_bytes(bytes(data))
     os.utime(chunk, ns=(st.st_atime_ns, st.st_mtime_ns))
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
+                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
     build_database(store, **KW)                       # sizes and times agree: kept
     with pytest.raises(GearshotError, match=r"s0_l0_g1\.zarr.*corrupt.*remove"):
         load_database(store, speed=15, load=10)
@@ -152,6 +158,8 @@ def test_modified_chunk_is_rebuilt_on_resume(store, monkeypatch):
     st = chunk.stat()
     os.utime(chunk, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
     monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
+    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
+                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
     build_database(store, **KW)
     np.testing.assert_array_equal(load_database(store, speed=15, load=10).sa.values, ref)
 

@@ -17,7 +17,13 @@ from typing import Any
 
 from ._errors import GearshotError
 
-__all__ = ["dask_client", "WORKER_MALLOC"]
+__all__ = ["dask_client", "WORKER_MALLOC", "IN_PROCESS_BLOCKS"]
+
+#: Database builds of at most this many blocks run in-process (one block per core on
+#: threads, :mod:`gearshot.sim._block_threads`): a LocalCluster's start-up and its workers'
+#: separate writes cost more than they save there (one paper condition, 12 blocks: 10.8 s
+#: in-process against 20 s on a 2-worker LocalCluster, benchmarks/RESULTS.md, session 8).
+IN_PROCESS_BLOCKS = 16
 
 #: glibc allocator settings of the LocalCluster's workers (set before they start). Dask's
 #: own ``MALLOC_TRIM_THRESHOLD_=65536`` also pins the mmap threshold at 128 KiB: every

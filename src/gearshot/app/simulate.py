@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from .._cluster import dask_client
+from .._cluster import IN_PROCESS_BLOCKS, dask_client
 
 __all__ = ["default_store", "simulate_database", "simulate_machine_database"]
 
@@ -27,12 +27,13 @@ def simulate_database(store: Path, *, speeds: Sequence[float], loads: Sequence[f
                       fault_types: Sequence[str] = ("ftff",), paired: bool = True,
                       scheduler: str | None = None, workers: int = 2) -> Path:
     """The paper pair's database over ``speeds`` × ``loads`` × ``grades`` × ``fault_types``
-    (blocks on a Dask cluster when there are several; see
-    :func:`gearshot._cluster.dask_client`); returns ``store``."""
+    (more than :data:`gearshot._cluster.IN_PROCESS_BLOCKS` blocks on a Dask cluster, see
+    :func:`gearshot._cluster.dask_client`; fewer in-process, one block per core);
+    returns ``store``."""
     from ..sim import GearPair, build_database
 
     n_blocks = len(speeds) * len(loads) * len(grades) * len(fault_types)
-    with dask_client(scheduler, workers, needed=n_blocks > 1) as client:
+    with dask_client(scheduler, workers, needed=n_blocks > IN_PROCESS_BLOCKS) as client:
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grades,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
                        fault_types=list(fault_types), paired=paired)
@@ -68,7 +69,7 @@ def simulate_machine_database(machine_file: Path, store: Path | None, *,
                                            n_faulty=n_faulty, seed=seed, paired=paired)
     sim_speeds = [mach.sim_speed(s) for s in speeds]
     n_blocks = len(sim_speeds) * len(loads) * len(grades) * len(fault_types)
-    with dask_client(scheduler, workers, needed=n_blocks > 1) as client:
+    with dask_client(scheduler, workers, needed=n_blocks > IN_PROCESS_BLOCKS) as client:
         build_database(store, pair, speeds=sim_speeds, loads=loads, grades=grades,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
                        fault_types=list(fault_types), paired=paired)

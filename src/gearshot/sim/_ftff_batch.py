@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 
 import numba as nb
 import numpy as np
 
+from ._bridge_gap import min_gap
 from ._compliance import (
     _N_SEGMENT,
     _U_TABLE,
@@ -103,61 +105,12 @@ def bridge_batch(pair: GearPair, faults, geometry=None):
 def _retreat(pair: GearPair, u, r, ang):
     """:meth:`FullToothFaceFault._retreat` over a batch: ``u`` (n, n_u) line-of-action
     fractions, flank points ``r, ang`` (n, n_pts). The per-knot part is numpy (the same
-    operations as for one fault); the search over the flank points runs in numba with
-    one arctangent per point (:func:`_min_gap`)."""
+    operations as for one fault); the search over the flank points runs in numba
+    (:func:`._bridge_gap.min_gap`)."""
     rb1, ra1 = pair.base_radius(pair.z_pinion), pair.tip_radius(pair.z_pinion)
     phi_p, centre = contact_angles(pair, u)
-    return _min_gap(np.cos(centre), np.sin(centre), phi_p, r, np.cos(ang), np.sin(ang),
-                    pair.center_distance, rb1, ra1)
-
-
-@nb.njit(cache=True, parallel=True)
-def _min_gap(cc, sc, phi_p, r, ca, sa, o2x, rb1, ra1):
-    """Smallest normal gap (clipped at 0) and the radius of its flank point, per knot.
-
-    A flank point at gear radius r and angle ``centre + ang`` lies at P = o2 + r
-    (cos, sin)(centre + ang) (angle addition); its pinion involute angle is
-    ``atan2(P) + inv(|P|)``, ``inv(rho) = tan(acos(rb1/rho)) - acos(rb1/rho)``, computed as
-    the angle of P turned back by ``acos(rb1/rho)`` (one arctangent) plus
-    ``sqrt(1 - c^2) / c``, c = rb1/|P|; the gap is wrapped to one base pitch circle as in
-    :meth:`FullToothFaceFault._retreat` (equal up to rounding). Points on the pinion's
-    flank ends (base and tip circle) count within a relative 1e-12."""
-    n, n_u = cc.shape
-    n_pts = r.shape[1]
-    ret = np.empty((n, n_u))
-    rad = np.empty((n, n_u))
-    circ = 2.0 * math.pi * rb1
-    half = math.pi * rb1
-    # the pinion flank's ends count (rounding of the rotated points must not drop the
-    # point at the pinion tip, where the contact at u = 1 lies)
-    lo_r, hi_r = rb1 * (1.0 - 1e-12), ra1 * (1.0 + 1e-12)
-    for fm in nb.prange(n * n_u):          # every knot of every fault on its own
-        f, m = fm // n_u, fm % n_u
-        best = np.inf
-        kb = 0
-        cm, sm, pp = cc[f, m], sc[f, m], phi_p[f, m]
-        for k in range(n_pts):
-            cth = cm * ca[f, k] - sm * sa[f, k]
-            sth = sm * ca[f, k] + cm * sa[f, k]
-            px = o2x + r[f, k] * cth
-            py = r[f, k] * sth
-            rp = math.hypot(px, py)
-            if rp < lo_r or rp > hi_r:
-                continue
-            c = rb1 / rp
-            s = math.sqrt(max(1.0 - c * c, 0.0))
-            theta = math.atan2(py * c - px * s, px * c + py * s) + s / c
-            gap = rb1 * (theta - pp)
-            t = gap + half                   # (gap + half) % circ - half, the modulo
-            if t < 0.0 or t >= circ:         # only where it changes t
-                t = t % circ
-            gap = t - half
-            if gap < best:
-                best = gap
-                kb = k
-        ret[f, m] = max(best, 0.0)
-        rad[f, m] = r[f, kb]
-    return ret, rad
+    return min_gap(np.cos(centre), np.sin(centre), phi_p, r, np.cos(ang), np.sin(ang),
+                   pair.center_distance, rb1, ra1)
 
 
 @functools.lru_cache(maxsize=32)
@@ -211,7 +164,7 @@ def _interp_walk(x, xp, fp, j):
     return slope * (x - xp[j]) + fp[j], j
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, nogil=True, parallel=True)
 def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs_tab,
                E, G, L):
     """Bending + shear + axial compliance: the Simpson sums of ``_tooth_compliance``
@@ -257,6 +210,7 @@ def _node_sums(xc, hc, cb, sb, arcs, x0, xb, hb, xi, w, x_tab, h_tab, xs_tab, hs
 _RETREAT_CHUNK = 8          # faults per numpy evaluation of the bridge (memory bound)
 _CACHE: dict = {}           # (pair, fault) -> (k, ef), insertion-ordered
 _CACHE_SIZE = 4096
+_LOCK = threading.Lock()     # guards _CACHE
 
 
 def ftff_tables(pair: GearPair, faults):
@@ -301,7 +255,7 @@ def _interp_point(x, xp, fp, lo, hi):
     return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _segment_points(knots, contact, s0s, s1s, s, g_lo, g_hi, n_seg):
     """The smooth segments of every fault's compliance (``stiffness._segments`` between
     the cut's start, load switch, end and the tip) and the gear roll (m) at their
@@ -350,7 +304,7 @@ def _in_segment(x, a, b):
     return x >= a and (x <= b if b == 1.0 else x < b)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _holds_point(s, a, b):
     for x in s:
         if _in_segment(x, a, b):
@@ -358,7 +312,7 @@ def _holds_point(s, a, b):
     return False
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s, trans):
     """The faulty gear tooth's compliance ``inv`` (interpolated from each segment's
     points, healthy elsewhere) and the displacement excitation ``ef``
@@ -379,14 +333,19 @@ def _fill_tables(inv, ef, s, seg_fault, seg_ab, kts, vals, knots, ret, s0s, s1s,
 
 def ftff_cached(pair: GearPair, faults):
     """``[(k, ef), ...]`` of non-healthy FTFFs (read-only arrays), the missing ones
-    computed in one :func:`ftff_tables` call and kept (the last 4096)."""
-    missing = [f for f in dict.fromkeys(faults) if (pair, f) not in _CACHE]
+    computed in one :func:`ftff_tables` call and kept (the last 4096). Safe to call from
+    several threads (an in-process build runs blocks side by side)."""
+    with _LOCK:
+        found = {f: _CACHE.get((pair, f)) for f in dict.fromkeys(faults)}
+    missing = [f for f, v in found.items() if v is None]
     if missing:
         k, ef = ftff_tables(pair, missing)
         for f, kr, er in zip(missing, k, ef, strict=True):
             kr.setflags(write=False)
             er.setflags(write=False)
-            _CACHE[(pair, f)] = (kr, er)
-        while len(_CACHE) > _CACHE_SIZE:
-            del _CACHE[next(iter(_CACHE))]
-    return [_CACHE[(pair, f)] for f in faults]
+            found[f] = (kr, er)
+        with _LOCK:
+            _CACHE.update(((pair, f), found[f]) for f in missing)
+            while len(_CACHE) > _CACHE_SIZE:
+                del _CACHE[next(iter(_CACHE))]
+    return [found[f] for f in faults]

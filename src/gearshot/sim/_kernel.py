@@ -38,7 +38,7 @@ G0 = 9.80665  # m/s^2 per g
 _ALPHA, _BETA, _GAMMA, _VT, _LOAD, _MOTOR, _INVD, _G, _OUT = range(9)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def contact_slots(mesh_pos, span):
     """The tooth pairs in contact at every step (shared by a batch).
 
@@ -103,7 +103,7 @@ def _table_index(n, u):
     return i, p - i
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def table_shared(pos, count, k_tab):
     """Per contact: cell and fraction on tables as long as ``k_tab``, and the healthy
     stiffness ``k_tab`` there."""
@@ -121,7 +121,7 @@ def table_shared(pos, count, k_tab):
     return cell, frac, k_h
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def spur_shared(pos, count, n_knots, g_nw, p_nw):
     """Per contact: the profile-error noise cell and fraction (``n_knots`` knots, as
     :func:`~gearshot.sim.profile_errors.noise_cell`) and sin/cos of the waviness angle
@@ -271,7 +271,7 @@ def _spur_mesh(n, b0, lanes, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_fra
             fex[g] += w * k * e
 
 
-@nb.njit(cache=True, parallel=True, fastmath=True)
+@nb.njit(cache=True, nogil=True, parallel=True, fastmath=True)
 def newmark_spur(load, motor_acc, count, wgt, pos, gtooth, ptooth, k_h, n_cell, n_frac,
                  trig, kf_tab, ef_tab, f_tooth, g_slope, g_wa, g_wb, g_noise, p_slope, p_wa,
                  p_wb, p_noise, mc, sc, X, V, A, lanes, rec_start, out):
@@ -318,7 +318,7 @@ def _table_mesh(n, b0, lanes, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_ta
             fex[g] += w * fo
 
 
-@nb.njit(cache=True, parallel=True, fastmath=True)
+@nb.njit(cache=True, nogil=True, parallel=True, fastmath=True)
 def newmark_tables(load, motor_acc, count, wgt, gtooth, ptooth, k_h, cell, frac, kf_tab,
                    f_tooth, fg_tab, fp_tab, fpf_tab, mc, sc, X, V, A, lanes, rec_start, out):
     """As :func:`newmark_spur`, with every tooth pair's stiffness and error force read

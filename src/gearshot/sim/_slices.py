@@ -93,7 +93,7 @@ def _running(fp, cum, r, n, step, t):
     return cum[r, i] + step * frac * (f0 + 0.5 * df * frac)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _box_rows(fp, cum, step, tau, lo, hi, eps_beta, out):
     """:func:`box` of every row (its own band ``lo[r] ... hi[r]``) into ``out``."""
     n = fp.shape[1] - 1

@@ -20,11 +20,12 @@ than the FTFF, ``code`` the type's fixed code in :mod:`gearshot.fault_registry`)
 signal's from the block's, so contents do not depend on order or interruption. A build of
 FTFFs only keeps the layout and manifest of stores built before fault types existed.
 
-The pieces: this module builds (:func:`build_database`, one block per task, in-process or
-on a Dask client); :mod:`._db_manifest` writes, checks and restores the manifest;
-:mod:`._db_checksums` writes and checks each block's record; :mod:`._db_load` loads a
-condition (:func:`load_database`); :mod:`._integrity` holds the store's lock and the
-blocks' draws; :mod:`._block_read` reads a block once, checked.
+The pieces: this module builds (:func:`build_database`, one block per task, in-process
+(:mod:`._block_threads`: one block per core side by side) or on a Dask client);
+:mod:`._db_manifest` writes, checks and restores the manifest; :mod:`._db_checksums`
+writes and checks each block's record; :mod:`._db_load` loads a condition
+(:func:`load_database`); :mod:`._integrity` holds the store's lock and the blocks' draws;
+:mod:`._block_read` reads a block once, checked.
 """
 
 from __future__ import annotations
@@ -34,28 +35,29 @@ import shutil
 import sys
 import time
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from .._atomic import atomic_dir, check_writable, remove_tree
-from .._cluster import dask_client
+from .._cluster import IN_PROCESS_BLOCKS, dask_client
 from .._errors import GearshotError
 from .._paths import data_home
 from .._validation import check_finite, check_int, check_load, check_speed, describe
 from ..fault_registry import check_fault_type, fault_type_record
 from ._block_read import resume_problem
+from ._block_threads import block_threads, run_blocks
 from ._db_checksums import ownership_problem, write_checksums
 from ._db_load import load_database
 from ._db_manifest import PAIR_ATTRS, block_name, make_manifest, pair_attrs, prepare_store
 from ._integrity import block_draws, store_lock
-from .dynamics import simulate_sa
+from .dynamics import simulate_sa, simulate_sa_paired
 from .geometry import GearPair
 
 __all__ = ["build_database", "load_database", "default_database_path", "pair_attrs",
            "PAIR_ATTRS"]
 
-_SMALL_BUILD = 16  # blocks; larger builds start a LocalCluster when no client is given
+_SMALL_BUILD = IN_PROCESS_BLOCKS  # larger builds start a LocalCluster when no client is given
 _MAX_POINTS = 1 << 20          # SA length bound (a block row is 8 MiB at this length)
 _MAX_SIGNALS = 1_000_000       # signals per block
 
@@ -93,7 +95,9 @@ def build_database(store, pair: GearPair | None = None, *, speeds, loads, grades
         Run blocks on this client (its workers write the blocks themselves, so the store
         must be on a file system they share). ``None``: a LocalCluster (one
         single-threaded worker process per core) for builds of more than 16 blocks,
-        in-process (numba threads over the batch) otherwise; ``False``: always in-process.
+        in-process otherwise; ``False``: always in-process. In-process, several blocks
+        run side by side on one thread per core (:mod:`._block_threads`), a single block
+        on numba threads over its batches.
     progress : bool
         Show a rich progress bar.
     fault_types : sequence of str
@@ -271,15 +275,18 @@ def _run_tasks(store: Path, pair: GearPair, todo: list[_Task], n_total: int, man
     paired = bool(manifest.get("paired"))
     with progress_of("simulating blocks", n_total, completed=n_total - len(todo),
                      enabled=progress) as bar:
-        if client is None:
-            for t in todo:
-                _build_block(str(store), pair, *t[:6], *args, fault_type=t.fault_type,
-                             paired=paired, manifest=manifest)
+        calls = [(str(store), pair, *t[:6], *args, True, t.fault_type, paired, manifest)
+                 for t in todo]
+        if client is None:     # one block per core side by side (numba: one thread each),
+            n_threads = block_threads(len(todo))     # or numba threads over the batch
+            if n_threads > 1:
+                run_blocks(_build_block, calls, n_threads, bar.advance)
+                return
+            for c in calls:
+                _build_block(*c[:12], False, *c[13:])
                 bar.advance()
             return
-        futures = [client.submit(_build_block, str(store), pair, *t[:6], *args, True,
-                                 t.fault_type, paired, manifest, pure=False)
-                   for t in todo]
+        futures = [client.submit(_build_block, *c, pure=False) for c in calls]
         _collect(client, futures, store, bar)
 
 
@@ -322,16 +329,15 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
     code = fault_type_record(fault_type).code
     n = n_healthy + n_faulty
     sizes, sig_seeds = block_draws(seed, i, j, k, code, n_healthy, n_faulty)
-    sa = simulate_sa(pair, speed=speed, load=load, grade=grade, fault_sizes=sizes,
-                     n_points=n_points, rng=[int(s) for s in sig_seeds],
-                     fault_type=fault_type)
-    data = {"sa": (("signal", "angle"), sa.astype(np.float64),
+    kw: dict[str, Any] = dict(speed=speed, load=load, grade=grade, fault_sizes=sizes,
+                              n_points=n_points, rng=[int(s) for s in sig_seeds],
+                              fault_type=fault_type)
+    sa, twins = simulate_sa_paired(pair, **kw) if paired else (simulate_sa(pair, **kw), None)
+    data = {"sa": (("signal", "angle"), sa,
                    {"units": "g", "long_name": "vertical acceleration SA"})}
-    if paired:
-        data["sa_twin"] = (("signal", "angle"), _healthy_twins(
-            pair, sa, sizes, sig_seeds, speed=speed, load=load, grade=grade,
-            n_points=n_points), {"units": "g", "long_name": "healthy twin SA (same "
-                                 "profile errors, no fault)"})
+    if twins is not None:
+        data["sa_twin"] = (("signal", "angle"), twins, {
+            "units": "g", "long_name": "healthy twin SA (same profile errors, no fault)"})
     ds = xr.Dataset(
         data,
         coords={"fault_size": ("signal", sizes), "grade": ("signal", np.full(n, grade)),
@@ -342,20 +348,18 @@ def _build_block(store: str, pair: GearPair, i: int, j: int, k: int, speed: floa
                "fault_type": fault_type})
     # exist_ok: another worker may have finished the same block first
     with atomic_dir(final, exist_ok=True) as tmp:
-        ds.to_zarr(tmp, mode="w", consolidated=False)
+        ds.to_zarr(tmp, mode="w", consolidated=False, encoding=_sa_encoding(data, n, n_points))
         write_checksums(tmp, manifest)
     return final.name
 
 
-def _healthy_twins(pair, sa, sizes, sig_seeds, *, speed, load, grade, n_points):
-    """The healthy SA of each signal's own gear pair: the same seed (so the same profile
-    errors of both wheels), fault size 0. A healthy signal is its own twin."""
-    twins = np.array(sa, dtype=np.float64, copy=True)
-    faulty = np.flatnonzero(sizes > 0)
-    if faulty.size:
-        twins[faulty] = simulate_sa(pair, speed=speed, load=load, grade=grade,
-                                    fault_sizes=np.zeros(faulty.size), n_points=n_points,
-                                    rng=[int(sig_seeds[i]) for i in faulty])
-    return twins
+_CHUNK_BYTES = 16 << 20     # SA chunk size bound: one chunk per array for a paper block
 
 
+def _sa_encoding(data: dict, n: int, n_points: int) -> dict:
+    """Zarr encoding of the SA arrays: chunks of whole signals up to 16 MiB (one chunk
+    for a block of the paper's 800 signals), uncompressed (zstd saved < 5 % on SAs and
+    cost more CPU than the simulation's serial steps; fewer files to fsync and check).
+    Stores written with other chunks or codecs load the same."""
+    rows = min(n, max(1, _CHUNK_BYTES // (8 * n_points)))
+    return {name: {"chunks": (rows, n_points), "compressors": None} for name in data}

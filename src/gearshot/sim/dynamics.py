@@ -21,10 +21,19 @@ import numpy as np
 import scipy.fft as sp_fft
 
 from .._errors import GearshotError
-from .._validation import check_int, check_load, check_positive, check_speed
+from .._validation import check_int, check_load, check_positive, check_speed, describe
 from ._decimate import StreamingDecimator, fir_half_length
-from ._inputs import as_rng, check_grade, check_pair, draw_errors, profile_fn, resolve_faults
+from ._inputs import (
+    as_rng,
+    check_grade,
+    check_pair,
+    check_sizes,
+    draw_errors,
+    profile_fn,
+    resolve_faults,
+)
 from ._system import integrator, make_batch, system_matrices, warmup_time
+from .faults import ToothFault
 from .geometry import GearPair
 
 __all__ = ["SimulationResult", "simulate", "simulate_sa", "system_matrices",
@@ -90,31 +99,84 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     load = check_load(load)
     grade = check_grade(grade)
     faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type)
-    n_sig = len(faults)
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
-    rng = as_rng(rng, n_sig)
-    t_rev = pair.z_gear / (pair.z_pinion * speed)
-    n_rev = sp_fft.next_fast_len(max(2 * n_points, int(math.ceil(t_rev * min_fs))), real=True)
-    dt = t_rev / n_rev
-    integ = integrator(pair, dt, load)
-    n_warm = int(math.ceil(warmup_time(pair, integ) / dt))
-    n_steps = n_warm + n_rev
-    tau = (np.arange(n_steps) + 1 - n_warm) * dt        # record: tau = 0 ... t_rev - dt
-    mesh_pos = tau * speed * pair.z_pinion
-    zeros = np.zeros(n_steps)
-    loads = np.full(n_steps, load)
-    ge, pe = draw_errors(pair, grade, n_sig, rng, same_gear, average_pinion=True)
-    out = np.empty((n_sig, n_points))
-    shared = None                        # the same steps for every batch: computed once
-    for start in range(0, n_sig, _BATCH_CHUNK):
-        sl = slice(start, start + _BATCH_CHUNK)
-        batch = make_batch(pair, integ, faults[sl], ge[sl], pe[sl])
-        if shared is None:
-            shared = batch.shared(mesh_pos)
-        acc = batch.run(mesh_pos, zeros, loads, n_warm - 1, n_rev, shared)
-        out[sl] = _fft_resample(acc, n_points)
-    return out
+    rng = as_rng(rng, len(faults))
+    run = _SteadyRun(pair, speed, load, n_points, min_fs)
+    ge, pe = draw_errors(pair, grade, len(faults), rng, same_gear, average_pinion=True)
+    return run.sas(faults, ge, pe)
+
+
+def simulate_sa_paired(pair: GearPair, *, speed: float, load: float, grade: int,
+                       fault_sizes, rng: list, n_points: int = 2048,
+                       fault_type: str = "ftff") -> tuple[np.ndarray, np.ndarray]:
+    """SAs of :func:`simulate_sa` (one seed per signal in ``rng``) and each signal's
+    healthy twin: the SA of the same gear pair (the same profile errors) without the
+    fault; a healthy signal (size 0) is its own twin.
+
+    The twins reuse the signals' profile errors, integrator and batch-shared contacts
+    instead of drawing and computing them again: equal to
+    ``simulate_sa(..., fault_sizes=zeros, rng=<the faulty signals' seeds>)``, bit for
+    bit (the same batches of 64 faulty signals).
+
+    Returns
+    -------
+    sa, twins : ndarray (n_signals, n_points)
+    """
+    check_pair(pair)
+    speed = check_speed(speed)
+    load = check_load(load)
+    grade = check_grade(grade)
+    faults = resolve_faults(fault_sizes, None, 0.5, 0.5, fault_type)
+    sizes = check_sizes(fault_sizes)
+    n_points = check_int(n_points, "n_points", minimum=16)
+    if not isinstance(rng, (list, tuple)):
+        raise GearshotError(f"rng must hold one seed per signal; got {describe(rng)}")
+    rng = as_rng(rng, len(faults))
+    run = _SteadyRun(pair, speed, load, n_points, DEFAULT_MIN_FS)
+    ge, pe = draw_errors(pair, grade, len(faults), rng, False, average_pinion=True)
+    sa = run.sas(faults, ge, pe)
+    twins = np.array(sa, dtype=np.float64, copy=True)
+    faulty = np.flatnonzero(sizes > 0)
+    if faulty.size:
+        healthy = [ToothFault()] * faulty.size      # what a size-0 fault of any type is
+        twins[faulty] = run.sas(healthy, [ge[i] for i in faulty], [pe[i] for i in faulty])
+    return sa, twins
+
+
+class _SteadyRun:
+    """The steady-state run of :func:`simulate_sa` for one pair and condition: time step,
+    warm-up, integrator and mesh positions, and the batch-shared contact data (computed
+    by the first batch, then reused by every batch of the run); arguments checked."""
+
+    def __init__(self, pair, speed, load, n_points, min_fs):
+        self.pair, self.load, self.n_points = pair, load, n_points
+        t_rev = pair.z_gear / (pair.z_pinion * speed)
+        self.n_rev = sp_fft.next_fast_len(max(2 * self.n_points, int(math.ceil(t_rev * min_fs))),
+                                          real=True)
+        dt = t_rev / self.n_rev
+        self.integ = integrator(pair, dt, self.load)
+        self.n_warm = int(math.ceil(warmup_time(pair, self.integ) / dt))
+        n_steps = self.n_warm + self.n_rev
+        tau = (np.arange(n_steps) + 1 - self.n_warm) * dt   # record: tau = 0 ... t_rev - dt
+        self.mesh_pos = tau * speed * pair.z_pinion
+        self.shared = None
+
+    def sas(self, faults, ge, pe) -> np.ndarray:
+        """SAs of signals with these faults and profile errors, in batches of 64."""
+        n_steps = self.mesh_pos.size
+        zeros = np.zeros(n_steps)
+        loads = np.full(n_steps, self.load)
+        out = np.empty((len(faults), self.n_points))
+        for start in range(0, len(faults), _BATCH_CHUNK):
+            sl = slice(start, start + _BATCH_CHUNK)
+            batch = make_batch(self.pair, self.integ, faults[sl], ge[sl], pe[sl])
+            if self.shared is None:
+                self.shared = batch.shared(self.mesh_pos)
+            acc = batch.run(self.mesh_pos, zeros, loads, self.n_warm - 1, self.n_rev,
+                            self.shared)
+            out[sl] = _fft_resample(acc, self.n_points)
+        return out
 
 
 def _fft_resample(x: np.ndarray, n_out: int) -> np.ndarray:

@@ -70,7 +70,8 @@ def simulate(
     scheduler: str | None = typer.Option(None, "--scheduler", help="Address of a "
                                             "running Dask scheduler."),
     workers: int = typer.Option(2, "--workers", help="LocalCluster workers when no "
-                                "--scheduler is given."),
+                                "--scheduler is given (builds of up to 16 blocks run "
+                                "in-process, one block per core)."),
     fault_type: list[str] = typer.Option(["ftff"], "--fault-type", help="Fault type(s): "
                                          f"{', '.join(FAULT_TYPE_NAMES)}."),
     machine: Path | None = typer.Option(None, "--machine", help=HELP_MACHINE),
