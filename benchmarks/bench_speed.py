@@ -304,10 +304,11 @@ def bench_compare(args):
 
 
 def _workers_usage(client) -> tuple[float, float]:
-    """(CPU seconds so far summed over the workers, largest worker peak RSS in MB)."""
+    """(CPU seconds so far summed over the workers, largest worker peak RSS in MB: their
+    own, VmHWM, see :func:`_own_peak_mb`)."""
     def usage():
         r = resource.getrusage(resource.RUSAGE_SELF)
-        return r.ru_utime + r.ru_stime, r.ru_maxrss / 1024
+        return r.ru_utime + r.ru_stime, _own_peak_mb()
 
     got = client.run(usage).values()
     return sum(c for c, _ in got), max(m for _, m in got)
