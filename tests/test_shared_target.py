@@ -139,28 +139,21 @@ def test_subtract_with_lags_is_subtract_healthy_bit_for_bit():
         subtract_with_lags(x, refs, lags=lags.astype(float))
 
 
-def test_sweep_task_reads_its_database_on_the_worker(monkeypatch):
-    """Under the distributed scheduler a task's lazy Zarr read would go to the scheduler as
-    a graph (the 24 MB "large graph" warnings of the paired paper sweep) and back."""
+def test_reading_a_database_involves_no_dask_scheduler(tmp_path):
+    """A block is decoded straight into numpy: under the distributed scheduler a lazy Zarr
+    read inside a task (a sweep condition, a family rig) would go to the scheduler as a
+    graph (the 24 MB "large graph" warnings of the paired paper sweep) and back."""
     import dask
-    import xarray as xr
 
-    import gearshot.sim as sim
-    from gearshot.experiments.runner import _simulated_task
+    from gearshot.sim import build_database, load_database
 
-    rng = np.random.default_rng(4)
-    y = np.r_[np.zeros(40), rng.uniform(0, 1, 160)]
-    seen = []
+    def no_scheduler(*args, **kwargs):
+        raise AssertionError("a dask scheduler was asked to compute")
 
-    def fake_load(store, **kw):
-        seen.append(dask.config.get("scheduler", None))
-        return xr.Dataset({"sa": (("signal", "angle"), synthetic_sa(y, 4, rng))},
-                          coords={"fault_size": ("signal", y)})
-
-    monkeypatch.setattr(sim, "load_database", fake_load)
-    frame = _simulated_task(dict(store="unused", speed=15.0, load=10.0, grade=7,
-                                 attenuation_db=10.0, tfs=["synthetic_000"],
-                                 selection_tf="synthetic_023", variants=["before_da"],
-                                 frf_folder=None, seed=0))
-    assert seen == ["synchronous"]
-    assert list(frame["variant"]) == ["before_da"] and frame["mae"].between(0, 1).all()
+    store = tmp_path / "db"
+    build_database(store, speeds=[15], loads=[10], grades=[5, 7], n_healthy=2, n_faulty=3,
+                   seed=4, client=False, progress=False, paired=True)
+    with dask.config.set(scheduler=no_scheduler):
+        db = load_database(store, speed=15, load=10)
+    assert all(isinstance(db[name].variable._data, np.ndarray) for name in ("sa", "sa_twin"))
+    assert db.sa.shape == (10, 2048) and np.isfinite(db.sa_twin.values).all()

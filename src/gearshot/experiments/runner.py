@@ -83,16 +83,11 @@ def _write_parquet_atomic(frame: pd.DataFrame, path: Path) -> None:
 
 def _simulated_task(spec: dict) -> pd.DataFrame:
     """One (speed, load, attenuation): every test TF × variant. Runs on a Dask worker."""
-    import dask
-
     from ..sim import load_database
     from .simulated import simulated_dataset
 
-    # read here, on this worker: under the distributed scheduler the store's lazy arrays
-    # would go to the scheduler as a graph (~24 MB per condition) and back as a result
-    with dask.config.set(scheduler="synchronous"):
-        db = load_database(spec["store"], speed=spec["speed"], load=spec["load"],
-                           grade=spec["grade"])
+    db = load_database(spec["store"], speed=spec["speed"], load=spec["load"],
+                       grade=spec["grade"])
     sa = db["sa"].values
     y = db["fault_size"].values
     bank = _bank(spec)

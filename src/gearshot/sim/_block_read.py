@@ -56,7 +56,10 @@ def read_block(path: Path):
                           f"{list(want)})")
         content[rel] = buf.from_bytes(data)
     try:
-        ds = xr.open_zarr(zarr.storage.MemoryStore(content), consolidated=False).load()
+        # chunks=None: decoded straight into numpy, no dask graph, so no scheduler is
+        # involved (on a Dask worker a lazy read would go to the scheduler and back)
+        ds = xr.open_zarr(zarr.storage.MemoryStore(content), consolidated=False,
+                          chunks=None).load()
     except Exception as exc:  # a decoder's error on a damaged chunk
         return None, f"it cannot be decoded ({type(exc).__name__}: {exc})"
     return ds, None
