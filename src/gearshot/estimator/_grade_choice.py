@@ -79,11 +79,13 @@ def _matched_noise(cache: dict[str, Any], power: FloatArray, n_points: int, seed
     """The residue noise of ``n_signals`` simulated signals (noise matching).
 
     Drawn from the ``match_noise`` step seed afresh for every set, so every grade and
-    setting of the same size gets the same draw: it is drawn once and kept in ``cache``."""
+    setting of the same size gets the same draw: it is drawn once and kept in ``cache``,
+    as the inverse FFT of :func:`_matched_noise_spectrum` (what
+    :func:`~gearshot.estimator.steps.residue_noise` computes from the same draw)."""
     key = f"noise/{n_signals}"
     if key not in cache:
-        rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
-        cache[key] = steps.residue_noise(power, n_signals, n_points, rng)
+        spectrum = _matched_noise_spectrum(cache, power, n_points, seed, n_signals)
+        cache[key] = np.asarray(np.fft.irfft(spectrum, n=n_points, axis=-1), np.float64)
     noise: FloatArray = cache[key]
     return noise
 
@@ -92,7 +94,7 @@ def _matched_noise_spectrum(cache: dict[str, Any], power: FloatArray, n_points: 
                             seed: int, n_signals: int) -> NDArray[np.complex128]:
     """The ``rfft`` of :func:`_matched_noise` (what the grade models add), kept in ``cache``."""
     key = f"noise_spectrum/{n_signals}"
-    if key not in cache:   # the same draw as _matched_noise, as its spectrum
+    if key not in cache:
         rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
         cache[key] = residue_noise_spectrum(power, n_signals, n_points, rng)
     spectrum: NDArray[np.complex128] = cache[key]
