@@ -94,17 +94,27 @@ def simulate_sa(pair: GearPair, *, speed: float, load: float, grade: int, fault_
     ndarray (n_signals, n_points)
         Vertical acceleration SAs, g.
     """
+    run, faults, ge, pe = _prepared_run(
+        pair, speed, load, grade, n_points, min_fs, rng, same_gear,
+        lambda: resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type))
+    return run.sas(faults, ge, pe)
+
+
+def _prepared_run(pair, speed, load, grade, n_points, min_fs, rng, same_gear, faults_of):
+    """Arguments checked (in this order), then the run, the faults (``faults_of()``) and
+    each signal's profile errors: what :func:`simulate_sa` and :func:`simulate_sa_paired`
+    integrate."""
     check_pair(pair)
     speed = check_speed(speed)
     load = check_load(load)
     grade = check_grade(grade)
-    faults = resolve_faults(fault_sizes, faults, fault_center, fault_depth, fault_type)
+    faults = faults_of()
     n_points = check_int(n_points, "n_points", minimum=16)
     min_fs = check_positive(min_fs, "min_fs")
     rng = as_rng(rng, len(faults))
     run = _SteadyRun(pair, speed, load, n_points, min_fs)
     ge, pe = draw_errors(pair, grade, len(faults), rng, same_gear, average_pinion=True)
-    return run.sas(faults, ge, pe)
+    return run, faults, ge, pe
 
 
 def simulate_sa_paired(pair: GearPair, *, speed: float, load: float, grade: int,
@@ -123,18 +133,12 @@ def simulate_sa_paired(pair: GearPair, *, speed: float, load: float, grade: int,
     -------
     sa, twins : ndarray (n_signals, n_points)
     """
-    check_pair(pair)
-    speed = check_speed(speed)
-    load = check_load(load)
-    grade = check_grade(grade)
-    faults = resolve_faults(fault_sizes, None, 0.5, 0.5, fault_type)
-    sizes = check_sizes(fault_sizes)
-    n_points = check_int(n_points, "n_points", minimum=16)
     if not isinstance(rng, (list, tuple)):
         raise GearshotError(f"rng must hold one seed per signal; got {describe(rng)}")
-    rng = as_rng(rng, len(faults))
-    run = _SteadyRun(pair, speed, load, n_points, DEFAULT_MIN_FS)
-    ge, pe = draw_errors(pair, grade, len(faults), rng, False, average_pinion=True)
+    run, faults, ge, pe = _prepared_run(
+        pair, speed, load, grade, n_points, DEFAULT_MIN_FS, rng, False,
+        lambda: resolve_faults(fault_sizes, None, 0.5, 0.5, fault_type))
+    sizes = check_sizes(fault_sizes)
     sa = run.sas(faults, ge, pe)
     twins = np.array(sa, dtype=np.float64, copy=True)
     faulty = np.flatnonzero(sizes > 0)
