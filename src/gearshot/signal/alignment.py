@@ -158,14 +158,8 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
     >>> print(int(index), round(float(delay), 2), bool(np.allclose(residual, fault)))
     1 2.25 True
     """
-    signals = as_signal_array(signals, "signals", min_length=2)
-    refs = as_signal_array(healthy_refs, "healthy_refs", max_ndim=2, min_length=2)
-    refs = np.atleast_2d(refs)
-    upsample = check_int(upsample, "upsample", minimum=1, maximum=10_000)
+    signals, refs, upsample = _checked(signals, healthy_refs, upsample, max_ndim=None)
     n = signals.shape[-1]
-    if refs.shape[-1] != n:
-        raise GearshotError(
-            f"healthy_refs have {refs.shape[-1]} points per cycle but signals have {n}")
     residual, ref_index, delays, _ = _subtract(signals.reshape(-1, n), refs, upsample,
                                                prune=True)
     residual = residual.reshape(signals.shape)
@@ -173,6 +167,20 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
         batch_shape = signals.shape[:-1]
         return residual, ref_index.reshape(batch_shape), delays.reshape(batch_shape)
     return residual
+
+
+def _checked(signals: ArrayLike, healthy_refs: ArrayLike, upsample: int, *,
+             max_ndim: int | None) -> tuple[FloatArray, FloatArray, int]:
+    """The inputs of :func:`subtract_healthy` / :func:`subtract_with_lags`, checked:
+    signals, references as rows (n_refs, n) of the same length, ``upsample``."""
+    x = as_signal_array(signals, "signals", max_ndim=max_ndim, min_length=2)
+    refs = np.atleast_2d(as_signal_array(healthy_refs, "healthy_refs", max_ndim=2,
+                                         min_length=2))
+    upsample = check_int(upsample, "upsample", minimum=1, maximum=10_000)
+    if refs.shape[-1] != x.shape[-1]:
+        raise GearshotError(f"healthy_refs have {refs.shape[-1]} points per cycle but "
+                            f"signals have {x.shape[-1]}")
+    return x, refs, upsample
 
 
 def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
@@ -245,14 +253,8 @@ def subtract_with_lags(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample:
     >>> bool(np.array_equal(half, subtract_healthy(signals / 2, refs / 2)))
     True
     """
-    x = as_signal_array(signals, "signals", max_ndim=2, min_length=2)
+    x, refs, upsample = _checked(signals, healthy_refs, upsample, max_ndim=2)
     flat = np.atleast_2d(x)
-    refs = np.atleast_2d(as_signal_array(healthy_refs, "healthy_refs", max_ndim=2,
-                                         min_length=2))
-    upsample = check_int(upsample, "upsample", minimum=1, maximum=10_000)
-    if refs.shape[-1] != flat.shape[-1]:
-        raise GearshotError(f"healthy_refs have {refs.shape[-1]} points per cycle but "
-                            f"signals have {flat.shape[-1]}")
     given = None
     if lags is not None:
         given = np.asarray(lags)
