@@ -22,14 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .speed_profile import _decimated, _levels
+from .speed_profile import _RATIOS, _decimated, _gain, _levels
 
 __all__ = ["RATIOS", "whole_order_scores"]
 
 #: Speed ratios a comb of whole orders may lock on.
-RATIOS = (1 / 2, 2 / 3, 3 / 2, 2.0)
-_FLOOR_DB = 10.0  # a whole order scores only above this level over the local floor
-_CAP_DB = 30.0  # one order counts at most this much
+RATIOS = _RATIOS
 
 
 def whole_order_scores(x: np.ndarray, fs: float, times: np.ndarray, angle: np.ndarray, *,
@@ -82,7 +80,7 @@ def whole_order_scores(x: np.ndarray, fs: float, times: np.ndarray, angle: np.nd
     n = 1 << int(np.ceil(np.log2(2 * grid.size)))
     level = _levels(np.abs(np.fft.rfft(z, n)) ** 2)
     d_order = 1.0 / (n * step)  # bin width, orders of the tracked speed
-    gain = np.clip(level - _FLOOR_DB, 0.0, _CAP_DB)
+    gain = _gain(level)
     out = {}
     for r in ratios:
         j = np.arange(1, int(top_order / r) + 1)

@@ -18,8 +18,7 @@ refined together by maximizing the coherent power of the lines that stand out
 (Nelder–Mead, :func:`scipy.optimize.minimize`).
 
 A line's level is its power over the local floor (a running median of the spectrum,
-:func:`scipy.ndimage.median_filter`) in dB; the comb's score sums the levels above
-:data:`_FLOOR_DB` (noise bins rarely reach it), capped at :data:`_CAP_DB`.
+:func:`scipy.ndimage.median_filter`) in dB; the comb's score sums their :func:`_gain`.
 """
 
 from __future__ import annotations
@@ -36,11 +35,11 @@ from .ridge import _orders, _speed_range
 
 __all__ = ["SpeedProfile", "fit_speed_profile"]
 
-_FLOOR_DB = 10.0  # a comb line scores only above this level over the local floor
+_FLOOR_DB = 10.0  # a comb line scores only above this level over the floor (noise: rarely)
 _CAP_DB = 30.0  # one line counts at most this much
 _LINE_DB = 15.0  # a line "stands out" in the whole-record order spectrum (noise: < 14)
 _SHAFT_WEIGHT = 0.5  # a whole order that is no mesh line counts half (f / j fits any line)
-_RATIOS = (1 / 2, 2 / 3, 3 / 2, 2)  # speed ratios a comb of whole orders cannot tell
+_RATIOS = (1 / 2, 2 / 3, 3 / 2, 2.0)  # speed ratios a comb of whole orders cannot tell
 _RATES = 160  # rates searched on the first span at most
 _KEEP = 6  # rate candidates carried from one stage to the next
 _KEEP_LAST = 3  # ... into the whole record's stage (the half record has sorted them)
@@ -138,6 +137,11 @@ def _spectrum(y: np.ndarray, dt: float, u: np.ndarray, shape: tuple[float, float
     return np.abs(np.fft.rfft(z, n)) ** 2, 1.0 / (n * step)
 
 
+def _gain(level: np.ndarray) -> np.ndarray:
+    """A line's share of a comb score: dB over :data:`_FLOOR_DB`, at most :data:`_CAP_DB`."""
+    return np.asarray(np.clip(level - _FLOOR_DB, 0.0, _CAP_DB))
+
+
 def _levels(power: np.ndarray) -> np.ndarray:
     """Level over the local floor, dB: the floor is the median of blocks of
     :data:`_MEDIAN_BINS` bins, interpolated between the blocks' centres."""
@@ -173,7 +177,7 @@ def _comb(level: np.ndarray, df: float, lines: np.ndarray, speeds: np.ndarray,
     slowest speed keeps) orders the cells; exact scores are computed cell by cell until
     no bound is above the best — the same maximum as scoring every speed."""
     import scipy.ndimage
-    gain = np.clip(level - _FLOOR_DB, 0.0, _CAP_DB).astype(np.float32)
+    gain = _gain(level).astype(np.float32)
     gain = np.maximum(gain[:-1], gain[1:])  # the line between two bins: the larger
     orders = np.arange(1.0, max(float(lines.max()), top_hz / float(speeds.min())) + 1.0)
     mesh = np.isin(orders, lines)
