@@ -57,7 +57,6 @@ from .geometry import GearPair
 __all__ = ["build_database", "load_database", "default_database_path", "pair_attrs",
            "PAIR_ATTRS"]
 
-_SMALL_BUILD = IN_PROCESS_BLOCKS  # larger builds start a LocalCluster when no client is given
 _MAX_POINTS = 1 << 20          # SA length bound (a block row is 8 MiB at this length)
 _MAX_SIGNALS = 1_000_000       # signals per block
 
@@ -230,7 +229,7 @@ def _build_locked(store: Path, pair: GearPair, manifest: dict, client, progress)
     todo = _blocks_to_build(store, manifest, tasks, progress)
     # no client given and many blocks: a LocalCluster of one worker per core, closed after
     with dask_client(None, os.cpu_count() or 1,
-                     needed=client is None and len(todo) > _SMALL_BUILD) as own:
+                     needed=client is None and len(todo) > IN_PROCESS_BLOCKS) as own:
         _run_tasks(store, pair, todo, len(tasks), manifest, client or own, progress)
 
 
