@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .speed_profile import _RATIOS, _decimated, _gain, _levels
+from .ridge import _RATIOS
+from .speed_profile import _decimated, _gain, _levels
 
 __all__ = ["RATIOS", "whole_order_scores"]
 

@@ -81,6 +81,18 @@ def _speed_range(speed_range: Any) -> tuple[float, float]:
     return lo, hi
 
 
+#: Speed ratios a comb of whole orders may lock on (a multi-shaft train's lines fit them).
+_RATIOS = (1 / 2, 2 / 3, 3 / 2, 2.0)
+
+
+def _ratios_in_range(speed_range: tuple[float, float], slow: float, fast: float
+                     ) -> tuple[float, ...]:
+    """The ratios ``r`` of :data:`_RATIOS` for which speeds from ``slow`` to ``fast``
+    times ``r`` also lie inside ``speed_range``: a comb there cannot exclude them."""
+    lo, hi = speed_range
+    return tuple(r for r in _RATIOS if lo <= r * slow and r * fast <= hi)
+
+
 def speed_ridge(x: np.ndarray, fs: float, *, orders: Any, speed_range: Any,
                 n_harmonics: int = 3, window: float = 0.5, max_rate: float | None = None,
                 smooth: float = 0.5, track: int | None = None) -> SpeedRidge:

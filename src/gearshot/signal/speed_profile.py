@@ -31,7 +31,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_int, check_positive
-from .ridge import _orders, _speed_range
+from .ridge import _orders, _ratios_in_range, _speed_range
 
 __all__ = ["SpeedProfile", "fit_speed_profile"]
 
@@ -39,7 +39,6 @@ _FLOOR_DB = 10.0  # a comb line scores only above this level over the floor (noi
 _CAP_DB = 30.0  # one line counts at most this much
 _LINE_DB = 15.0  # a line "stands out" in the whole-record order spectrum (noise: < 14)
 _SHAFT_WEIGHT = 0.5  # a whole order that is no mesh line counts half (f / j fits any line)
-_RATIOS = (1 / 2, 2 / 3, 3 / 2, 2.0)  # speed ratios a comb of whole orders cannot tell
 _RATES = 160  # rates searched on the first span at most
 _KEEP = 6  # rate candidates carried from one stage to the next
 _KEEP_LAST = 3  # ... into the whole record's stage (the half record has sorted them)
@@ -75,13 +74,9 @@ class SpeedProfile:
         record (0 to ``duration`` s) also lies inside ``speed_range``, else None: there
         the whole orders of a multi-shaft train (other shafts' harmonics at fractional
         orders) may fit ``r`` times the true speed as well, and the fit cannot tell."""
-        t = np.linspace(0.0, duration, 65)
-        s = self.speed(t)
-        lo, hi = speed_range
-        for r in _RATIOS:
-            if lo <= r * float(s.min()) and r * float(s.max()) <= hi:
-                return float(r)
-        return None
+        s = self.speed(np.linspace(0.0, duration, 65))
+        found = _ratios_in_range(speed_range, float(s.min()), float(s.max()))
+        return float(found[0]) if found else None
 
     def speed(self, t: np.ndarray) -> np.ndarray:
         """Shaft speed at times ``t`` (s from the first sample), rev/s."""

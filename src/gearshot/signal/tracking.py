@@ -60,8 +60,8 @@ from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range, check_int, check_positive
 from .demodulation import angle_pulse_times, demodulate_angle
 from .harmonic_phase import _db, _fused, _inner, _Pass, _phase_pass
-from .ratio_check import RATIOS, whole_order_scores
-from .ridge import SpeedRidge, _orders, _speed_range, speed_ridge
+from .ratio_check import whole_order_scores
+from .ridge import SpeedRidge, _orders, _ratios_in_range, _speed_range, speed_ridge
 from .speed_profile import SpeedProfile, _fit
 
 __all__ = ["SpeedRidge", "ShaftAngle", "speed_ridge", "demodulate_angle", "angle_pulse_times",
@@ -334,8 +334,8 @@ def _ratio_checked(x: np.ndarray, fs: float, est: ShaftAngle, kw: dict[str, Any]
     orders :data:`_RATIO_SWITCH` times as strong) and that ridge passes every check, else
     a refusal naming both speeds."""
     lo, hi = _speed_range(kw["speed_range"])
-    slow, fast = float(est.ridge.speed.min()), float(est.ridge.speed.max())
-    alts = tuple(r for r in RATIOS if lo <= r * slow and r * fast <= hi)
+    alts = _ratios_in_range((lo, hi), float(est.ridge.speed.min()),
+                            float(est.ridge.speed.max()))
     if not alts:
         return est
     top = 2.0 * float(est.order if kw.get("track") is not None else _orders(kw["orders"])[0])
