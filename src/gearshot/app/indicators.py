@@ -143,7 +143,11 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         ``{"kind": "indicators", "machine", "machine_file", "shaft", "tacho_shaft",
         "shaft_speed_ratio", "units", "records": [...]}``; one record per file and
         sensor: ``{"file", "sensor", "tacho_speed_hz", "shaft_speed_hz", "speed_source",
-        "speed_uncertainty_hz", "n_cycles", "indicators"}``. ``tacho_speed_hz`` is the mean
+        "speed_uncertainty_hz", "n_cycles", "indicators", "input_check"}``;
+        ``input_check`` is ``"ok"`` or the failed check of
+        :mod:`gearshot.io.input_health` (a dead, constant, clipped or implausible
+        channel), whose ``indicators`` are then all null and ``n_cycles`` null.
+        ``tacho_speed_hz`` is the mean
         speed of the machine's reference (tacho) shaft, read from the tacho
         (``speed_source="tacho"``) or, for a machine without ``[tacho]``, estimated from the
         vibration (``"vibration"``, with the standard uncertainty of the instantaneous
@@ -183,17 +187,34 @@ def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
     """The payload records of one file: one per sensor."""
     from ..io import Recording
 
+    from ..features import available_features
+    from ..io.input_health import check_input
+
     rec = Recording.read(path, machine=machine)
-    tacho = float(rec.shaft_speed())
+    checks = {n: check_input(rec.channel(n).acceleration, units=machine.sensor(n).unit)
+              for n in names}
+    try:
+        tacho = float(rec.shaft_speed())
+    except GearshotError as exc:   # no tacho: the speed comes from a failed sensor?
+        bad = [f"{n}: {c.failed} ({c.reason})" for n, c in checks.items() if not c.ok]
+        if bad:
+            raise GearshotError(f"{str(path)!r} fails the input check of "
+                                f"{'; '.join(bad)}; {exc}") from None
+        raise
     rows = []
     for name in names:
-        res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
-                               baseline=baselines[name])[name]
+        if checks[name].ok:
+            res = shaft_indicators(rec, machine, shaft=shaft, sensors=[name],
+                                   baseline=baselines[name])[name]
+        else:   # no indicator of a failed channel: null, with the check named
+            res = {"n_cycles": None, "indicators": dict.fromkeys(
+                (*available_features(), *INDICATOR_EXTRAS))}
         rows.append({"file": Path(path).name, "sensor": name,
                      "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
                      "speed_source": rec.speed_source,
                      "speed_uncertainty_hz": rec.speed_uncertainty,
-                     "n_cycles": res["n_cycles"], "indicators": res["indicators"]})
+                     "n_cycles": res["n_cycles"], "indicators": res["indicators"],
+                     "input_check": checks[name].label})
     return rows
 
 
@@ -207,12 +228,13 @@ def _case_of(file_name: str) -> tuple[str, str]:
 def format_indicators(payload: dict[str, Any]) -> str:
     """The payload as the aligned text table ``gearshot indicators`` prints (one row per
     record and sensor; plain Python, so that a one-record call does not import pandas)."""
-    head = ["file", "sensor", "tacho_hz", "shaft_hz", "n_cycles"]
+    head = ["file", "sensor", "tacho_hz", "shaft_hz", "n_cycles", "input_check"]
     rows = []
     for r in payload["records"]:
         rows.append([r["file"], r.get("sensor", ""), f"{r['tacho_speed_hz']:.4g}",
-                     f"{r['shaft_speed_hz']:.4g}", str(r["n_cycles"])]
-                    + [f"{v:.4g}" for v in r["indicators"].values()])
+                     f"{r['shaft_speed_hz']:.4g}", str(r["n_cycles"]),
+                     r.get("input_check", "ok")]
+                    + ["null" if v is None else f"{v:.4g}" for v in r["indicators"].values()])
     if payload["records"]:
         head += list(payload["records"][0]["indicators"])
     widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
@@ -227,7 +249,8 @@ def indicator_table(payload: dict[str, Any]):
     rows = []
     for r in payload["records"]:
         case, cond = _case_of(r["file"])
-        extra = {k: r[k] for k in ("speed_source", "speed_uncertainty_hz") if k in r}
+        extra = {k: r[k] for k in ("speed_source", "speed_uncertainty_hz", "input_check")
+                 if k in r}
         rows.append({"file": r["file"], "case": case, "condition": cond,
                      "sensor": r.get("sensor", ""),
                      "tacho_speed_hz": r.get("tacho_speed_hz", r.get("speed_hz")),
@@ -238,7 +261,7 @@ def indicator_table(payload: dict[str, Any]):
 
 _META = ("file", "case", "condition", "sensor", "tacho_speed_hz", "shaft_speed_hz",
          "speed_source", "speed_uncertainty_hz",
-         "n_cycles")
+         "n_cycles", "input_check")
 
 
 def indicator_figures(payload: dict[str, Any], folder: str | Path, *,

@@ -10,6 +10,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range
+from ..io.input_health import input_check_column, mark_rows, require_ok
 from ..paper import GEAR_TEETH, PINION_TEETH
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
@@ -54,9 +55,12 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, predicted, low, high, comparability, comparable``
-        (roles: :data:`ROLES`; the last two from
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
+        ``recording, role, segment, predicted, low, high, comparability, comparable,
+        input_check`` (roles: :data:`ROLES`; ``comparability``/``comparable`` from
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`; ``input_check``:
+        ``"ok"`` or the failed check of :mod:`gearshot.io.input_health`, per recording and
+        segment, with ``predicted``/``low``/``high`` withdrawn (NaN) on a failed row). A
+        healthy or faulty recording that fails an input check is refused.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
@@ -79,7 +83,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    targets, healthy_sa, long, example = _segments(files, healthy, faulty, kw)
+    targets, healthy_sa, long, example, health = _segments(files, healthy, faulty, kw)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
@@ -95,6 +99,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
                                         predicted=est.predict(sa), low=low, high=high,
                                         comparability=comp.score,
                                         comparable=comp.comparable)))
+        mark_rows(frames[-1], input_check_column(**health[_key(path)]))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load
     return frame
@@ -109,16 +114,27 @@ def _segments(files, healthy, faulty, kw):
     """
     from ..io import recording_segments
 
-    targets = [(path, recording_segments(path, **kw)) for path in files]
+    health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)
+
+    def cut(path, role=None, **more):
+        found: dict = {}
+        out = recording_segments(path, health=found, **more, **kw)
+        health[_key(path)] = found
+        if role is not None:   # a recording the fit uses: refused unless every check passes
+            for check in (found["recording"], *found["segments"]):
+                require_ok(check, path, role)
+        return out
+
+    targets = [(path, cut(path)) for path in files]
     healthy_sa, long = [], None
     for i, p in enumerate(healthy):
         if i == 0:
-            sa, long = recording_segments(p, long=True, **kw)
+            sa, long = cut(p, "healthy", long=True)
         else:
-            sa = recording_segments(p, **kw)
+            sa = cut(p, "healthy")
         healthy_sa.append(sa)
-    example = recording_segments(faulty, **kw)[0]
-    return targets, np.vstack(healthy_sa), long, example
+    example = cut(faulty, "faulty")[0]
+    return targets, np.vstack(healthy_sa), long, example, health
 
 
 def _key(path) -> Path:

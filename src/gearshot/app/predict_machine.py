@@ -12,6 +12,8 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
+from ..io.input_health import (check_input, check_segments, input_check_column, mark_rows,
+                               require_ok)
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 
@@ -33,8 +35,9 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     """SA segments of the monitored gear's shaft for one recording file.
 
     ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
-    machine without ``[tacho]``) and ``speed_uncertainty_hz`` (rev/s of the reference
-    shaft, ``None`` with a tacho).
+    machine without ``[tacho]``), ``speed_uncertainty_hz`` (rev/s of the reference
+    shaft, ``None`` with a tacho) and the sensor's input checks
+    (:mod:`gearshot.io.input_health`): ``recording`` and ``segments``.
 
     Returns
     -------
@@ -62,7 +65,21 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
     if info is not None:
         info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
+        info.update(input_health(rec.channel(name).acceleration, blocks.mean(axis=1),
+                                 machine.sensor(name).unit))
     return blocks.mean(axis=1), x, rec.shaft_speed()
+
+
+def input_health(raw, sas, unit) -> dict:
+    """The input checks of one sensor of a recording: its raw samples and its SA
+    segments (:mod:`gearshot.io.input_health`)."""
+    return dict(recording=check_input(raw, units=unit), segments=check_segments(sas, units=unit))
+
+
+def _require_healthy_input(info: dict, path, role: str) -> None:
+    """Refuse a recording the fit uses unless it and each of its segments pass."""
+    for check in (info["recording"], *info["segments"]):
+        require_ok(check, path, role)
 
 
 def _comparability_columns(est, sas) -> tuple[np.ndarray, np.ndarray]:
@@ -139,7 +156,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
         segment looks like the fitted machine; ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
-        ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
+        ``vibration``; ``input_check``: ``"ok"`` or the failed check of
+        :mod:`gearshot.io.input_health`, per recording and segment, with the row's
+        ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
+        recording that fails is refused); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
         ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
         reference.
     """
@@ -210,6 +230,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
 
     for p in healthy:
         sa, x, sp = cut(p)
+        _require_healthy_input(seg.sources[str(p)], p, "healthy")
         seg.healthy_speeds.append(sp)
         n_fit = sa.shape[0] - int(np.floor(holdout * sa.shape[0]))
         if n_fit < 1:
@@ -221,6 +242,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
         seg.rows.extend((str(p), "healthy_holdout", k, sp, sa[k])
                         for k in range(n_fit, sa.shape[0]))
     fsa, _, fsp = cut(faulty)
+    _require_healthy_input(seg.sources[str(faulty)], faulty, "faulty")
     example_segment = check_int(example_segment, "example_segment", minimum=0,
                                 maximum=fsa.shape[0] - 1)
     seg.example = fsa[example_segment]
@@ -290,6 +312,9 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame.attrs["load_source"] = cond.load_source
     frame.attrs["load_choice"] = None if cond.choice is None else cond.choice.as_dict()
     frame.attrs["load_note"] = "" if cond.choice is None else f" ({cond.choice.describe()})"
+    mark_rows(frame, [input_check_column(seg.sources[r]["recording"],
+                                         seg.sources[r]["segments"], [k])[0]
+                      for r, k in zip(frame["recording"], frame["segment"])])
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]

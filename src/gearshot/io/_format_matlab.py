@@ -23,7 +23,7 @@ import numpy as np
 
 from .._errors import GearshotError
 from ._fileio import FS_NAMES, RawFile, atomic_path
-from ._format_hdf5 import check_extent
+from ._format_hdf5 import check_extent, check_heaps
 
 if TYPE_CHECKING:
     import h5py
@@ -106,6 +106,7 @@ def read_mat(path: Path) -> RawFile:
     path = Path(path)
     if _is_v73(path):
         variables: dict[str, Any] = {}
+        check_heaps(path)   # a zeroed heap would hang libhdf5
         with h5py.File(path, "r") as f:
             for name, obj in f.items():
                 if isinstance(obj, h5py.Dataset) and not name.startswith("#"):

@@ -27,6 +27,7 @@ from ._format_matlab import read_mat, write_mat
 from ._format_tdms import read_tdms
 from ._format_text import TEXT_SUFFIXES, read_text
 from ._format_wav import read_wav, write_wav
+from .input_health import check_numeric
 from ._tacho import SPEED_TOLERANCE as SPEED_TOLERANCE  # its old home
 
 if TYPE_CHECKING:
@@ -253,6 +254,10 @@ class Recording(AngleDomainRecording):
             given = fs if fs is not None else (
                 layout.fs if layout is not None and raw.fs is None else None)
             rate = reconcile_fs(raw, given)
+        numeric = check_numeric(acc)
+        if not numeric.ok:
+            raise GearshotError(f"{str(path)!r} fails the input check 'non_numeric': "
+                                f"{numeric.reason}")
         meta = dict(raw.metadata)
         if machine is not None:
             units = [s.unit for s in machine.sensors]

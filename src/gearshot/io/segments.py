@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
+from .input_health import check_input, check_segments
 from .recording import Recording
 
 __all__ = ["recording_segments"]
@@ -16,12 +17,21 @@ def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
                        pinion_teeth: int = PINION_TEETH,
                        cycles_per_segment: int | None = CYCLES_PER_SEGMENT,
                        samples_per_cycle: int = SAMPLES_PER_CYCLE,
-                       long: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """SA segments (and optionally the angle-domain signal) of one recording file."""
+                       long: bool = False, health: dict | None = None
+                       ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """SA segments (and optionally the angle-domain signal) of one recording file.
+
+    ``health``, when given, receives the input checks
+    (:mod:`gearshot.io.input_health`): ``"recording"`` (the raw samples') and
+    ``"segments"`` (one per SA segment).
+    """
     rec = Recording.read(path)
     sa = rec.to_sa_segments(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
                             cycles_per_segment=cycles_per_segment,
                             samples_per_cycle=samples_per_cycle)
+    if health is not None:
+        health.update(recording=check_input(rec.acceleration, units=rec.units),
+                      segments=check_segments(sa, units=rec.units))
     if not long:
         return sa
     x = rec.angle_domain(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
