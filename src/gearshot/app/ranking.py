@@ -93,6 +93,8 @@ def indicator_ranking(payload: dict[str, Any], labels: pd.DataFrame) -> pd.DataF
     from .indicators import _META, indicator_table
 
     table = indicator_table(payload)
+    if "input_check" in table:   # a channel that failed its input check has no indicator
+        table = table[table["input_check"] == "ok"]
     merged = table.merge(labels.drop(columns=[c for c in ("case", "condition")
                                               if c in labels]), on="file", how="inner")
     if "cell" in merged and merged["cell"].notna().all():
