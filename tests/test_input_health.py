@@ -385,3 +385,19 @@ def test_machine_predict_refuses_a_dead_healthy_recording(tmp_path):
         _segment_recordings(Machine.from_toml(SPUR), [path], path, [], cps=10,
                             sensor="acc_input", holdout=0.25, example_segment=0)
     assert f"'{path}' (healthy) fails the input check 'dead'" in str(err.value)
+
+
+def test_a_read_stuck_inside_libhdf5_is_killed_at_the_budget(zero_tail):
+    """Without the heap walk, libhdf5 loops on the zero-tail file holding Python's global
+    lock (no thread timeout can fire): the read runs in a child process that is killed when
+    the budget (here 1 s + 1 s/MB) is spent. Run in its own process, bounded by 60 s."""
+    code = ("import functools, sys\nfrom pathlib import Path\n"
+            "import gearshot.io.recording as r\nfrom gearshot import GearshotError\n"
+            "from gearshot.io._format_hdf5 import read_hdf5\nr.READ_BUDGET_S = 1.0\n"
+            "try:\n    r._bounded_read(functools.partial(read_hdf5, walk_heaps=False), "
+            "Path(sys.argv[1]), isolate=True)\nexcept GearshotError as e:\n"
+            "    print('refused:', e)\n")
+    res = subprocess.run([sys.executable, "-c", code, str(zero_tail[1])], capture_output=True,
+                         text=True, timeout=60, env={"PYTHONPATH": str(SRC)})
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("refused:") and "did not finish within 2 s" in res.stdout

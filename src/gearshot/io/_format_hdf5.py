@@ -166,10 +166,12 @@ def _check_digest(path: Path, ds: Any, data: np.ndarray) -> None:
                             f"{str(stored)[:12]}..., read {found[:12]}...)")
 
 
-def read_hdf5(path: Path) -> RawFile:
-    """Read a native (or generic) HDF5 recording file."""
+def read_hdf5(path: Path, *, walk_heaps: bool = True) -> RawFile:
+    """Read a native (or generic) HDF5 recording file (``walk_heaps``: first
+    :func:`check_heaps`)."""
     import h5py  # imported on use: text/zip readers never pay for it
-    check_heaps(path)
+    if walk_heaps:
+        check_heaps(path)
     with h5py.File(path, "r") as f:
         attrs = {k: _attr(v) for k, v in f.attrs.items()}
         if attrs.get("gearshot_format") == FORMAT_NAME:

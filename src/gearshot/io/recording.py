@@ -239,7 +239,7 @@ class Recording(AngleDomainRecording):
                 machine = Machine.from_toml(machine)
         layout = None if machine is None else machine.layout
         try:
-            raw = _bounded_read(_reader(fmt, layout), path)
+            raw = _bounded_read(_reader(fmt, layout), path, isolate=fmt in ("hdf5", "mat"))
         except GearshotError:
             raise
         except Exception as exc:  # corrupt / truncated / not this format
@@ -362,14 +362,27 @@ def _reader(fmt: str, layout: FileLayout | None) -> Callable[[Path], RawFile]:
     return readers[fmt]
 
 
-def _bounded_read(reader: Callable[[Path], RawFile], path: Path) -> RawFile:
+def _bounded_read(reader: Callable[[Path], RawFile], path: Path, *,
+                  isolate: bool = False) -> RawFile:
     """Run ``reader(path)`` in a worker thread; the caller waits in short, interruptible
     steps (Ctrl-C is honoured at once) and gives up with a :class:`GearshotError` after
-    :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file)."""
+    :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file).
+
+    ``isolate``: run it in a child process instead (:mod:`._read_isolated`), for readers
+    that call libhdf5, which holds Python's global lock through a call: a thread stuck
+    there cannot be abandoned, a process can be killed. (A process that runs several
+    threads, or may not start a child, reads in the thread.)
+    """
     import threading
     import time
 
     budget = READ_BUDGET_S + path.stat().st_size / 1e6
+    if isolate:
+        from ._read_isolated import can_isolate, read_isolated
+
+        if can_isolate():
+            raw_file: RawFile = read_isolated(reader, path, budget)
+            return raw_file
     box: dict[str, Any] = {}
 
     def work() -> None:
