@@ -57,7 +57,9 @@ def test_indicators_json_layout_and_figures(small, tmp_path):
     want = {*available_features(), "rms_raw", "rms_residual"}
     for rec, name in zip(payload["records"], ("spur2", "spur3")):
         assert list(rec) == ["file", "sensor", "tacho_speed_hz", "shaft_speed_hz",
-                             "speed_source", "speed_uncertainty_hz", "n_cycles", "indicators"]
+                             "speed_source", "speed_uncertainty_hz", "n_cycles", "indicators",
+                             "input_check"]
+        assert rec["input_check"] == "ok"
         assert rec["file"] == f"{name}_30hz_High_1.zip" and rec["sensor"] == "acc_input"
         assert rec["speed_source"] == "tacho" and rec["speed_uncertainty_hz"] is None
         assert 29.0 < rec["tacho_speed_hz"] < 30.0  # read from the tacho, input shaft

@@ -297,7 +297,7 @@ def fit_files(tmp_path_factory, zero_tail):
 @pytest.mark.parametrize("case, check", [("zero", "dead"), ("constant", "constant"),
                                          ("times_1e30", "implausible_level")])
 def test_predict_marks_every_row_of_a_failed_test_recording(fit_files, case, check):
-    from gearshot.app.predict import predict_from_files
+    from gearshot.app.predict import input_check_summary, predict_from_files
 
     db, paths, tests = fit_files
     frame = predict_from_files(db, paths[:2], paths[2], 0.5, [paths[1], tests[case]],
@@ -307,6 +307,8 @@ def test_predict_marks_every_row_of_a_failed_test_recording(fit_files, case, che
     assert len(bad) >= 1 and (bad["input_check"] == check).all()
     assert bad[["predicted", "low", "high"]].isna().all().all()   # no number at all
     assert (good["input_check"] == "ok").all() and good["predicted"].notna().all()
+    line = input_check_summary(frame)
+    assert f"failed for {len(bad)} ({check} {len(bad)})" in line and "no estimate" in line
 
 
 def test_predict_refuses_a_failed_fit_recording(fit_files, zero_tail):

@@ -185,9 +185,8 @@ def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
 def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
                  baselines: dict[str, float | None], ratio: float) -> list[dict[str, Any]]:
     """The payload records of one file: one per sensor."""
-    from ..io import Recording
-
     from ..features import available_features
+    from ..io import Recording
     from ..io.input_health import check_input
 
     rec = Recording.read(path, machine=machine)

@@ -14,7 +14,8 @@ from ..io.input_health import input_check_column, mark_rows, require_ok
 from ..paper import GEAR_TEETH, PINION_TEETH
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
-           "format_predictions", "comparable_summary", "summary_table", "ROLES"]
+           "format_predictions", "comparable_summary", "input_check_summary",
+           "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
 #: the fit. ``healthy_fitted``: a healthy segment the estimator was fitted on (an
@@ -237,8 +238,20 @@ def comparable_summary(frame: pd.DataFrame) -> str:
     return line
 
 
+def input_check_summary(frame: pd.DataFrame) -> str:
+    """One line counting the segments by their ``input_check`` (issue #29)."""
+    if "input_check" not in frame or not len(frame):
+        return "input_check: no segment checked"
+    failed = frame.loc[frame["input_check"] != "ok", "input_check"]
+    if failed.empty:
+        return f"input_check: ok for all {len(frame)} segment(s)"
+    counts = ", ".join(f"{name} {n}" for name, n in failed.value_counts().items())
+    return (f"input_check: ok for {len(frame) - len(failed)} segment(s), failed for "
+            f"{len(failed)} ({counts}): no estimate is given for them")
+
+
 def format_predictions(frame: pd.DataFrame, where: str) -> str:
     """What ``gearshot predict`` prints: the condition, the summary per recording and
-    role (:func:`summary_table`) and the comparability count."""
+    role (:func:`summary_table`), the comparability count and the input-check count."""
     table = summary_table(frame).to_string(index=False, float_format=lambda v: f"{v:.3f}")
-    return "\n".join([where, table, comparable_summary(frame)])
+    return "\n".join([where, table, comparable_summary(frame), input_check_summary(frame)])

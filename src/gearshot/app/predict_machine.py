@@ -12,8 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..io.input_health import (check_input, check_segments, input_check_column, mark_rows,
-                               require_ok)
+from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 
@@ -147,7 +146,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
         load_source, load_clarity, predicted, low, high, comparability, comparable,
-        speed_source, speed_uncertainty_hz`` (``database_load``: the load estimated at,
+        input_check, speed_source, speed_uncertainty_hz`` (``database_load``: the load estimated at,
         N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
         (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
@@ -159,8 +158,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         ``vibration``; ``input_check``: ``"ok"`` or the failed check of
         :mod:`gearshot.io.input_health`, per recording and segment, with the row's
         ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
-        recording that fails is refused); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
-        ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
+        recording that fails is refused); ``attrs`` hold the condition (``speed_hz``,
+        ``load``, ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
         reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf

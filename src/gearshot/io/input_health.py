@@ -49,8 +49,8 @@ import numpy as np
 from .._errors import GearshotError
 
 __all__ = ["InputCheck", "check_input", "check_numeric", "check_segments",
-           "input_check_column", "mark_rows", "require_ok", "CHECKS", "OK", "MAX_PEAK_G", "DEAD_FLOOR_G", "CLIP_FRACTION",
-           "G_PER_UNIT"]
+           "input_check_column", "mark_rows", "require_ok", "CHECKS", "OK", "MAX_PEAK_G",
+           "DEAD_FLOOR_G", "CLIP_FRACTION", "G_PER_UNIT"]
 
 #: Names of the checks (the values of the ``input_check`` column besides ``"ok"``).
 CHECKS = ("non_numeric", "implausible_level", "dead", "constant", "clipped", "damaged_bytes")

@@ -27,8 +27,8 @@ from ._format_matlab import read_mat, write_mat
 from ._format_tdms import read_tdms
 from ._format_text import TEXT_SUFFIXES, read_text
 from ._format_wav import read_wav, write_wav
-from .input_health import check_numeric
 from ._tacho import SPEED_TOLERANCE as SPEED_TOLERANCE  # its old home
+from .input_health import check_numeric
 
 if TYPE_CHECKING:
     from ..machine import FileLayout, Machine

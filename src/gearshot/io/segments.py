@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -17,7 +18,7 @@ def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
                        pinion_teeth: int = PINION_TEETH,
                        cycles_per_segment: int | None = CYCLES_PER_SEGMENT,
                        samples_per_cycle: int = SAMPLES_PER_CYCLE,
-                       long: bool = False, health: dict | None = None
+                       long: bool = False, health: dict[str, Any] | None = None
                        ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """SA segments (and optionally the angle-domain signal) of one recording file.
 
