@@ -45,6 +45,25 @@ def _stats(label, items):
           f"{edge:.2g} | {rec_ok}/{len(items)} | {sum(seg)}/{len(seg)} |")
 
 
+def _clip_shares(label, items):
+    """Share of samples at the extremes after clipping every raw channel at a level."""
+    levels = {"90 % of the peak": lambda c: 0.9 * np.abs(c).max(),
+              "half the peak": lambda c: 0.5 * np.abs(c).max(),
+              "3 standard deviations": lambda c: 3 * c.std()}
+    for name, level in levels.items():
+        shares = []
+        for raw, _ in items:
+            for c in raw:
+                rail = level(c)
+                x = np.clip(c, -rail, rail)
+                shares.append((np.count_nonzero(x == x.min()) + np.count_nonzero(x == x.max()))
+                              / x.size)
+        caught = sum(check_input(np.clip(c, -level(c), level(c))).failed == "clipped"
+                     for raw, _ in items for c in raw)
+        print(f"| {label} | clipped at {name} | {min(shares):.2g} - {max(shares):.2g} | "
+              f"{caught}/{len(shares)} |")
+
+
 def _rig(folder: Path, seeds, speed, load):
     items = []
     for seed in seeds:
@@ -121,9 +140,14 @@ def main(folder: str, part: str) -> None:
           "max share at extremes | recordings ok | segments ok |")
     print("|---|---|---|---|---|---|---|---|")
     if part == "dev":
-        _stats("dev: rig seeds 0-1, 15 rps 10 N m", _rig(out, (0, 1), 15, 10))
-        run1 = sorted(p.name for p in PHM.glob("*_1.zip"))
-        _stats("dev: PHM09 run 1", _phm(run1))
+        rig = _rig(out, (0, 1), 15, 10)
+        _stats("dev: rig seeds 0-1, 15 rps 10 N m", rig)
+        run1 = _phm(sorted(p.name for p in PHM.glob("*_1.zip")))
+        _stats("dev: PHM09 run 1", run1)
+        print("\n| set | clip | share of samples at the extremes | channels refused as clipped |")
+        print("|---|---|---|---|")
+        _clip_shares("dev: rig seeds 0-1", rig)
+        _clip_shares("dev: PHM09 run 1", run1)
         return
     _stats("held out: rig seeds 2-5, 30 rps 5 N m", _rig(out, (2, 3, 4, 5), 30, 5))
     run2 = sorted(p.name for p in PHM.glob("*_2.zip"))
