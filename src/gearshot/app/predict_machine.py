@@ -64,18 +64,18 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
     if info is not None:
         info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
-        info.update(input_health(rec.channel(name).acceleration, blocks.mean(axis=1),
+        info.update(_input_health(rec.channel(name).acceleration, blocks.mean(axis=1),
                                  machine.sensor(name).unit))
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
-def input_health(raw, sas, unit) -> dict:
+def _input_health(raw, sas, unit) -> dict:
     """The input checks of one sensor of a recording: its raw samples and its SA
     segments (:mod:`gearshot.io.input_health`)."""
     return dict(recording=check_input(raw, units=unit), segments=check_segments(sas, units=unit))
 
 
-def _require_healthy_input(info: dict, path, role: str) -> None:
+def _require_fit_input(info: dict, path, role: str) -> None:
     """Refuse a recording the fit uses unless it and each of its segments pass."""
     for check in (info["recording"], *info["segments"]):
         require_ok(check, path, role)
@@ -146,9 +146,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
         load_source, load_clarity, predicted, low, high, comparability, comparable,
-        input_check, speed_source, speed_uncertainty_hz`` (``database_load``: the load estimated at,
-        N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
-        (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
+        input_check, speed_source, speed_uncertainty_hz`` (``database_load``: the load
+        estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or
+        ``chosen`` (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
         ``comparability``/``comparable``: the score of
@@ -159,8 +159,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         :mod:`gearshot.io.input_health`, per recording and segment, with the row's
         ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
         recording that fails is refused); ``attrs`` hold the condition (``speed_hz``,
-        ``load``, ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
-        reference.
+        ``load``, ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None),
+        the grade and the simulated reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
 
@@ -229,7 +229,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
 
     for p in healthy:
         sa, x, sp = cut(p)
-        _require_healthy_input(seg.sources[str(p)], p, "healthy")
+        _require_fit_input(seg.sources[str(p)], p, "healthy")
         seg.healthy_speeds.append(sp)
         n_fit = sa.shape[0] - int(np.floor(holdout * sa.shape[0]))
         if n_fit < 1:
@@ -241,7 +241,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
         seg.rows.extend((str(p), "healthy_holdout", k, sp, sa[k])
                         for k in range(n_fit, sa.shape[0]))
     fsa, _, fsp = cut(faulty)
-    _require_healthy_input(seg.sources[str(faulty)], faulty, "faulty")
+    _require_fit_input(seg.sources[str(faulty)], faulty, "faulty")
     example_segment = check_int(example_segment, "example_segment", minimum=0,
                                 maximum=fsa.shape[0] - 1)
     seg.example = fsa[example_segment]
