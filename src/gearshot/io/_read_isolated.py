@@ -20,11 +20,13 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar, cast
 
 from .._errors import GearshotError
 
 __all__ = ["read_isolated", "can_isolate"]
+
+_T = TypeVar("_T")
 
 
 def can_isolate() -> bool:
@@ -49,7 +51,7 @@ def _child(reader: Callable[[Path], Any], path: Path, conn: Any) -> None:
         conn.close()
 
 
-def read_isolated(reader: Callable[[Path], Any], path: Path, budget: float) -> Any:
+def read_isolated(reader: Callable[[Path], _T], path: Path, budget: float) -> _T:
     """``reader(path)`` in a child process, given up after ``budget`` seconds.
 
     Raises
@@ -89,4 +91,4 @@ def read_isolated(reader: Callable[[Path], Any], path: Path, budget: float) -> A
         receive.close()
     if status == "exc":
         raise payload
-    return payload
+    return cast(_T, payload)

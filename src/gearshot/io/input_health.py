@@ -278,8 +278,9 @@ def mark_rows(frame: Any, column: Sequence[str]) -> Any:
     return frame
 
 
-def require_ok(check: InputCheck, path: Any, role: str) -> None:
-    """Refuse a recording that fits the estimator unless it passed every check.
+def require_ok(check: InputCheck, path: Any, role: str | None = None) -> None:
+    """Refuse a recording (e.g. one that fits the estimator, its ``role``) unless it
+    passed every check.
 
     Raises
     ------
@@ -287,5 +288,6 @@ def require_ok(check: InputCheck, path: Any, role: str) -> None:
         One line naming the file, its role and the failed check.
     """
     if not check.ok:
-        raise GearshotError(f"{str(path)!r} ({role}) fails the input check {check.failed!r}: "
+        where = "" if role is None else f" ({role})"
+        raise GearshotError(f"{str(path)!r}{where} fails the input check {check.failed!r}: "
                             f"{check.reason}")

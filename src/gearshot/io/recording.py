@@ -27,8 +27,9 @@ from ._format_matlab import read_mat, write_mat
 from ._format_tdms import read_tdms
 from ._format_text import TEXT_SUFFIXES, read_text
 from ._format_wav import read_wav, write_wav
+from ._read_isolated import can_isolate, read_isolated
 from ._tacho import SPEED_TOLERANCE as SPEED_TOLERANCE  # its old home
-from .input_health import check_numeric
+from .input_health import check_numeric, require_ok
 
 if TYPE_CHECKING:
     from ..machine import FileLayout, Machine
@@ -254,10 +255,7 @@ class Recording(AngleDomainRecording):
             given = fs if fs is not None else (
                 layout.fs if layout is not None and raw.fs is None else None)
             rate = reconcile_fs(raw, given)
-        numeric = check_numeric(acc)
-        if not numeric.ok:
-            raise GearshotError(f"{str(path)!r} fails the input check 'non_numeric': "
-                                f"{numeric.reason}")
+        require_ok(check_numeric(acc), path)   # NaN or inf: refused, naming the check
         meta = dict(raw.metadata)
         if machine is not None:
             units = [s.unit for s in machine.sensors]
@@ -364,25 +362,17 @@ def _reader(fmt: str, layout: FileLayout | None) -> Callable[[Path], RawFile]:
 
 def _bounded_read(reader: Callable[[Path], RawFile], path: Path, *,
                   isolate: bool = False) -> RawFile:
-    """Run ``reader(path)`` in a worker thread; the caller waits in short, interruptible
-    steps (Ctrl-C is honoured at once) and gives up with a :class:`GearshotError` after
-    :data:`READ_BUDGET_S` + 1 s per MB (a library caught in a damaged file).
-
-    ``isolate``: run it in a child process instead (:mod:`._read_isolated`), for readers
-    that call libhdf5, which holds Python's global lock through a call: a thread stuck
-    there cannot be abandoned, a process can be killed. (A process that runs several
-    threads, or may not start a child, reads in the thread.)
-    """
+    """Run ``reader(path)`` in a worker thread (``isolate``: in a child process when
+    :func:`._read_isolated.can_isolate`, for libhdf5, which holds Python's global lock
+    through a call); the caller waits in short, interruptible steps (Ctrl-C is honoured at
+    once) and gives up with a :class:`GearshotError` after :data:`READ_BUDGET_S` + 1 s per
+    MB (a library caught in a damaged file)."""
     import threading
     import time
 
     budget = READ_BUDGET_S + path.stat().st_size / 1e6
-    if isolate:
-        from ._read_isolated import can_isolate, read_isolated
-
-        if can_isolate():
-            raw_file: RawFile = read_isolated(reader, path, budget)
-            return raw_file
+    if isolate and can_isolate():
+        return read_isolated(reader, path, budget)
     box: dict[str, Any] = {}
 
     def work() -> None:
