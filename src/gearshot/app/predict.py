@@ -10,17 +10,18 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range
-from ..paper import GEAR_TEETH, PINION_TEETH
+from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
-           "format_predictions", "comparable_summary", "summary_table", "ROLES"]
+           "format_predictions", "comparable_summary", "trust_summary", "fit_check_line",
+           "add_trust_columns", "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
 #: the fit. ``healthy_fitted``: a healthy segment the estimator was fitted on (an
 #: in-sample estimate); ``example``: the one faulty example (its estimate is near the
 #: declared size by construction); ``faulty_rest``: the faulty recording's other segments
-#: (same record as the example); ``healthy_holdout``: healthy segments kept out of the fit
-#: (``--machine``); ``test``: a recording the fit never saw.
+#: (same record as the example; they check the fit); ``healthy_holdout``: healthy segments
+#: kept out of the fit (they check it too); ``test``: a recording the fit never saw.
 ROLES = ("healthy_fitted", "example", "faulty_rest", "healthy_holdout", "test")
 
 
@@ -33,7 +34,7 @@ def _recording_files(path: Path):
 
 def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, speed, load=None,
                        coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                       selection_tf=None):
+                       selection_tf=None, holdout=0.25):
     """Fit the estimator from files and predict every SA segment of ``recordings``.
 
     The recordings are segmented for ``gear_teeth`` / ``pinion_teeth`` (default: the
@@ -50,13 +51,23 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     selection_tf : optional
         Step 1's held-out TF (default :func:`gearshot.estimator.default_selection_tf` of
         ``seed``).
+    holdout : float in [0, 1), default 0.25
+        Fraction of each healthy recording's segments (the last ``floor(holdout · n)``)
+        kept out of the fit (and of the TF estimate) and estimated
+        (``role="healthy_holdout"``); with the faulty recording's other segments
+        (``role="faulty_rest"``, always estimated) they check the fit
+        (:attr:`~gearshot.estimator.OneFaultShotEstimator.fit_check_`) and calibrate the
+        intervals.
 
     Returns
     -------
     pandas.DataFrame
-        ``recording, role, segment, predicted, low, high, comparability, comparable``
-        (roles: :data:`ROLES`; the last two from
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
+        ``recording, role, segment, predicted, low, high, comparability, comparable,
+        fit_check, trusted`` (roles: :data:`ROLES`; ``comparability``/``comparable`` from
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`; ``fit_check``
+        the fit's verdict, the same in every row; ``trusted``:
+        :func:`gearshot.estimator.trusted_column`). ``attrs["fit_check"]``:
+        :meth:`~gearshot.estimator.fit_check.FitCheck.as_dict`.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
@@ -79,46 +90,72 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    targets, healthy_sa, long, example = _segments(files, healthy, faulty, kw)
+    targets, healthy_sa, long, example, rest, held = _segments(files, healthy, faulty, kw,
+                                                                holdout)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
+    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf,
+            healthy_holdout=np.vstack([sa for _, sa, _ in held]), example_record=rest, **kw)
     fitted = {_key(p) for p in healthy}
+    estimated = {_key(p) for p in files}
     frames = []
     for path, sa in targets:
-        low, high = est.predict_interval(sa, coverage=coverage)
-        comp = est.comparability(sa)
-        frames.append(pd.DataFrame(dict(recording=str(path),
-                                        role=_roles(path, len(sa), fitted, faulty),
-                                        segment=np.arange(len(sa)),
-                                        predicted=est.predict(sa), low=low, high=high,
-                                        comparability=comp.score,
-                                        comparable=comp.comparable)))
+        roles = _roles(path, len(sa), fitted, faulty)
+        n_held = sum(len(h) for p, h, _ in held if _key(p) == _key(path))
+        if n_held:
+            roles[len(sa) - n_held:] = ["healthy_holdout"] * n_held
+        frames.append(_rows(est, path, roles, sa, coverage))
+    # the hold-outs that check the fit are estimated even when not asked for
+    for path, sa, n_fit in held:
+        if len(sa) and _key(path) not in estimated:
+            frames.append(_rows(est, path, ["healthy_holdout"] * len(sa), sa, coverage,
+                                start=n_fit))
+    if _key(faulty) not in estimated and len(rest):
+        frames.append(_rows(est, faulty, ["faulty_rest"] * len(rest), rest, coverage,
+                            start=1))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load
+    add_trust_columns(frame, est.fit_check_)
     return frame
 
 
-def _segments(files, healthy, faulty, kw):
-    """SA segments of the targets, the healthy recordings (stacked; the first one's long
-    angle-domain signal too) and the faulty example (the faulty recording's first segment).
+def _rows(est, path, roles, sa, coverage, start: int = 0) -> pd.DataFrame:
+    """One row per SA segment of one recording: estimate, interval, comparability."""
+    low, high = est.predict_interval(sa, coverage=coverage)
+    comp = est.comparability(sa)
+    return pd.DataFrame(dict(recording=str(path), role=roles,
+                             segment=start + np.arange(len(sa)), predicted=est.predict(sa),
+                             low=low, high=high, comparability=comp.score,
+                             comparable=comp.comparable))
+
+
+def _segments(files, healthy, faulty, kw, holdout=0.0):
+    """SA segments of the targets; the healthy recordings' fitted segments (stacked; the
+    first one's long angle-domain signal too, without its hold-outs); the faulty example
+    (the faulty recording's first segment) and its record's other segments; each healthy
+    recording's hold-outs (its last ``floor(holdout · n)`` segments) as (path, SAs).
 
     Every recording is read and segmented before the fit: a file too short for one SA
     segment (or unreadable) fails now, not after minutes of fitting.
     """
+    from ..estimator.fit_check import holdout_count
     from ..io import recording_segments
 
     targets = [(path, recording_segments(path, **kw)) for path in files]
-    healthy_sa, long = [], None
+    healthy_sa, long, held = [], None, []
     for i, p in enumerate(healthy):
         if i == 0:
             sa, long = recording_segments(p, long=True, **kw)
         else:
             sa = recording_segments(p, **kw)
-        healthy_sa.append(sa)
-    example = recording_segments(faulty, **kw)[0]
-    return targets, np.vstack(healthy_sa), long, example
+        n_fit = len(sa) - holdout_count(len(sa), holdout)
+        if i == 0 and n_fit < len(sa):  # held-out segments stay out of the TF estimate
+            long = long[: n_fit * CYCLES_PER_SEGMENT * SAMPLES_PER_CYCLE]
+        healthy_sa.append(sa[:n_fit])
+        held.append((p, sa[n_fit:], n_fit))
+    faulty_sa = recording_segments(faulty, **kw)
+    return targets, np.vstack(healthy_sa), long, faulty_sa[0], faulty_sa[1:], held
 
 
 def _key(path) -> Path:
@@ -134,14 +171,17 @@ def _roles(path, n: int, fitted: set, faulty) -> list[str]:
 
 
 def summary_table(frame: pd.DataFrame, roles: Sequence[str] = ROLES) -> pd.DataFrame:
-    """One row per recording and role: segments, mean estimate and mean interval, headed
-    columns (the printed summary of ``gearshot predict``)."""
+    """One row per recording and role: segments, mean estimate and mean interval, the
+    comparable and the trusted segments' counts, headed columns (the printed summary of
+    ``gearshot predict``)."""
     order = {r: i for i, r in enumerate(roles)}
     by = ["recording", "role"] if "role" in frame else ["recording"]
     aggs = dict(segments=("predicted", "size"), estimated_size=("predicted", "mean"),
                 low=("low", "mean"), high=("high", "mean"))
     if "comparable" in frame:
         aggs["comparable"] = ("comparable", "sum")
+    if "trusted" in frame:
+        aggs["trusted"] = ("trusted", "sum")
     table = frame.groupby(by, sort=False).agg(**aggs).reset_index()
     if "role" in table:
         table = table.sort_values("role", key=lambda r: r.map(order), kind="stable")
@@ -189,7 +229,8 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
         raise GearshotError("--recordings: give at least one file or folder to estimate")
     frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
                                speed=speed, load=load, coverage=coverage,
-                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed)
+                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed,
+                               holdout=holdout)
     return frame, (f"database condition: {frame.attrs['speed']:g} rps, load "
                    f"{frame.attrs['load']:g} N m")
 
@@ -221,8 +262,64 @@ def comparable_summary(frame: pd.DataFrame) -> str:
     return line
 
 
+def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
+    """Add the fit's verdict and ``trusted`` to a predict table, in place.
+
+    ``fit_check``: ``check.verdict`` in every row ("passed" or the reason); ``trusted``:
+    :func:`gearshot.estimator.trusted_column` (input check "ok" — a table without
+    ``input_check`` counts as "ok" —, comparable and the fit check passed);
+    ``frame.attrs["fit_check"]``: ``check.as_dict()``.
+    """
+    from ..estimator import trusted_column
+
+    frame["fit_check"] = check.verdict
+    frame["trusted"] = trusted_column(frame) if len(frame) else pd.Series(dtype=bool)
+    frame.attrs["fit_check"] = check.as_dict()
+    return frame
+
+
+def fit_check_line(frame: pd.DataFrame) -> str:
+    """One line with the fit's verdict on its own hold-outs (printed before the
+    estimates)."""
+    check = frame.attrs.get("fit_check")
+    if not check:
+        verdict = str(frame["fit_check"].iloc[0]) if "fit_check" in frame and len(frame) \
+            else "unknown"
+        return f"fit check: {verdict}"
+    parts = []
+    if check.get("n_healthy"):
+        parts.append(f"{check['n_healthy']} healthy hold-out(s) read "
+                     f"{check['healthy_mean']:.3f} on average")
+    if check.get("n_example"):
+        parts.append(f"{check['n_example']} other segment(s) of the example record read "
+                     f"{check['example_mean']:.3f} against the declared "
+                     f"{check['declared_size']:g}")
+    line = f"fit check: {check['verdict']}"
+    if parts:
+        line += " (" + "; ".join(parts) + ")"
+    if check["verdict"] != "passed":
+        line += " — no estimate of this fit is trusted"
+    return line
+
+
+def trust_summary(frame: pd.DataFrame) -> str:
+    """One line counting the trusted segments of a predict table."""
+    if "trusted" not in frame or not len(frame):
+        return "trusted: no segment estimated"
+    n_yes = int(frame["trusted"].astype(bool).sum())
+    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input check ok, comparable and "
+            f"fit check passed)")
+
+
 def format_predictions(frame: pd.DataFrame, where: str) -> str:
-    """What ``gearshot predict`` prints: the condition, the summary per recording and
-    role (:func:`summary_table`) and the comparability count."""
+    """What ``gearshot predict`` prints: the condition, the fit's verdict
+    (:func:`fit_check_line`), the summary per recording and role (:func:`summary_table`),
+    the comparability count and the trusted count."""
     table = summary_table(frame).to_string(index=False, float_format=lambda v: f"{v:.3f}")
-    return "\n".join([where, table, comparable_summary(frame)])
+    lines = [where]
+    if "fit_check" in frame or frame.attrs.get("fit_check"):
+        lines.append(fit_check_line(frame))
+    lines += [table, comparable_summary(frame)]
+    if "trusted" in frame:
+        lines.append(trust_summary(frame))
+    return "\n".join(lines)
