@@ -130,6 +130,9 @@ def main() -> None:
     cells = pd.DataFrame(rows)
     pooled = pd.DataFrame([dict(part=part, cell="pooled", **summarize(sub))
                            for part, sub in table.groupby("part", sort=False)])
+    # pooled: every cell separated (segments of different cells are not compared)
+    pooled["separated"] = [bool(cells[cells.part == p].separated.all())
+                           for p in pooled.part]
     with pd.option_context("display.width", 250, "display.max_columns", 30,
                            "display.max_colwidth", 70):
         print(pd.concat([cells, pooled], ignore_index=True).to_string(
