@@ -222,3 +222,31 @@ def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
     assert flagged["trusted"].tolist() == [True, False]
     with pytest.raises(GearshotError, match="input_check holds 1 value"):
         est.trust(healthy[-2:], input_check=["ok"])
+
+
+def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(spur_db,
+                                                                              tmp_path):
+    from gearshot.app.predict import format_predictions, predict_recordings, write_predictions
+    from gearshot.app.report import report_from_any_json
+
+    frame, where = predict_recordings(
+        spur_db, [_record("spur3_30hz_High_1.zip")], _record("spur2_30hz_High_1.zip"), 0.5,
+        [_record("spur3_30hz_Low_1.zip")], machine=SPUR, speed=30.0, load=10.0,
+        cycles_per_segment=10)
+    text = format_predictions(frame, where)
+    lines = text.splitlines()
+    assert lines[1].startswith("fit check: passed (2 healthy hold-out(s) read")
+    n_trusted = int(frame["trusted"].sum())
+    assert f"trusted: {n_trusted} of {len(frame)} segment(s)" in text
+    # the Low-load record is not comparable to the High-load fit: estimated, not trusted
+    low = frame["recording"].str.contains("Low")
+    assert not frame.loc[low, "trusted"].any() and frame.loc[~low, "trusted"].all()
+    csv = pd.read_csv(write_predictions(frame, tmp_path / "p.csv"))
+    assert csv["trusted"].tolist() == frame["trusted"].tolist()
+    assert (csv["fit_check"] == "passed").all()
+    rows = json.loads(write_predictions(frame, tmp_path / "p.json").read_text())
+    assert all(isinstance(r["trusted"], bool) and r["fit_check"] == "passed" for r in rows)
+    report = report_from_any_json(tmp_path / "p.json", tmp_path / "report")
+    md = report.read_text()
+    assert f"Trusted segments: {n_trusted} of {len(frame)}" in md
+    assert "Fit check: passed." in md and (tmp_path / "report" / "estimates.png").is_file()
