@@ -61,7 +61,7 @@ from .calibration import (
     resolve_calibration,
 )
 from .comparability import fit_comparability
-from .fit_check import MIN_HOLDOUTS, FitCheck, Holdouts, check_fit, split_holdouts
+from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
 
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
@@ -336,24 +336,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                       healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
-        self.fit_check_ = self._check_holdouts(holdouts)
-        return self
-
-    def _check_holdouts(self, holdouts: Holdouts) -> FitCheck:
-        """The fit check: the hold-outs read by the fitted estimator."""
-        def read(sa: FloatArray | None) -> FloatArray | None:
-            return None if sa is None or not len(sa) else self.predict(sa)
-
         n_fit = len(self.target_healthy_features_) + len(self.references_)
-        n_h = 0 if holdouts.healthy is None else len(holdouts.healthy)
-        healthy_note = ""
-        if n_h < MIN_HOLDOUTS:
-            healthy_note = (f"{n_fit + n_h} healthy segments give {n_h} hold-out(s)"
-                            + ("" if holdouts.fraction is None
-                               else f" at holdout {holdouts.fraction:g}")
-                            + f", {MIN_HOLDOUTS} needed")
-        return check_fit(read(holdouts.healthy), read(holdouts.example), self.faulty_size_,
-                         healthy_note=healthy_note)
+        self.fit_check_ = check_holdouts(self.predict, holdouts, n_fit, self.faulty_size_)
+        return self
 
     def _fit(self, database: Any, target_healthy: ArrayLike,
              faulty_example: ArrayLike | None, faulty_size: float | None,

@@ -26,6 +26,7 @@ are far beyond it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -35,7 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range
 
-__all__ = ["FitCheck", "Holdouts", "check_fit", "holdout_count", "split_holdouts",
+__all__ = ["FitCheck", "Holdouts", "check_fit", "check_holdouts", "holdout_count",
+           "split_holdouts",
            "trusted_column", "TRUST_COLUMNS", "HEALTHY_LIMIT", "EXAMPLE_LIMIT",
            "MIN_HOLDOUTS", "PASSED"]
 
@@ -265,6 +267,34 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         verdict = PASSED
     return FitCheck(verdict, healthy, example, declared_size, h_mean, e_mean,
                     len(healthy), len(example), healthy_limit, example_limit)
+
+
+def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+                   holdouts: Holdouts, n_fit: int, declared_size: float | None) -> FitCheck:
+    """The fit check of a fitted estimator: its hold-outs read by ``predict``.
+
+    Parameters
+    ----------
+    predict : callable
+        The fitted estimator's ``predict``.
+    holdouts : Holdouts
+        From :func:`split_holdouts`.
+    n_fit : int
+        Healthy SAs the fit used (said in an "unchecked" verdict).
+    declared_size : float or None
+        The example's declared size (None: zero-shot).
+    """
+    def read(sa: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
+        return None if sa is None or not len(sa) else predict(sa)
+
+    n_h = 0 if holdouts.healthy is None else len(holdouts.healthy)
+    note = ""
+    if n_h < MIN_HOLDOUTS:
+        note = (f"{n_fit + n_h} healthy segments give {n_h} hold-out(s)"
+                + ("" if holdouts.fraction is None else f" at holdout {holdouts.fraction:g}")
+                + f", {MIN_HOLDOUTS} needed")
+    return check_fit(read(holdouts.healthy), read(holdouts.example), declared_size,
+                     healthy_note=note)
 
 
 #: The columns of :meth:`OneFaultShotEstimator.trust`, in order.
