@@ -188,7 +188,8 @@ def test_too_short_healthy_record_is_unchecked_not_silent(spur_db):
     frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.5,
                      holdout=0.05)
     verdict = frame.attrs["fit_check"]["verdict"]
-    assert verdict.startswith("unchecked: ") and "give 0 hold-out(s)" in verdict
+    assert verdict == ("unchecked: 11 healthy segments give 0 hold-out(s) at holdout 0.05, "
+                       "2 needed")
     assert not frame["trusted"].any()
     assert "healthy_holdout" not in set(frame["role"])
 
@@ -250,3 +251,35 @@ def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(sp
     md = report.read_text()
     assert f"Trusted segments: {n_trusted} of {len(frame)}" in md
     assert "Fit check: passed." in md and (tmp_path / "report" / "estimates.png").is_file()
+
+
+@pytest.mark.parametrize("duration, n_held", [(40.0, 1), (24.0, 0)])
+def test_predict_without_machine_holds_out_and_checks(tmp_path, duration, n_held):
+    """`predict` without --machine (virtual-rig files of the paper's pair): each healthy
+    recording's last quarter is held out and estimated after its fitted segments; with
+    three segments per recording 25 % rounds to none and the fit says "unchecked"."""
+    from gearshot.app.predict import predict_from_files
+    from gearshot.app.simulate import simulate_database
+    from gearshot.rig import VirtualRig
+
+    idx = VirtualRig(seed=1, engine="surrogate").campaign(
+        tmp_path / "camp", speed=15, load=10, duration=duration, healthy=2, sizes=(0.5,),
+        repetitions=1, progress=False)
+    h1, h2, faulty = idx["path"].tolist()
+    db = simulate_database(tmp_path / "db", speeds=[15], loads=[10], grades=[7],
+                           n_healthy=6, n_faulty=12, seed=0, workers=1)
+    frame = predict_from_files(db, [h1, h2], faulty, 0.5, [h2], speed=15, load=10)
+    held = frame[frame["role"] == "healthy_holdout"]
+    assert len(held) == 2 * n_held
+    assert (frame["role"] == "faulty_rest").sum() >= 1   # estimated without being asked
+    fitted = frame[(frame["recording"] == h2) & (frame["role"] == "healthy_fitted")]
+    if n_held:
+        # h2's hold-out follows its fitted segments; h1's is estimated though not asked
+        assert held.loc[held["recording"] == h2, "segment"].tolist() == [len(fitted)]
+        assert set(held["recording"]) == {h1, h2}
+        assert frame.attrs["fit_check"]["n_healthy"] == 2
+    else:
+        assert frame.attrs["fit_check"]["verdict"] == (
+            "unchecked: 6 healthy segments give 0 hold-out(s) at holdout 0.25, 2 needed")
+        assert not frame["trusted"].any()
+    assert (frame["fit_check"] == frame.attrs["fit_check"]["verdict"]).all()

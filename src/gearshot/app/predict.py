@@ -96,7 +96,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
     est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf,
-            healthy_holdout=np.vstack([sa for _, sa, _ in held]), example_record=rest, **kw)
+            holdout=holdout, healthy_holdout=np.vstack([sa for _, sa, _ in held]),
+            example_record=rest, **kw)
     fitted = {_key(p) for p in healthy}
     estimated = {_key(p) for p in files}
     frames = []

@@ -167,7 +167,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     # the database must be of the machine's monitored pair (refused otherwise)
     est.fit(cond.slice, np.vstack(seg.train), seg.example, faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
-            pinion_teeth=machine.mate()[1], healthy_holdout=seg.holdout_sas("healthy_holdout"),
+            pinion_teeth=machine.mate()[1], holdout=holdout,
+            healthy_holdout=seg.holdout_sas("healthy_holdout"),
             example_record=seg.holdout_sas("faulty_rest"))
     frame = _estimates(est, seg, cond, coverage)
     add_trust_columns(frame, est.fit_check_)

@@ -303,8 +303,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             SA cycle, and its mate); SAs of another pair than the database's are refused.
         holdout : float in [0, 1), default 0.0
             Fraction of ``target_healthy`` (its last ``floor(holdout · n)`` SAs) kept out
-            of the fit and read back by the fit check (used when ``healthy_holdout`` is
-            None). ``gearshot predict`` holds out 0.25 of each healthy recording.
+            of the fit and read back by the fit check; with ``healthy_holdout``, the
+            fraction those were cut with (named in an "unchecked" verdict). ``gearshot
+            predict`` holds out 0.25 of each healthy recording.
         healthy_holdout : array_like (n, n_points), optional
             Healthy SAs kept out of the fit (e.g. the last segments of each healthy
             recording): their estimates must read near 0 (:attr:`fit_check_`).

@@ -155,7 +155,8 @@ def split_holdouts(target_healthy: ArrayLike, holdout: float = 0.0,
     target_healthy : array_like (n, n_points)
     holdout : float in [0, 1)
         With ``healthy_holdout`` None: the last ``floor(holdout · n)`` healthy SAs are
-        held out (:func:`holdout_count`). Ignored otherwise (0 is fine).
+        held out (:func:`holdout_count`). Otherwise the fraction the caller cut
+        ``healthy_holdout`` with (said in an "unchecked" verdict; 0: not said).
     healthy_holdout, example_record : array_like (m, n_points) or (n_points,), optional
 
     Returns
@@ -185,8 +186,10 @@ def split_holdouts(target_healthy: ArrayLike, holdout: float = 0.0,
         return arr
 
     example = checked(example_record, "example_record")
-    if healthy_holdout is not None:
-        return healthy, Holdouts(checked(healthy_holdout, "healthy_holdout"), example, None)
+    if healthy_holdout is not None:  # cut by the caller (``holdout`` only said)
+        holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
+        return healthy, Holdouts(checked(healthy_holdout, "healthy_holdout"), example,
+                                 float(holdout) if holdout else None)
     n_out = holdout_count(healthy.shape[0], holdout)
     if n_out == 0:
         return healthy, Holdouts(None, example, float(holdout) if holdout else None)
