@@ -14,7 +14,7 @@ from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
-from .predict import add_trust_columns
+from .trust import add_trust_columns
 
 __all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
 
