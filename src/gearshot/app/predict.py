@@ -11,18 +11,19 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_in_range
 from ..io.input_health import input_check_column, mark_rows, require_ok
-from ..paper import GEAR_TEETH, PINION_TEETH
+from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
+from .trust import add_trust_columns, fit_check_line, trust_summary
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
            "format_predictions", "comparable_summary", "input_check_summary",
-           "summary_table", "ROLES"]
+           "trust_summary", "fit_check_line", "add_trust_columns", "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
 #: the fit. ``healthy_fitted``: a healthy segment the estimator was fitted on (an
 #: in-sample estimate); ``example``: the one faulty example (its estimate is near the
 #: declared size by construction); ``faulty_rest``: the faulty recording's other segments
-#: (same record as the example); ``healthy_holdout``: healthy segments kept out of the fit
-#: (``--machine``); ``test``: a recording the fit never saw.
+#: (same record as the example; they check the fit); ``healthy_holdout``: healthy segments
+#: kept out of the fit (they check it too); ``test``: a recording the fit never saw.
 ROLES = ("healthy_fitted", "example", "faulty_rest", "healthy_holdout", "test")
 
 
@@ -35,7 +36,7 @@ def _recording_files(path: Path):
 
 def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, speed, load=None,
                        coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                       selection_tf=None):
+                       selection_tf=None, holdout=0.25):
     """Fit the estimator from files and predict every SA segment of ``recordings``.
 
     The recordings are segmented for ``gear_teeth`` / ``pinion_teeth`` (default: the
@@ -52,16 +53,27 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     selection_tf : optional
         Step 1's held-out TF (default :func:`gearshot.estimator.default_selection_tf` of
         ``seed``).
+    holdout : float in [0, 1), default 0.25
+        Fraction of each healthy recording's segments (the last ``floor(holdout · n)``)
+        kept out of the fit (and of the TF estimate) and estimated
+        (``role="healthy_holdout"``); with the faulty recording's other segments
+        (``role="faulty_rest"``, always estimated) they check the fit
+        (:attr:`~gearshot.estimator.OneFaultShotEstimator.fit_check_`) and calibrate the
+        intervals.
 
     Returns
     -------
     pandas.DataFrame
         ``recording, role, segment, predicted, low, high, comparability, comparable,
-        input_check`` (roles: :data:`ROLES`; ``comparability``/``comparable`` from
+        input_check, fit_check, trusted`` (roles: :data:`ROLES`;
+        ``comparability``/``comparable`` from
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`; ``input_check``:
         ``"ok"`` or the failed check of :mod:`gearshot.io.input_health`, per recording and
-        segment, with ``predicted``/``low``/``high`` withdrawn (NaN) on a failed row). A
-        healthy or faulty recording that fails an input check is refused.
+        segment, with ``predicted``/``low``/``high`` withdrawn (NaN) on a failed row;
+        ``fit_check`` the fit's verdict, the same in every row; ``trusted``:
+        :func:`gearshot.estimator.trusted_column`). ``attrs["fit_check"]``:
+        :meth:`~gearshot.estimator.fit_check.FitCheck.as_dict`. A healthy or faulty
+        recording that fails an input check is refused.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
@@ -84,35 +96,59 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    targets, healthy_sa, long, example, health = _segments(files, healthy, faulty, kw)
+    targets, healthy_sa, long, example, rest, held, health = _segments(
+        files, healthy, faulty, kw, holdout)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
+    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf,
+            holdout=holdout, healthy_holdout=np.vstack([sa for _, sa, _ in held]),
+            example_record=rest, **kw)
     fitted = {_key(p) for p in healthy}
+    estimated = {_key(p) for p in files}
     frames = []
     for path, sa in targets:
-        low, high = est.predict_interval(sa, coverage=coverage)
-        comp = est.comparability(sa)
-        frames.append(pd.DataFrame(dict(recording=str(path),
-                                        role=_roles(path, len(sa), fitted, faulty),
-                                        segment=np.arange(len(sa)),
-                                        predicted=est.predict(sa), low=low, high=high,
-                                        comparability=comp.score,
-                                        comparable=comp.comparable)))
-        mark_rows(frames[-1], input_check_column(**health[_key(path)]))
+        roles = _roles(path, len(sa), fitted, faulty)
+        n_held = sum(len(h) for p, h, _ in held if _key(p) == _key(path))
+        if n_held:
+            roles[len(sa) - n_held:] = ["healthy_holdout"] * n_held
+        frames.append(_rows(est, path, roles, sa, coverage, health))
+    # the hold-outs that check the fit are estimated even when not asked for
+    for path, sa, n_fit in held:
+        if len(sa) and _key(path) not in estimated:
+            frames.append(_rows(est, path, ["healthy_holdout"] * len(sa), sa, coverage,
+                                health, start=n_fit))
+    if _key(faulty) not in estimated and len(rest):
+        frames.append(_rows(est, faulty, ["faulty_rest"] * len(rest), rest, coverage,
+                            health, start=1))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load
+    add_trust_columns(frame, est.fit_check_)
     return frame
 
 
-def _segments(files, healthy, faulty, kw):
-    """SA segments of the targets, the healthy recordings (stacked; the first one's long
-    angle-domain signal too) and the faulty example (the faulty recording's first segment).
+def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFrame:
+    """One row per SA segment of one recording: estimate, interval, comparability and the
+    input checks of its segments (``health``: resolved path -> checks)."""
+    low, high = est.predict_interval(sa, coverage=coverage)
+    comp = est.comparability(sa)
+    rows = pd.DataFrame(dict(recording=str(path), role=roles,
+                             segment=start + np.arange(len(sa)), predicted=est.predict(sa),
+                             low=low, high=high, comparability=comp.score,
+                             comparable=comp.comparable))
+    return mark_rows(rows, input_check_column(**health[_key(path)], rows=rows["segment"]))
+
+
+def _segments(files, healthy, faulty, kw, holdout=0.0):
+    """SA segments of the targets; the healthy recordings' fitted segments (stacked; the
+    first one's long angle-domain signal too, without its hold-outs); the faulty example
+    (the faulty recording's first segment) and its record's other segments; each healthy
+    recording's hold-outs (its last ``floor(holdout · n)`` segments) as (path, SAs).
 
     Every recording is read and segmented before the fit: a file too short for one SA
     segment (or unreadable) fails now, not after minutes of fitting.
     """
+    from ..estimator.fit_check import holdout_count
     from ..io import recording_segments
 
     health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)
@@ -127,15 +163,19 @@ def _segments(files, healthy, faulty, kw):
         return out
 
     targets = [(path, cut(path)) for path in files]
-    healthy_sa, long = [], None
+    healthy_sa, long, held = [], None, []
     for i, p in enumerate(healthy):
         if i == 0:
             sa, long = cut(p, "healthy", long=True)
         else:
             sa = cut(p, "healthy")
-        healthy_sa.append(sa)
-    example = cut(faulty, "faulty")[0]
-    return targets, np.vstack(healthy_sa), long, example, health
+        n_fit = len(sa) - holdout_count(len(sa), holdout)
+        if i == 0 and n_fit < len(sa):  # held-out segments stay out of the TF estimate
+            long = long[: n_fit * CYCLES_PER_SEGMENT * SAMPLES_PER_CYCLE]
+        healthy_sa.append(sa[:n_fit])
+        held.append((p, sa[n_fit:], n_fit))
+    faulty_sa = cut(faulty, "faulty")
+    return targets, np.vstack(healthy_sa), long, faulty_sa[0], faulty_sa[1:], held, health
 
 
 def _key(path) -> Path:
@@ -151,14 +191,17 @@ def _roles(path, n: int, fitted: set, faulty) -> list[str]:
 
 
 def summary_table(frame: pd.DataFrame, roles: Sequence[str] = ROLES) -> pd.DataFrame:
-    """One row per recording and role: segments, mean estimate and mean interval, headed
-    columns (the printed summary of ``gearshot predict``)."""
+    """One row per recording and role: segments, mean estimate and mean interval, the
+    comparable and the trusted segments' counts, headed columns (the printed summary of
+    ``gearshot predict``)."""
     order = {r: i for i, r in enumerate(roles)}
     by = ["recording", "role"] if "role" in frame else ["recording"]
     aggs = dict(segments=("predicted", "size"), estimated_size=("predicted", "mean"),
                 low=("low", "mean"), high=("high", "mean"))
     if "comparable" in frame:
         aggs["comparable"] = ("comparable", "sum")
+    if "trusted" in frame:
+        aggs["trusted"] = ("trusted", "sum")
     table = frame.groupby(by, sort=False).agg(**aggs).reset_index()
     if "role" in table:
         table = table.sort_values("role", key=lambda r: r.map(order), kind="stable")
@@ -206,7 +249,8 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
         raise GearshotError("--recordings: give at least one file or folder to estimate")
     frame = predict_from_files(database, healthy, faulty, faulty_size, recordings,
                                speed=speed, load=load, coverage=coverage,
-                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed)
+                               gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed,
+                               holdout=holdout)
     return frame, (f"database condition: {frame.attrs['speed']:g} rps, load "
                    f"{frame.attrs['load']:g} N m")
 
@@ -251,7 +295,14 @@ def input_check_summary(frame: pd.DataFrame) -> str:
 
 
 def format_predictions(frame: pd.DataFrame, where: str) -> str:
-    """What ``gearshot predict`` prints: the condition, the summary per recording and
-    role (:func:`summary_table`), the comparability count and the input-check count."""
+    """What ``gearshot predict`` prints: the condition, the fit's verdict
+    (:func:`fit_check_line`), the summary per recording and role (:func:`summary_table`),
+    the comparability, input-check and trusted counts."""
     table = summary_table(frame).to_string(index=False, float_format=lambda v: f"{v:.3f}")
-    return "\n".join([where, table, comparable_summary(frame), input_check_summary(frame)])
+    lines = [where]
+    if "fit_check" in frame or frame.attrs.get("fit_check"):
+        lines.append(fit_check_line(frame))
+    lines += [table, comparable_summary(frame), input_check_summary(frame)]
+    if "trusted" in frame:
+        lines.append(trust_summary(frame))
+    return "\n".join(lines)

@@ -15,6 +15,7 @@ from .._validation import check_in_range, check_int
 from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
+from .trust import add_trust_columns
 
 __all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
 
@@ -132,9 +133,12 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     sensor : str, optional
         Default: the machine's first sensor.
     holdout : float
-        Fraction of each healthy recording's segments (the last ones) kept out of the fit
-        and estimated (``role="healthy_holdout"``); the faulty recording's other segments
-        are estimated too (``role="faulty_rest"``; they come from the example's record).
+        Fraction of each healthy recording's segments (the last ``floor(holdout · n)``)
+        kept out of the fit and estimated (``role="healthy_holdout"``); the faulty
+        recording's other segments are estimated too (``role="faulty_rest"``; they come
+        from the example's record). Both groups check the fit (``fit_check``) and
+        calibrate the intervals; a recording too short to give hold-outs leaves the fit
+        "unchecked", and its estimates untrusted.
     example_segment, coverage, seed
         Which faulty segment is the example; interval coverage; random state.
     params : dict, optional
@@ -158,9 +162,13 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         ``vibration``; ``input_check``: ``"ok"`` or the failed check of
         :mod:`gearshot.io.input_health`, per recording and segment, with the row's
         ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
-        recording that fails is refused); ``attrs`` hold the condition (``speed_hz``,
-        ``load``, ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None),
-        the grade and the simulated reference.
+        recording that fails is refused), ``fit_check`` (the fit's verdict on its own
+        hold-outs, the same in every row: "passed" or the reason,
+        :attr:`OneFaultShotEstimator.fit_check_`) and ``trusted``
+        (:func:`gearshot.estimator.trusted_column`); ``attrs`` hold the ``fit_check``
+        (:meth:`FitCheck.as_dict`), the condition (``speed_hz``, ``load``,
+        ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade
+        and the simulated reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
 
@@ -179,8 +187,11 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     # the database must be of the machine's monitored pair (refused otherwise)
     est.fit(cond.slice, np.vstack(seg.train), seg.example, faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
-            pinion_teeth=machine.mate()[1])
+            pinion_teeth=machine.mate()[1], holdout=holdout,
+            healthy_holdout=seg.holdout_sas("healthy_holdout"),
+            example_record=seg.holdout_sas("faulty_rest"))
     frame = _estimates(est, seg, cond, coverage)
+    add_trust_columns(frame, est.fit_check_)
     frame.attrs["grade"] = getattr(est, "grade_", None)
     frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame
@@ -213,6 +224,12 @@ class _Segments:
     speeds: dict = field(default_factory=dict)  # file -> tacho speed, Hz
     healthy_speeds: list = field(default_factory=list)
     sources: dict = field(default_factory=dict)  # file -> speed_source, uncertainty
+
+    def holdout_sas(self, role: str) -> np.ndarray:
+        """The SAs of the rows of ``role`` (hold-outs), stacked; (0, n) when none."""
+        sas = [r[4] for r in self.rows if r[1] == role]
+        n = self.example.size if self.example is not None else 0
+        return np.stack(sas) if sas else np.empty((0, n))
 
 
 def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, holdout,

@@ -126,9 +126,15 @@ def _predict_report(rows, out: Path, *, source: Path) -> Path:
              f"{len(frame)} SA segments of {frame['recording'].nunique()} recording(s). "
              "Role: what a segment was to the fit (healthy_fitted and example were fitted "
              "on; healthy_holdout, faulty_rest and test were not).", ""]
+    if "fit_check" in frame and len(frame):
+        lines += [f"Fit check: {frame['fit_check'].iloc[0]}.", ""]
     if "comparable" in frame:
         lines += [f"Comparable segments: {int(frame['comparable'].astype(bool).sum())} of "
                   f"{len(frame)}.", ""]
+    if "trusted" in frame:
+        lines += [f"Trusted segments: {int(frame['trusted'].astype(bool).sum())} of "
+                  f"{len(frame)} (input check ok, comparable, fit check passed); the figure "
+                  "draws the untrusted ones as hollow grey markers.", ""]
     lines += _md_table(table)
     for caption, fig in figs.items():
         lines += [f"## {caption}", "", f"![{caption}]({fig.name})", ""]
@@ -138,6 +144,9 @@ def _predict_report(rows, out: Path, *, source: Path) -> Path:
 
 
 def _predict_figure(frame, path: Path) -> Path:
+    """Estimates and intervals per recording, one colour per role; untrusted estimates
+    (``trusted`` False) apart, as hollow grey markers with one legend entry."""
+    import numpy as np
     from matplotlib.figure import Figure
 
     from .._atomic import atomic_path
@@ -146,16 +155,28 @@ def _predict_figure(frame, path: Path) -> Path:
     fig = Figure(figsize=(7, 1.4 + 0.35 * len(names)), layout="constrained")
     ax = fig.subplots()
     roles = list(dict.fromkeys(frame["role"])) if "role" in frame else [None]
+    trusted = frame["trusted"].astype(bool) if "trusted" in frame else None
+    untrusted_label = "untrusted (any role)"
     for k, role in enumerate(roles):
         part = frame if role is None else frame[frame["role"] == role]
-        y = [names.index(r) + 0.12 * (k - (len(roles) - 1) / 2) for r in part["recording"]]
-        ax.errorbar(part["predicted"], y,
-                    xerr=[part["predicted"] - part["low"], part["high"] - part["predicted"]],
-                    fmt="o", ms=3, lw=0.6, color=f"C{k}", label=role)
+        y = np.array([names.index(r) + 0.12 * (k - (len(roles) - 1) / 2)
+                      for r in part["recording"]])
+        ok = np.ones(len(part), bool) if trusted is None else trusted[part.index].to_numpy()
+        for keep, style in ((ok, dict(fmt="o", color=f"C{k}", label=role)),
+                            (~ok, dict(fmt="o", color="0.6", mfc="none",
+                                       label=untrusted_label))):
+            if not keep.any():
+                continue
+            sub = part[keep]
+            ax.errorbar(sub["predicted"], y[keep],
+                        xerr=[sub["predicted"] - sub["low"], sub["high"] - sub["predicted"]],
+                        ms=3, lw=0.6, **style)
+            if style["label"] == untrusted_label:
+                untrusted_label = "_nolegend_"  # one legend entry for every untrusted role
     ax.set_yticks(range(len(names)), [Path(n).name for n in names], fontsize=7)
     ax.set_xlim(-0.02, 1.02)
     ax.set_xlabel("estimated fault size y (0 healthy ... 1), bars: prediction interval")
-    if roles != [None]:
+    if roles != [None] or trusted is not None:
         ax.legend(fontsize=7, title="role", title_fontsize=7, loc="lower right")
     with atomic_path(path, make_parents=True) as tmp:
         fig.savefig(tmp, dpi=110, format="png")

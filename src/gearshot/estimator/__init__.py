@@ -5,6 +5,7 @@
 ``uncertainty``                grade weights and prediction intervals (not paper steps)
 ``zero_shot``                  grade choice from healthy data alone
 ``comparability``              does a segment look like the fitted machine (issue #19)
+``fit_check``                  the fit's own hold-outs read back: its verdict (issue #29)
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
 ``EstimatorOptions``            its research settings (one constructor parameter)
 ``save_estimator`` / ``load``  persistence with version metadata
@@ -12,11 +13,12 @@
 """
 
 from .._errors import NotFittedError
-from . import comparability, steps, uncertainty
+from . import comparability, fit_check, steps, uncertainty
 from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from ._params import check_estimator_params
 from .calibration import CalibrationOptions
 from .comparability import Comparability, ComparabilityReference, harmonic_profile
+from .fit_check import FitCheck, check_fit, trusted_column
 from .options import EstimatorOptions
 from .persistence import load_estimator, save_estimator
 from .steps import (
@@ -31,7 +33,13 @@ from .steps import (
     suppress_harmonics_target,
     tune_grade,
 )
-from .uncertainty import conformal_quantile, grade_weights, mixture_interval, prune_weights
+from .uncertainty import (
+    conformal_quantile,
+    grade_weights,
+    holdout_interval,
+    mixture_interval,
+    prune_weights,
+)
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
 __all__ = [
@@ -47,6 +55,11 @@ __all__ = [
     "Comparability",
     "ComparabilityReference",
     "harmonic_profile",
+    "fit_check",
+    "FitCheck",
+    "check_fit",
+    "trusted_column",
+    "holdout_interval",
     "select_features",
     "tune_grade",
     "estimate_tf",

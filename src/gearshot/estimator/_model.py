@@ -61,6 +61,7 @@ from .calibration import (
     resolve_calibration,
 )
 from .comparability import fit_comparability
+from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
 
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
@@ -205,6 +206,12 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         (:mod:`gearshot.estimator.comparability`).
     mesh_orders_ : tuple of int
         The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
+    fit_check_ : FitCheck
+        The fit's own hold-outs read back (:mod:`gearshot.estimator.fit_check`): healthy
+        SAs kept out of the fit against 0, the example record's other segments against
+        ``faulty_size``, their counts and a ``verdict`` ("passed" or the reason;
+        "unchecked: ..." with too few hold-outs). Its residuals calibrate
+        :meth:`predict_interval`.
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -266,7 +273,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     def fit(self, database: Any, target_healthy: ArrayLike,
             faulty_example: ArrayLike | None = None, faulty_size: float | None = None,
             healthy_long: ArrayLike | None = None, *, selection_tf: Any = None,
-            gear_teeth: int | None = None, pinion_teeth: int | None = None) -> Self:
+            gear_teeth: int | None = None, pinion_teeth: int | None = None,
+            holdout: float = 0.0, healthy_holdout: ArrayLike | None = None,
+            example_record: ArrayLike | None = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters
@@ -292,6 +301,20 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         gear_teeth, pinion_teeth : int, optional
             The pair the target SAs were segmented for (the gear whose revolution is the
             SA cycle, and its mate); SAs of another pair than the database's are refused.
+        holdout : float in [0, 1), default 0.0
+            Fraction of ``target_healthy`` (its last ``floor(holdout · n)`` SAs) kept out
+            of the fit and read back by the fit check; with ``healthy_holdout``, the
+            fraction those were cut with (named in an "unchecked" verdict). ``gearshot
+            predict`` holds out 0.25 of each healthy recording.
+        healthy_holdout : array_like (n, n_points), optional
+            Healthy SAs kept out of the fit (e.g. the last segments of each healthy
+            recording): their estimates must read near 0 (:attr:`fit_check_`).
+        example_record : array_like (n, n_points), optional
+            The example record's other segments (not the example itself): their
+            estimates must read near ``faulty_size``.
+
+        Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``);
+        the hold-outs also calibrate :meth:`predict_interval`.
 
         Returns
         -------
@@ -305,13 +328,18 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             The estimator is left as it was before the call.
         """
         validate_params(self.get_params(deep=False), self._parameter_constraints)
+        target_healthy, holdouts = split_holdouts(target_healthy, holdout, healthy_holdout,
+                                                  example_record)
         orders = resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
         self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
         try:
-            return self._fit(database, target_healthy, faulty_example, faulty_size,
-                             healthy_long, selection_tf, orders)
+            self._fit(database, target_healthy, faulty_example, faulty_size,
+                      healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
+        n_fit = len(self.target_healthy_features_) + len(self.references_)
+        self.fit_check_ = check_holdouts(self.predict, holdouts, n_fit, self.faulty_size_)
+        return self
 
     def _fit(self, database: Any, target_healthy: ArrayLike,
              faulty_example: ArrayLike | None, faulty_size: float | None,

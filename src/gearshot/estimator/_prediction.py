@@ -13,9 +13,20 @@ from .._errors import GearshotError, NotFittedError
 from .._validation import as_signal_array, check_in_range
 from ._target import target_features
 from .comparability import Comparability, ComparabilityReference
-from .uncertainty import conformal_quantile, mixture_interval
+from .fit_check import TRUST_COLUMNS, FitCheck, trusted_column
+from .uncertainty import conformal_quantile, holdout_interval, mixture_interval
 
 FloatArray = NDArray[np.float64]
+
+def _per_row(value: Any, n: int, name: str) -> list[str]:
+    """One string per row from one string or a sequence of ``n``."""
+    if isinstance(value, str):
+        return [value] * n
+    values = [str(v) for v in value]
+    if len(values) != n:
+        raise GearshotError(f"{name} holds {len(values)} value(s) for {n} SA(s); give one "
+                            f"string or one per SA")
+    return values
 
 
 # scikit-learn ships no type information: its classes are Any to mypy
@@ -100,9 +111,56 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
                                 "a comparability reference; fit it again")
         return reference.evaluate(sa, threshold)
 
+    def trust(self, sa: ArrayLike, input_check: Any = None, *,
+              coverage: float = 0.9) -> Any:
+        """Every estimate with the checks it passed or failed (issue #29).
+
+        Parameters
+        ----------
+        sa : array_like (n_signals, n_points) or (n_points,)
+        input_check : str or sequence of str, optional
+            The input-health verdict of each SA ("ok" or the failed check), one for all or
+            one per SA; None: "ok".
+        coverage : float in (0, 1), default 0.9
+            Coverage of ``low`` and ``high``.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per SA: ``predicted, low, high`` (:meth:`predict`,
+            :meth:`predict_interval`), ``comparability, comparable``
+            (:meth:`comparability`), ``input_check``, ``fit_check`` (the fit's verdict,
+            ``fit_check_.verdict``: "passed" or the reason) and ``trusted``: the input
+            check is "ok", the segment is comparable and the fit check passed.
+        """
+        import pandas as pd
+
+        self._check_fitted("trust")
+        arr = as_signal_array(sa, "sa", max_ndim=2)
+        arr = arr.reshape(-1, arr.shape[-1])
+        low, high = self.predict_interval(arr, coverage=coverage)
+        comp = self.comparability(arr)
+        frame = pd.DataFrame(dict(predicted=self.predict(arr), low=low, high=high,
+                                  comparability=comp.score, comparable=comp.comparable))
+        frame["input_check"] = "ok" if input_check is None else _per_row(
+            input_check, len(arr), "input_check")
+        check: FitCheck | None = getattr(self, "fit_check_", None)
+        frame["fit_check"] = "unchecked: fitted before the fit check existed" \
+            if check is None else check.verdict
+        frame["trusted"] = trusted_column(frame)
+        return frame.loc[:, list(TRUST_COLUMNS)]
+
     def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,
                          ) -> tuple[FloatArray, FloatArray]:
-        """Prediction intervals: split-conformal residuals widened by the model discrepancy.
+        """Prediction intervals, calibrated on the fit's real hold-outs when it has them.
+
+        A checked fit (``fit_check_`` with enough healthy hold-outs and segments of the
+        example record, passed or failed) gives intervals calibrated on their real
+        residuals, widened by the run-to-run spread
+        (:func:`~gearshot.estimator.uncertainty.holdout_interval`): a healthy segment of
+        the machine has 0 in its interval, the example record's segments the declared
+        size, at ``coverage``. Without hold-outs (an unchecked fit) the intervals are
+        the simulated ones below, which cannot show the simulation-to-reality bias.
 
         Each grade model says ``y = ŷ_g ± r + δ``: ``r`` from its validation residuals
         (split conformal), ``δ ~ N(0, model_discrepancy²)`` the simulation-to-reality
@@ -124,6 +182,11 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         self._check_fitted("predict_interval")
         coverage = check_in_range(coverage, "coverage", 0, 1, low_inclusive=False,
                                   high_inclusive=False)
+        check: FitCheck | None = getattr(self, "fit_check_", None)
+        if check is not None and check.checked and check.n_healthy and check.n_example:
+            healthy, example = check.residuals()
+            low, high = holdout_interval(self.predict(sa), healthy, example, coverage)
+            return np.clip(low, 0, 1), np.clip(high, 0, 1)
         X = self.features_of(sa)
         discrepancy = float(self.model_discrepancy)
         settings, models = self.calibration_["settings"], self.setting_models_

@@ -41,6 +41,7 @@ SAFE_TYPES = (
     "gearshot.estimator.options.EstimatorOptions",
     "gearshot.estimator.comparability.Comparability",
     "gearshot.estimator.comparability.ComparabilityReference",
+    "gearshot.estimator.fit_check.FitCheck",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",
     "sklearn.neighbors._kd_tree.KDTree",
 )

@@ -7,7 +7,10 @@ The paper keeps one tuned grade and gives point estimates. Two additions live he
   (shared with the zero-shot weights of :mod:`gearshot.estimator.zero_shot`).
 * :func:`conformal_quantile` and :func:`mixture_interval`: split-conformal prediction
   intervals from the validation residuals of step 8, widened by a model discrepancy and
-  mixed over the weighted grade models.
+  mixed over the weighted grade models (the interval of a fit without hold-outs).
+* :func:`holdout_interval`: intervals calibrated on the real residuals of the fit's own
+  hold-outs (:mod:`gearshot.estimator.fit_check`) with a run-to-run spread
+  (:data:`RUN_SPREAD`): the interval of a checked fit.
 """
 
 from __future__ import annotations
@@ -19,7 +22,18 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._errors import GearshotError
 
-__all__ = ["grade_weights", "prune_weights", "conformal_quantile", "mixture_interval"]
+__all__ = ["grade_weights", "prune_weights", "conformal_quantile", "mixture_interval",
+           "holdout_interval", "RUN_SPREAD"]
+
+#: Standard deviation (fault-size units) of the change of a segment's estimate from one
+#: run of a machine to the next (remounting, path drift, temperature) that the hold-outs
+#: of one run cannot show. Chosen on the development cells of the PHM09 spur subset
+#: (30 Hz High and Low, fit on run 1, estimated on run 2; benchmarks/phm09_run2.py): the
+#: smallest of 0, 0.04, 0.06, 0.08, 0.10, 0.12 whose 90 % intervals hold 0 for ≥ 90 % of
+#: the healthy run-2 segments and 0.5 for ≥ 90 % of the chipped ones in each cell (0.08:
+#: 82 % of the 30 Hz High healthy segments; 0.10: all; benchmarks/RESULTS.md "Trust: fit
+#: check, intervals and run-to-run").
+RUN_SPREAD = 0.10
 
 
 def grade_weights(predictions: ArrayLike, grades: Sequence[int], faulty_size: float,
@@ -136,3 +150,54 @@ def mixture_interval(predictions: Mapping[int, ArrayLike], weights: Mapping[int,
     hi_idx = np.minimum((cdf < 1 - tail).sum(axis=1), values.shape[1] - 1)
     rows = np.arange(values.shape[0])
     return sorted_values[rows, lo_idx], sorted_values[rows, hi_idx]
+
+
+def holdout_interval(predictions: ArrayLike, healthy_residuals: ArrayLike,
+                     example_residuals: ArrayLike, coverage: float, *,
+                     run_spread: float = RUN_SPREAD,
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Prediction intervals calibrated on the real residuals of a fit's hold-outs.
+
+    The hold-outs are the machine's own segments of known size that the fit never saw:
+    healthy segments (residual ``ŷ − 0``) and the example record's other segments
+    (``ŷ − declared size``). Over-reading and under-reading are bounded separately, each
+    by the split-conformal quantile (:func:`conformal_quantile`, at ``coverage``) of the
+    group that shows it: over-reading by the larger of the healthy and the example
+    groups' positive residuals, under-reading by the example group's negative ones (a
+    healthy segment cannot read below 0). Each bound is widened in quadrature by the
+    run-to-run spread, ``z · run_spread`` with ``z`` the normal quantile of
+    ``(1 + coverage) / 2``: hold-outs of one run show the segment-to-segment scatter of
+    that run, not how a later run of the same machine moves.
+
+    ``low = ŷ − sqrt(over² + (z·s)²)``, ``high = ŷ + sqrt(under² + (z·s)²)``.
+
+    Parameters
+    ----------
+    predictions : array_like (n,)
+    healthy_residuals, example_residuals : array_like
+        Signed residuals of the two hold-out groups (each non-empty).
+    coverage : float in (0, 1)
+    run_spread : float >= 0, default :data:`RUN_SPREAD`
+
+    Returns
+    -------
+    low, high : ndarray (n,)
+        Not clipped.
+    """
+    from scipy.stats import norm
+
+    if not 0 < coverage < 1:
+        raise GearshotError(f"coverage must lie in (0, 1); got {coverage!r}")
+    if not run_spread >= 0:
+        raise GearshotError(f"run_spread must be >= 0; got {run_spread!r}")
+    healthy = np.asarray(healthy_residuals, float).reshape(-1)
+    example = np.asarray(example_residuals, float).reshape(-1)
+    if not healthy.size or not example.size:
+        raise GearshotError("holdout_interval needs healthy and example residuals; got "
+                            f"{healthy.size} and {example.size}")
+    over = max(float(conformal_quantile(np.maximum(healthy, 0), coverage)),
+               float(conformal_quantile(np.maximum(example, 0), coverage)))
+    under = float(conformal_quantile(np.maximum(-example, 0), coverage))
+    spread = float(norm.ppf((1 + coverage) / 2)) * run_spread
+    pred = np.asarray(predictions, float)
+    return pred - np.hypot(over, spread), pred + np.hypot(under, spread)

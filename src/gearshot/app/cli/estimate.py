@@ -52,8 +52,10 @@ _HELP = {
                "gear train; speeds in tacho-shaft Hz.",
     "cycles": "With --machine: revolutions per SA segment (default: the machine's).",
     "sensor": "With --machine: sensor name (default the first).",
-    "holdout": "With --machine: fraction of each healthy recording's segments kept out of "
-               "the fit and estimated.",
+    "holdout": "Fraction of each healthy recording's segments (the last ones) kept out of "
+               "the fit and estimated; with the example record's other segments they check "
+               "the fit (the fit_check column: 'passed' or the reason) and calibrate the "
+               "intervals.",
     "tolerance": "With --machine: largest relative distance between a recording's tacho "
                  "speed and the database condition (beyond it the recording is refused).",
     "labels": "CSV with columns file, label (and optionally cell): rank the indicators by "

@@ -1,0 +1,57 @@
+"""The trust columns of a predict table (issue #29): the fit's verdict in every row,
+``trusted``, and the lines ``gearshot predict`` prints about them."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+__all__ = ["add_trust_columns", "fit_check_line", "trust_summary"]
+
+
+def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
+    """Add the fit's verdict and ``trusted`` to a predict table, in place.
+
+    ``fit_check``: ``check.verdict`` in every row ("passed" or the reason); ``trusted``:
+    :func:`gearshot.estimator.trusted_column` (input check "ok" — a table without
+    ``input_check`` counts as "ok" —, comparable and the fit check passed);
+    ``frame.attrs["fit_check"]``: ``check.as_dict()``.
+    """
+    from ..estimator import trusted_column
+
+    frame["fit_check"] = check.verdict
+    frame["trusted"] = trusted_column(frame) if len(frame) else pd.Series(dtype=bool)
+    frame.attrs["fit_check"] = check.as_dict()
+    return frame
+
+
+def fit_check_line(frame: pd.DataFrame) -> str:
+    """One line with the fit's verdict on its own hold-outs (printed before the
+    estimates)."""
+    check = frame.attrs.get("fit_check")
+    if not check:
+        verdict = str(frame["fit_check"].iloc[0]) if "fit_check" in frame and len(frame) \
+            else "unknown"
+        return f"fit check: {verdict}"
+    parts = []
+    if check.get("n_healthy"):
+        parts.append(f"{check['n_healthy']} healthy hold-out(s) read "
+                     f"{check['healthy_mean']:.3f} on average")
+    if check.get("n_example"):
+        parts.append(f"{check['n_example']} other segment(s) of the example record read "
+                     f"{check['example_mean']:.3f} against the declared "
+                     f"{check['declared_size']:g}")
+    line = f"fit check: {check['verdict']}"
+    if parts:
+        line += " (" + "; ".join(parts) + ")"
+    if check["verdict"] != "passed":
+        line += " — no estimate of this fit is trusted"
+    return line
+
+
+def trust_summary(frame: pd.DataFrame) -> str:
+    """One line counting the trusted segments of a predict table."""
+    if "trusted" not in frame or not len(frame):
+        return "trusted: no segment estimated"
+    n_yes = int(frame["trusted"].astype(bool).sum())
+    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input check ok, comparable and "
+            f"fit check passed)")

@@ -1,0 +1,285 @@
+"""A fit that checks itself, calibrated intervals and the trust columns (issue #29).
+
+Verdicts and intervals on analytic residuals; the whole chain on the real PHM09 spur
+records (../shared/data/phm09, 30 Hz, 10-revolution SAs of the input shaft) with a
+test-sized database of the machine's pair (12 grades × 6 healthy + 24 faulty, paired).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gearshot import GearshotError, Machine
+from gearshot.estimator import OneFaultShotEstimator, check_fit, holdout_interval
+from gearshot.estimator.fit_check import (
+    EXAMPLE_LIMIT,
+    HEALTHY_LIMIT,
+    holdout_count,
+    split_holdouts,
+    trusted_column,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+SPUR = ROOT / "examples" / "machines" / "phm09_spur.toml"
+PHM = ROOT.parent / "shared" / "data" / "phm09"
+
+
+# ------------------------------------------------------------------- verdicts
+def test_a_fit_whose_holdouts_read_right_passes():
+    check = check_fit([0.02, 0.08, 0.05], [0.45, 0.52, 0.48], 0.5)
+    assert check.verdict == "passed" and check.passed and check.checked
+    assert check.n_healthy == 3 and check.n_example == 3
+    assert check.healthy_mean == pytest.approx(0.05)
+    assert check.example_mean == pytest.approx(0.4833333)
+    healthy, example = check.residuals()
+    np.testing.assert_allclose(example, [-0.05, 0.02, -0.02], atol=1e-12)
+    assert json.loads(json.dumps(check.as_dict()))["passed"] is True
+
+
+def test_healthy_holdouts_that_read_as_fault_fail_the_fit():
+    check = check_fit([0.40, 0.46], [0.5, 0.5], 0.5)
+    assert not check.passed and check.checked
+    assert check.verdict == (f"healthy hold-outs read 0.43 on average (limit "
+                             f"{HEALTHY_LIMIT:g})")
+
+
+def test_example_record_far_from_the_declared_size_fails_the_fit():
+    check = check_fit([0.0, 0.01], [0.18, 0.20], 0.5)
+    assert check.verdict == ("example record's other segments read 0.19 against the "
+                             f"declared 0.5 (limit ± {EXAMPLE_LIMIT:g})")
+    # both failures are named
+    both = check_fit([0.4, 0.4], [0.1, 0.1], 0.5)
+    assert "healthy hold-outs" in both.verdict and "example record's" in both.verdict
+
+
+def test_too_few_holdouts_leave_the_fit_unchecked():
+    assert holdout_count(3, 0.25) == 0      # 25 % of 3 segments rounds to none
+    assert holdout_count(12, 0.25) == 3
+    check = check_fit([], [0.5, 0.5], 0.5,
+                      healthy_note="3 healthy segments give 0 hold-out(s), 2 needed")
+    assert check.verdict == "unchecked: 3 healthy segments give 0 hold-out(s), 2 needed"
+    assert not check.passed and not check.checked
+    one = check_fit([0.0, 0.0], [0.5], 0.5)
+    assert one.verdict.startswith("unchecked: 1 other segment(s) of the example record")
+    # an unchecked fit that also reads wrong says both
+    assert "(and healthy hold-outs read 0.50" in check_fit([0.5], [], 0.5).verdict
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda: check_fit([np.nan, 0.0], [0.5, 0.5], 0.5), "healthy_estimates"),
+    (lambda: check_fit([0.0, 0.0], [0.5, 0.5], 1.5), "declared_size"),
+    (lambda: check_fit([0.0, 0.0], [0.5, 0.5], 0.5, min_holdouts=0), "min_holdouts"),
+    (lambda: holdout_count(4, 1.0), "holdout"),
+    (lambda: split_holdouts(np.zeros((4, 16)), healthy_holdout=np.zeros((2, 8))),
+     "healthy_holdout has 8 points"),
+    (lambda: holdout_interval([0.1], [], [0.0], 0.9), "healthy and example residuals"),
+    (lambda: holdout_interval([0.1], [0.1], [0.0], 1.0), "coverage"),
+    (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, run_spread=-1), "run_spread"),
+])
+def test_bad_input_names_the_argument(call, words):
+    with pytest.raises(GearshotError, match=words):
+        call()
+
+
+def test_split_holdouts_keeps_the_last_segments_out():
+    sa = np.arange(8 * 4, dtype=float).reshape(8, 4)
+    fit, held = split_holdouts(sa, 0.25)
+    np.testing.assert_array_equal(fit, sa[:6])
+    np.testing.assert_array_equal(held.healthy, sa[6:])
+    assert held.fraction == 0.25 and held.example is None
+
+
+# ------------------------------------------------------------------ intervals
+def test_holdout_interval_is_the_conformal_bound_of_each_side():
+    rng = np.random.default_rng(0)
+    healthy = np.abs(rng.normal(0, 0.05, 19))       # healthy over-read, ≥ 0
+    example = rng.normal(-0.1, 0.05, 19)            # the example record under-reads
+    low, high = holdout_interval([0.3], healthy, example, 0.9, run_spread=0.0)
+    rank = int(np.ceil(20 * 0.9)) - 1
+    over = max(np.sort(healthy)[rank], np.sort(np.maximum(example, 0))[rank])
+    under = np.sort(np.maximum(-example, 0))[rank]
+    np.testing.assert_allclose([low[0], high[0]], [0.3 - over, 0.3 + under])
+    # each hold-out's own interval holds its truth at the stated coverage
+    lo_h, _ = holdout_interval(healthy, healthy, example, 0.9, run_spread=0.0)
+    _, hi_e = holdout_interval(example + 0.5, healthy, example, 0.9, run_spread=0.0)
+    assert (lo_h <= 0).mean() >= 0.9 and (hi_e >= 0.5).mean() >= 0.9
+    # the run-to-run spread widens both sides in quadrature
+    low2, high2 = holdout_interval([0.3], healthy, example, 0.9, run_spread=0.1)
+    z = 1.6448536269514722
+    np.testing.assert_allclose([0.3 - low2[0], high2[0] - 0.3],
+                               [np.hypot(over, 0.1 * z), np.hypot(under, 0.1 * z)])
+
+
+def test_trusted_needs_every_check():
+    frame = pd.DataFrame(dict(comparable=[True, True, False, True],
+                              fit_check=["passed", "passed", "passed", "unchecked: x"],
+                              input_check=["ok", "dead channel", "ok", "ok"]))
+    assert trusted_column(frame).tolist() == [True, False, False, False]
+    # a table without input_check counts it as ok; without fit_check nothing is trusted
+    assert trusted_column(frame.drop(columns="input_check")).tolist() == [True, True,
+                                                                          False, False]
+    assert not trusted_column(frame.drop(columns="fit_check")).any()
+
+
+# ------------------------------------------------------------ real PHM09 records
+def _record(name: str) -> Path:
+    path = PHM / name
+    if not path.is_file():
+        pytest.skip(f"{path} is absent; real-data checks need ../shared/data/phm09")
+    return path
+
+
+@pytest.fixture(scope="module")
+def spur_db(tmp_path_factory):
+    from gearshot.app.simulate import simulate_machine_database
+
+    store = tmp_path_factory.mktemp("fitcheck") / "db"
+    _record("spur3_30hz_High_1.zip")
+    simulate_machine_database(SPUR, store, speeds=[30], loads=[10], grades=range(1, 13),
+                              n_healthy=6, n_faulty=24, seed=0, workers=1)
+    return store
+
+
+def _predict(db, healthy: str, faulty: str, size: float, recordings=(), holdout=0.25):
+    from gearshot.app.predict_machine import predict_from_machine
+
+    return predict_from_machine(Machine.from_toml(SPUR), db, [_record(healthy)],
+                                _record(faulty), size, [_record(r) for r in recordings],
+                                speed=30.0, load=10.0, cycles_per_segment=10, seed=0,
+                                holdout=holdout)
+
+
+def test_real_fit_passes_and_its_intervals_cover_run_two(spur_db):
+    """Fit on run 1 (30 Hz High); run 2 of the same gears, never seen by the fit: 0 in
+    the healthy gear's intervals, the declared 0.5 in the chipped gear's."""
+    frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.5,
+                     ["spur3_30hz_High_2.zip", "spur2_30hz_High_2.zip"])
+    check = frame.attrs["fit_check"]
+    assert check["verdict"] == "passed"
+    assert check["n_healthy"] == 2 and check["n_example"] == 10
+    assert (frame["fit_check"] == "passed").all()
+    assert frame["trusted"].dtype == bool and frame["trusted"].all()
+    # the hold-outs read back what they are
+    assert check["healthy_mean"] < HEALTHY_LIMIT
+    assert abs(check["example_mean"] - 0.5) < EXAMPLE_LIMIT
+    run2 = frame[frame["recording"].str.endswith("_2.zip")]
+    healthy = run2[run2["recording"].str.contains("spur3")]
+    chipped = run2[run2["recording"].str.contains("spur2")]
+    assert ((healthy["low"] <= 0) & (0 <= healthy["high"])).mean() >= 0.9
+    assert ((chipped["low"] <= 0.5) & (0.5 <= chipped["high"])).mean() >= 0.9
+    assert (run2["high"] - run2["low"]).mean() <= 0.40
+    assert chipped["predicted"].min() > healthy["predicted"].max()
+
+
+def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
+    frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.95)
+    verdict = frame.attrs["fit_check"]["verdict"]
+    assert verdict != "passed" and "against the declared 0.95" in verdict
+    assert (frame["fit_check"] == verdict).all() and not frame["trusted"].any()
+
+
+def test_too_short_healthy_record_is_unchecked_not_silent(spur_db):
+    # 10-revolution segments of the 30 Hz record: 11 whole ones; holdout 0.05 → none
+    frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.5,
+                     holdout=0.05)
+    verdict = frame.attrs["fit_check"]["verdict"]
+    assert verdict == ("unchecked: 11 healthy segments give 0 hold-out(s) at holdout 0.05, "
+                       "2 needed")
+    assert not frame["trusted"].any()
+    assert "healthy_holdout" not in set(frame["role"])
+
+
+def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
+    """est.trust: the documented columns; a Low-load fit's estimates of High-load
+    segments of the same healthy gear are not trusted."""
+    from gearshot.app.predict_machine import machine_segments
+    from gearshot.estimator import default_selection_tf
+    from gearshot.sim import load_database
+
+    machine = Machine.from_toml(SPUR)
+    seg = {name: machine_segments(_record(name), machine, cycles_per_segment=10)
+           for name in ("spur3_30hz_Low_1.zip", "spur2_30hz_Low_1.zip",
+                        "spur3_30hz_High_1.zip")}
+    healthy, long, _ = seg["spur3_30hz_Low_1.zip"]
+    faulty = seg["spur2_30hz_Low_1.zip"][0]
+    est = OneFaultShotEstimator(mesh_order=list(machine.mesh_orders("input")),
+                                random_state=0)
+    db = load_database(spur_db, speed=machine.sim_speed(30.0), load=10.0)
+    est.fit(db, healthy, faulty[0], 0.5, long, selection_tf=default_selection_tf(0),
+            gear_teeth=32, pinion_teeth=96, holdout=0.25, example_record=faulty[1:])
+    assert est.fit_check_.passed and est.fit_check_.n_healthy == 2
+    same = est.trust(healthy[-2:])
+    assert list(same.columns) == ["predicted", "low", "high", "comparability", "comparable",
+                                  "input_check", "fit_check", "trusted"]
+    assert same["trusted"].all() and (same["low"] <= 0).all()
+    other_load = est.trust(seg["spur3_30hz_High_1.zip"][0])
+    assert not other_load["trusted"].any()
+    flagged = est.trust(healthy[-2:], input_check=["ok", "dead channel"])
+    assert flagged["trusted"].tolist() == [True, False]
+    with pytest.raises(GearshotError, match="input_check holds 1 value"):
+        est.trust(healthy[-2:], input_check=["ok"])
+
+
+def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(spur_db,
+                                                                              tmp_path):
+    from gearshot.app.predict import format_predictions, predict_recordings, write_predictions
+    from gearshot.app.report import report_from_any_json
+
+    frame, where = predict_recordings(
+        spur_db, [_record("spur3_30hz_High_1.zip")], _record("spur2_30hz_High_1.zip"), 0.5,
+        [_record("spur3_30hz_Low_1.zip")], machine=SPUR, speed=30.0, load=10.0,
+        cycles_per_segment=10)
+    text = format_predictions(frame, where)
+    lines = text.splitlines()
+    assert lines[1].startswith("fit check: passed (2 healthy hold-out(s) read")
+    n_trusted = int(frame["trusted"].sum())
+    assert f"trusted: {n_trusted} of {len(frame)} segment(s)" in text
+    # the Low-load record is not comparable to the High-load fit: estimated, not trusted
+    low = frame["recording"].str.contains("Low")
+    assert not frame.loc[low, "trusted"].any() and frame.loc[~low, "trusted"].all()
+    csv = pd.read_csv(write_predictions(frame, tmp_path / "p.csv"))
+    assert csv["trusted"].tolist() == frame["trusted"].tolist()
+    assert (csv["fit_check"] == "passed").all()
+    rows = json.loads(write_predictions(frame, tmp_path / "p.json").read_text())
+    assert all(isinstance(r["trusted"], bool) and r["fit_check"] == "passed" for r in rows)
+    report = report_from_any_json(tmp_path / "p.json", tmp_path / "report")
+    md = report.read_text()
+    assert f"Trusted segments: {n_trusted} of {len(frame)}" in md
+    assert "Fit check: passed." in md and (tmp_path / "report" / "estimates.png").is_file()
+
+
+@pytest.mark.parametrize("duration, n_held", [(40.0, 1), (24.0, 0)])
+def test_predict_without_machine_holds_out_and_checks(tmp_path, duration, n_held):
+    """`predict` without --machine (virtual-rig files of the paper's pair): each healthy
+    recording's last quarter is held out and estimated after its fitted segments; with
+    three segments per recording 25 % rounds to none and the fit says "unchecked"."""
+    from gearshot.app.predict import predict_from_files
+    from gearshot.app.simulate import simulate_database
+    from gearshot.rig import VirtualRig
+
+    idx = VirtualRig(seed=1, engine="surrogate").campaign(
+        tmp_path / "camp", speed=15, load=10, duration=duration, healthy=2, sizes=(0.5,),
+        repetitions=1, progress=False)
+    h1, h2, faulty = idx["path"].tolist()
+    db = simulate_database(tmp_path / "db", speeds=[15], loads=[10], grades=[7],
+                           n_healthy=6, n_faulty=12, seed=0, workers=1)
+    frame = predict_from_files(db, [h1, h2], faulty, 0.5, [h2], speed=15, load=10)
+    held = frame[frame["role"] == "healthy_holdout"]
+    assert len(held) == 2 * n_held
+    assert (frame["role"] == "faulty_rest").sum() >= 1   # estimated without being asked
+    fitted = frame[(frame["recording"] == h2) & (frame["role"] == "healthy_fitted")]
+    if n_held:
+        # h2's hold-out follows its fitted segments; h1's is estimated though not asked
+        assert held.loc[held["recording"] == h2, "segment"].tolist() == [len(fitted)]
+        assert set(held["recording"]) == {h1, h2}
+        assert frame.attrs["fit_check"]["n_healthy"] == 2
+    else:
+        assert frame.attrs["fit_check"]["verdict"] == (
+            "unchecked: 6 healthy segments give 0 hold-out(s) at holdout 0.25, 2 needed")
+        assert not frame["trusted"].any()
+    assert (frame["fit_check"] == frame.attrs["fit_check"]["verdict"]).all()
