@@ -123,12 +123,11 @@ def check_seed(seed: int, option: str = "--seed") -> None:
 def given(ctx: typer.Context, option: str) -> bool:
     """Whether ``option`` (as spelt on the command line, ``"--speed"``) was given by the
     user rather than left at its default."""
-    from click.core import ParameterSource
-
     for param in ctx.command.params:
         if option in param.opts or option in getattr(param, "secondary_opts", ()):
             source = ctx.get_parameter_source(param.name or "")
-            return source in (ParameterSource.COMMANDLINE, ParameterSource.ENVIRONMENT)
+            # by name: typer's parser is its own copy of click's, with its own enum
+            return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
     raise GearshotError(f"no option {option!r} on {ctx.command_path}")  # a wrong call
 
 

@@ -13,7 +13,7 @@ import typer
 
 from ..._errors import GearshotError
 from ._apps import app
-from ._options import check_seed, early, write_json
+from ._options import check_seed, early, only_with, refuse_together, write_json
 
 __all__ = ["predict", "indicators", "report", "FAULTY_SIZE_HELP"]
 
@@ -64,6 +64,7 @@ _HELP = {
 
 @app.command()
 def predict(
+    ctx: typer.Context,
     database: Path = typer.Option(..., "--database", help=_HELP["database"]),
     healthy: list[str] = typer.Option(..., "--healthy", help=_HELP["healthy"]),
     faulty: Path = typer.Option(..., "--faulty", help=_HELP["faulty"]),
@@ -85,6 +86,12 @@ def predict(
     speed_tolerance: float = typer.Option(0.05, "--speed-tolerance", help=_HELP["tolerance"]),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    for teeth in ("--gear-teeth", "--pinion-teeth"):
+        refuse_together(ctx, "--machine", teeth, "the machine file gives the monitored "
+                        "gear's teeth and its train")
+    for option in ("--cycles-per-segment", "--sensor", "--holdout", "--speed-tolerance"):
+        only_with(ctx, option, "--machine", "recordings without a machine file are the "
+                  "paper rig's, one sensor, every segment estimated")
     if out.suffix.lower() not in (".csv", ".json"):
         raise GearshotError(f"--out {str(out)!r} must end in .csv or .json (the formats "
                             f"predict writes); got suffix {out.suffix!r}")
