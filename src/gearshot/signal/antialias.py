@@ -21,8 +21,8 @@ from .._typing import ComplexArray, FloatArray
 from .._validation import (
     MAX_POINTS,
     as_signal_array,
-    check_in_range,
     check_fs,
+    check_in_range,
     check_int,
     check_positive,
     finite_result,
