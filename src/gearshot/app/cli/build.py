@@ -89,7 +89,7 @@ def simulate(
     from ...paper import PAPER_LOADS, PAPER_SPEEDS
     from ..simulate import default_store, simulate_database, simulate_machine_database
 
-    for other in ("--speed", "--load", "--machine"):
+    for other in ("--machine", "--speed", "--load"):
         refuse_together(ctx, "--paper", other, "--paper builds the paper pair at all the "
                         "paper's speeds and loads")
     if machine is not None and not given(ctx, "--speed"):
