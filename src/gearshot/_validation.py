@@ -238,11 +238,11 @@ def check_speed(value: Any, name: str = "speed") -> float:
 
 def check_load(value: Any, name: str = "load") -> float:
     """A load torque in N m in [:data:`MIN_LOAD`, :data:`MAX_LOAD`]."""
-    value = check_positive(value, name)
-    if not MIN_LOAD <= value <= MAX_LOAD:
+    load: float = check_positive(value, name)
+    if not MIN_LOAD <= load <= MAX_LOAD:
         raise GearshotError(f"{name} must lie in [{MIN_LOAD:g}, {MAX_LOAD:g}] N m; got "
-                            f"{value:g}")
-    return value
+                            f"{load:g}")
+    return load
 
 
 def check_attenuation(value: Any, name: str = "attenuation_db") -> float:
@@ -254,7 +254,7 @@ def check_attenuation(value: Any, name: str = "attenuation_db") -> float:
 
 def check_fs(value: Any, name: str = "fs") -> float:
     """A sampling rate (or a frequency) in Hz in (0, :data:`MAX_FS`]."""
-    value = check_positive(value, name)
-    if value > MAX_FS:
-        raise GearshotError(f"{name} must lie in (0, {MAX_FS:g}] Hz; got {value:g}")
-    return value
+    rate: float = check_positive(value, name)
+    if rate > MAX_FS:
+        raise GearshotError(f"{name} must lie in (0, {MAX_FS:g}] Hz; got {rate:g}")
+    return rate

@@ -3,6 +3,8 @@ with the global options: ``-V/--version``, ``-v/--verbose``, ``-q/--quiet``."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import typer
 import typer.core
 
@@ -16,7 +18,7 @@ __all__ = ["app", "experiment_app", "VERBOSITY"]
 VERBOSITY = {"verbose": False, "quiet": False}
 
 
-def _flag_type(self: typer.core.TyperOption, ctx: typer.Context) -> str | None:
+def _flag_type(self: typer.core.TyperOption, ctx: Any) -> str | None:
     """The help's type column: nothing for a flag (``--paper``, ``--paired/--no-paired``,
     ``--help``), which takes no value; the value's type for every other option."""
     if self.is_flag or self.count:
