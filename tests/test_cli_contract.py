@@ -402,8 +402,13 @@ def test_a_batch_goes_on_past_bad_records(phm, tmp_path, monkeypatch, capsys):
 def test_a_batch_of_only_bad_records_writes_nothing(phm, tmp_path, monkeypatch, capsys):
     out = tmp_path / "ind.json"
     code, _, err = gearshot(monkeypatch, capsys, "indicators", "--machine", SPUR, "--shaft",
+                            "input", phm["bad"], phm["short"], "--json", out)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 3 and "none of the 2 recording(s)" in lines[-1]
+    assert not out.exists()
+    code, _, err = gearshot(monkeypatch, capsys, "indicators", "--machine", SPUR, "--shaft",
                             "input", phm["bad"], "--json", out)
-    assert code == 2 and "none of the 1 recording(s)" in err.splitlines()[-1]
+    one_line(code, err, "broken.zip")                  # one record: its own error alone
     assert not out.exists()
 
 

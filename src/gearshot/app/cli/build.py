@@ -92,6 +92,10 @@ def simulate(
     for other in ("--machine", "--speed", "--load"):
         refuse_together(ctx, "--paper", other, "--paper builds the paper pair at all the "
                         "paper's speeds and loads")
+    if machine is not None:
+        from ...machine import Machine
+
+        Machine.from_toml(machine)       # a bad machine file first, named
     if machine is not None and not given(ctx, "--speed"):
         raise GearshotError("--machine needs --speed: the tacho shaft's speed(s) in Hz at "
                             "which the machine runs (the default, 15, is the paper rig's "

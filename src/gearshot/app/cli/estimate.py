@@ -163,6 +163,8 @@ def indicators(
                                 baseline_paths=base, machine_file=machine, speed_hints=hints,
                                 errors="collect")
     failures = payload.pop("failures")
+    if len(files) == 1 and failures:     # one record: its error is the one line
+        raise GearshotError(failures[0]["error"])
     for failure in failures:
         name = Path(failure["file"]).name
         text = failure["error"] if name in failure["error"] else f"{name}: {failure['error']}"
