@@ -9,6 +9,13 @@ and exceptions other than GearshotError (or RuntimeWarnings) from the public API
 It ends with the cases of issue #22 (``benchmarks/integrity_paths.py``: concurrent builds,
 manifest tampering, zeroed recordings and crafted model files, a full disk, exit 3).
 
+The command-line contract of issue #32 (options never silently ignored, empty paths, stores
+into folders of other files, checks before the long work, the same bounds everywhere, a
+batch past bad records, all-or-nothing outputs on a full disk, speed hints) runs first;
+``--contract`` runs only that part:
+
+    PYTHONPATH=src python benchmarks/failure_paths.py --contract
+
 The API table and the fuzz strategies are those of tests/test_reliability.py (imported from
 there, so the benchmark and the tests cannot drift apart); here each fuzzed function gets
 120 examples instead of CI's 60.
@@ -17,6 +24,7 @@ there, so the benchmark and the tests cannot drift apart); here each fuzzed func
 from __future__ import annotations
 
 import importlib.util
+import json
 import os
 import resource
 import shutil
@@ -48,7 +56,179 @@ def leftovers(folder: Path) -> list[Path]:
     return [p for p in folder.rglob("*") if p.name.startswith(".") and "tmp" in p.name]
 
 
+def _crop(name: str, folder: Path, rows: int) -> Path:
+    """A zipped copy of a PHM09 record holding its first ``rows`` rows."""
+    import zipfile
+
+    with zipfile.ZipFile(ROOT.parent / "shared" / "data" / "phm09" / name) as zf:
+        member = zf.namelist()[0]
+        lines = zf.read(member).splitlines(keepends=True)[:rows]
+    out = folder / name
+    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(member, b"".join(lines))
+    return out
+
+
+def contract() -> dict[str, int]:
+    """Issue #32's command-line contract; prints one line per case and returns the counts
+    that must be zero."""
+    work = Path(tempfile.mkdtemp(prefix="gearshot-contract-"))
+    env = dict(os.environ, PYTHONPATH=str(SRC), GEARSHOT_DATA=str(work / "home"))
+    W = str(work)
+    spur = ROOT / "examples" / "machines" / "phm09_spur.toml"
+    notacho = ROOT / "examples" / "machines" / "phm09_spur_notacho.toml"
+    camp = work / "camp"
+    camp.mkdir()
+    (camp / "index.csv").write_text("path,fault_size\n")
+    (camp / "s15_l10_y0.00_r0.h5").write_bytes(b"x")
+    phm = work / "phm"
+    phm.mkdir()
+    r30 = _crop("spur2_30hz_High_1.zip", phm, 100_000)
+    r40 = _crop("spur3_40hz_High_1.zip", phm, 100_000)
+    bad = phm / "broken.zip"
+    bad.write_bytes(b"not a zip")
+    pred = ["predict", "--database", f"{W}/db", "--healthy", f"{W}/h.h5", "--faulty",
+            f"{W}/f.h5", "--faulty-size", "0.5", "--recordings", W, "--speed", "15"]
+    big = str(2**40)
+    # category -> [(command line, words the one error line must hold)]
+    refused = {
+        "ignored or overridden option": [
+            (["simulate", "--paper", "--speed", "15"], ["--paper", "--speed"]),
+            (["simulate", "--paper", "--load", "5"], ["--paper", "--load"]),
+            (["simulate", "--paper", "--machine", spur], ["--paper", "--machine"]),
+            (["experiment", "simulated", "--full", "--speed", "20"], ["--full", "--speed"]),
+            (["experiment", "simulated", "--full", "--load", "5"], ["--full", "--load"]),
+            (pred + ["--machine", spur, "--gear-teeth", "38"], ["--machine", "--gear-teeth"]),
+            (pred + ["--machine", spur, "--pinion-teeth", "17"],
+             ["--machine", "--pinion-teeth"]),
+            (pred + ["--cycles-per-segment", "10"], ["--cycles-per-segment", "--machine"]),
+            (pred + ["--sensor", "acc_input"], ["--sensor", "--machine"]),
+            (pred + ["--holdout", "0.3"], ["--holdout", "--machine"]),
+            (pred + ["--speed-tolerance", "0.1"], ["--speed-tolerance", "--machine"]),
+            (["experiment", "rig-family", "--range", "heldout", "--seed", "5"],
+             ["--range", "--seed"]),
+            (["simulate", "--machine", spur, "--store", f"{W}/db"], ["--machine", "--speed"]),
+            (["indicators", "--machine", spur, "--shaft", "input", f"{r30}@30"],
+             ["speed hint"]),
+            (["-v", "-q", "rig", f"{W}/rig"], ["--verbose", "--quiet"]),
+        ],
+        "empty or foreign path": [
+            (["simulate", "--store", ""], ["empty"]),
+            (["rig", ""], ["empty"]),
+            (["demo", "--out", ""], ["empty"]),
+            (["demo", "--out="], ["--out", "empty"]),
+            (["simulate", "--store", camp], ["--store", "not a gearshot database"]),
+            (["experiment", "simulated", "--store", camp], ["--store", "index.csv"]),
+            (["experiment", "rig", "--store", camp], ["--store", "index.csv"]),
+        ],
+        "bad value, checked before the long work": [
+            (["experiment", "rig", "--attenuation-db", "inf"], ["--attenuation-db", "inf"]),
+            (["experiment", "rig", "--attenuation-db", "-1"], ["--attenuation-db", "-1"]),
+            (["experiment", "simulated", "--attenuation-db", "nan"], ["--attenuation-db"]),
+            (["experiment", "simulated", "--attenuation-db", "-inf"], ["--attenuation-db"]),
+            (["experiment", "simulated", "--attenuation-db", "1e308"], ["--attenuation-db"]),
+            (["experiment", "simulated", "--attenuation-db", "-1000"], ["--attenuation-db"]),
+            (["experiment", "simulated", "--selection-tf", "bogus"], ["--selection-tf"]),
+            (["experiment", "simulated", "--n-healthy", "2"], ["--n-healthy", "2"]),
+            (["experiment", "simulated", "--n-faulty", "3"], ["--n-faulty", "3"]),
+            (["demo", "--seed", big], ["--seed", big]),
+            (["demo", "--draws", "0"], ["--draws", "0"]),
+            (["simulate", "--seed", big], ["--seed", big]),
+            (["rig", f"{W}/rig", "--seed", big], ["--seed", big]),
+            (["experiment", "simulated", "--seed", big], ["--seed", big]),
+            (["experiment", "rig", "--seed", big], ["--seed", big]),
+            (["simulate", "--load", "1e-320"], ["--load"]),
+            (["rig", f"{W}/rig", "--load", "1e-320"], ["--load"]),
+            (["experiment", "rig", "--load", "1e-320"], ["--load"]),
+            (["experiment", "simulated", "--load", "1e-320"], ["--load"]),
+            (["indicators", "--machine", notacho, "--shaft", "input", f"{r30}@fast"],
+             ["'@'"]),
+            (["indicators", "--machine", notacho, "--shaft", "input", r30, "--speed-hint",
+              "1e9"], ["speed hint"]),
+        ],
+    }
+    counts = dict(cases=0, exit3=0, ignored=0, not_one_line=0, slow=0, left_behind=0,
+                  tracebacks=0)
+    print(f"{'exit':>4} {'s':>5}  command line -> error line")
+
+    def run(args, preexec=None):
+        t0 = time.perf_counter()
+        res = subprocess.run([sys.executable, "-m", "gearshot.app.cli", *map(str, args)],
+                             capture_output=True, text=True, env=env, timeout=600,
+                             preexec_fn=preexec, cwd=work)
+        return res, time.perf_counter() - t0
+
+    for category, cases in refused.items():
+        print(f"-- {category}")
+        for args, words in cases:
+            before = sorted(p.name for p in work.iterdir())
+            res, secs = run(args)
+            err = [ln for ln in res.stderr.splitlines() if ln.strip()]
+            counts["cases"] += 1
+            counts["exit3"] += res.returncode == 3
+            counts["tracebacks"] += "Traceback" in res.stderr
+            # refused at once and naming what it refuses; otherwise the option was ignored
+            counts["ignored"] += res.returncode != 2 or not err or not all(
+                str(w) in err[0] for w in words)
+            counts["not_one_line"] += len(err) != 1
+            counts["slow"] += secs > 30          # a refusal after a build would take minutes
+            counts["left_behind"] += sorted(p.name for p in work.iterdir()) != before
+            shown = " ".join(str(a).replace(W, "$W").replace(str(ROOT) + "/", "")
+                             for a in args)
+            print(f"{res.returncode:>4} {secs:5.1f}  gearshot {shown}\n"
+                  f"                -> {(err[0] if err else '').replace(W, '$W')[:160]}")
+
+    print("-- a batch past bad records; all-or-nothing outputs; speed hints")
+    ind = ["indicators", "--machine", spur, "--shaft", "input", "--sensor", "acc_input"]
+    res, _ = run(ind + [r30, bad, r40, "--json", f"{W}/batch.json"])
+    payload = json.loads((work / "batch.json").read_text()) if (
+        work / "batch.json").is_file() else {"records": []}
+    batch_ok = (res.returncode == 2 and len(payload["records"]) == 2
+                and len(res.stderr.strip().splitlines()) == 2)
+    counts["exit3"] += res.returncode == 3
+    print(f"{res.returncode:>4}  indicators r30 broken.zip r40 -> {len(payload['records'])} "
+          f"records written, {len(res.stderr.strip().splitlines())} error lines"
+          f"{'' if batch_ok else '  FAILED'}")
+    full_ok = True
+    for limit in (20_000, 29_000, 33_000):         # a disk full after some of the figures
+        out, figs = work / f"full{limit}.json", work / f"figs{limit}"
+        res, _ = run(ind + [r30, "--json", out, "--out", figs], preexec=fsize(limit))
+        pngs = list(figs.glob("*.png")) if figs.exists() else []
+        clean = res.returncode != 0 and not out.exists() and not pngs
+        full_ok &= clean and res.returncode != 3
+        print(f"{res.returncode:>4}  indicators --json --out, files up to {limit} B -> "
+              f"json {'written' if out.exists() else 'none'}, {len(pngs)} PNG(s)"
+              f"{'' if clean else '  PARTIAL'}")
+    res, _ = run(["indicators", "--machine", notacho, "--shaft", "input", "--sensor",
+                  "acc_input", f"{r30}@30", r40, "--speed-hint", "40", "--json",
+                  f"{W}/hint.json"])
+    hinted = json.loads((work / "hint.json").read_text())["records"] if (
+        work / "hint.json").is_file() else []
+    hint_ok = res.returncode == 0 and [round(r["tacho_speed_hz"]) for r in hinted] == [30, 40]
+    print(f"{res.returncode:>4}  indicators (no tacho) r30@30 r40 --speed-hint 40 -> "
+          f"{[round(r['tacho_speed_hz'], 2) for r in hinted]} Hz"
+          f"{'' if hint_ok else '  FAILED'}")
+    counts.update(batch_failed=int(not batch_ok), partial_outputs=int(not full_ok),
+                  hint_failed=int(not hint_ok))
+    counts["temporaries_left"] = len(leftovers(work))
+    shutil.rmtree(work, ignore_errors=True)
+    print()
+    print(f"command-line contract: {counts['cases']} refused command lines; exit 3 "
+          f"{counts['exit3']}; silently ignored (not refused naming the options) "
+          f"{counts['ignored']}; not exactly one error line {counts['not_one_line']}; "
+          f"tracebacks {counts['tracebacks']}; refused after > 30 s {counts['slow']}; "
+          f"files left behind {counts['left_behind']}; batch past a bad record failed "
+          f"{counts['batch_failed']}; partial outputs on a full disk "
+          f"{counts['partial_outputs']}; speed hints failed {counts['hint_failed']}; "
+          f"temporaries left {counts['temporaries_left']}")
+    return counts
+
+
 def main() -> None:
+    contract()
+    if "--contract" in sys.argv[1:]:
+        return
+    print()
     work = Path(tempfile.mkdtemp(prefix="gearshot-failures-"))
     home = work / "home"
     env = dict(os.environ, PYTHONPATH=str(SRC), GEARSHOT_DATA=str(home))

@@ -280,7 +280,7 @@ def test_plain_progress_lines_carry_percent_and_eta():
     for _ in range(3):
         bar.advance()
     lines = stream.getvalue().splitlines()
-    assert lines[0] == "simulating blocks: 1/4 (25 %), elapsed 0s, ETA unknown"
+    assert lines[0] == "simulating blocks: 1/4 (25 %), elapsed 0s, ETA not yet known"
     # the step at 5 s is within the interval: no line; 2 steps in 12 s: 6 s for the last
     assert lines[1] == "simulating blocks: 3/4 (75 %), elapsed 12s, ETA 6s"
     assert lines[2] == "simulating blocks: 4/4 (100 %), elapsed 24s, done"

@@ -28,6 +28,10 @@ __all__ = [
     "MAX_FS",
     "check_speed",
     "check_load",
+    "MIN_LOAD",
+    "ATTENUATION_DB_RANGE",
+    "check_attenuation",
+    "check_fs",
 ]
 
 #: Largest magnitude accepted in a signal: its square, sums of squares over millions of
@@ -37,10 +41,15 @@ MAX_ABS = 1e100
 MAX_POINTS = 1 << 24
 
 #: Physical bounds, checked wherever a speed, load or sampling rate enters: shaft speeds in
-#: rev/s (0.5 rps = 30 rpm up to 60 000 rpm), load torques in N m, sampling rates in Hz.
+#: rev/s (0.5 rps = 30 rpm up to 60 000 rpm), load torques in N m (1 mN m, a watch's
+#: gear train, up to 100 kN m), sampling rates in Hz.
 SPEED_RANGE = (0.5, 1000.0)
+MIN_LOAD = 1e-3
 MAX_LOAD = 1e5
 MAX_FS = 1e8
+#: Path attenuation in dB, wherever one enters (commands, virtual rig, simulated
+#: experiment): a loss from 0 dB (none) to 200 dB (a factor 1e-10 in amplitude).
+ATTENUATION_DB_RANGE = (0.0, 200.0)
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -228,8 +237,24 @@ def check_speed(value: Any, name: str = "speed") -> float:
 
 
 def check_load(value: Any, name: str = "load") -> float:
-    """A load torque in N m in (0, :data:`MAX_LOAD`]."""
-    value = check_positive(value, name)
-    if value > MAX_LOAD:
-        raise GearshotError(f"{name} must lie in (0, {MAX_LOAD:g}] N m; got {value:g}")
-    return value
+    """A load torque in N m in [:data:`MIN_LOAD`, :data:`MAX_LOAD`]."""
+    load: float = check_positive(value, name)
+    if not MIN_LOAD <= load <= MAX_LOAD:
+        raise GearshotError(f"{name} must lie in [{MIN_LOAD:g}, {MAX_LOAD:g}] N m; got "
+                            f"{load:g}")
+    return load
+
+
+def check_attenuation(value: Any, name: str = "attenuation_db") -> float:
+    """A path attenuation in dB within :data:`ATTENUATION_DB_RANGE` (every command and API
+    function applies these bounds through this check)."""
+    lo, hi = ATTENUATION_DB_RANGE
+    return check_in_range(value, name, lo, hi)
+
+
+def check_fs(value: Any, name: str = "fs") -> float:
+    """A sampling rate (or a frequency) in Hz in (0, :data:`MAX_FS`]."""
+    rate: float = check_positive(value, name)
+    if rate > MAX_FS:
+        raise GearshotError(f"{name} must lie in (0, {MAX_FS:g}] Hz; got {rate:g}")
+    return rate

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -11,9 +11,10 @@ import numpy as np
 
 from .._atomic import atomic_path
 from .._errors import GearshotError
+from .._validation import check_speed
 
 __all__ = ["shaft_indicators", "record_indicators", "indicator_table", "indicator_figures",
-           "format_indicators", "indicator_units",
+           "format_indicators", "indicator_units", "check_speed_hints",
            "baseline_variance", "INDICATOR_EXTRAS"]
 
 #: Indicators added to every registered feature: RMS of the raw (mean-removed) time signal
@@ -118,8 +119,9 @@ def indicator_units(machine, sensor: str) -> dict[str, str]:
 def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
                       sensors: Sequence[str] | str | None = None,
                       baseline_paths: Sequence[str | Path] = (),
-                      machine_file: str | Path | None = None, sensor: str | None = None
-                      ) -> dict[str, Any]:
+                      machine_file: str | Path | None = None, sensor: str | None = None,
+                      speed_hints: Mapping[str, float] | None = None,
+                      errors: str = "raise") -> dict[str, Any]:
     """The ``gearshot indicators`` payload for recording files.
 
     Parameters
@@ -136,6 +138,15 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         Healthy recordings: NA4's baseline variance, per sensor.
     machine_file : path, optional
         Recorded in the payload.
+    speed_hints : mapping of str to float, optional
+        Nominal speed (Hz) of the machine's reference shaft per file (``str(path)``), for
+        records without a tacho: the speed is searched within ±10 % of it (before the
+        machine file's ``[speed] range_hz``). A machine with a tacho takes none.
+    errors : {"raise", "collect"}
+        A file that cannot be read or analysed (no tacho, unreadable, too short): raise its
+        :class:`~gearshot.GearshotError` (default), or ``"collect"`` it -- one
+        ``{"file", "error"}`` entry in the payload's ``"failures"`` -- and go on with the
+        other files (a batch).
 
     Returns
     -------
@@ -152,23 +163,50 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         (``speed_source="tacho"``) or, for a machine without ``[tacho]``, estimated from the
         vibration (``"vibration"``, with the standard uncertainty of the instantaneous
         speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
-        the gear train).
+        the gear train). With ``errors="collect"``, also ``"failures"``.
     """
     machine.check_shaft(shaft, "--shaft")
+    if errors not in ("raise", "collect"):
+        raise GearshotError(f"errors must be 'raise' or 'collect'; got {errors!r}")
+    hints = check_speed_hints(speed_hints, machine)
     if isinstance(sensors, str):
         sensors = [sensors]
     names = [machine.sensor(s).name for s in
              (sensors or ([sensor] if sensor else [s.name for s in machine.sensors]))]
     ratio = float(machine.speed_ratio(shaft))
     baselines = _baselines(baseline_paths, machine, shaft, names)
-    records = [row for path in paths
-               for row in _record_rows(path, machine, shaft, names, baselines, ratio)]
+    records: list[dict[str, Any]] = []
+    failures: list[dict[str, str]] = []
+    for path in paths:
+        try:
+            records += _record_rows(path, machine, shaft, names, baselines, ratio,
+                                    hints.get(str(path)))
+        except GearshotError as exc:
+            if errors == "raise":
+                raise
+            failures.append({"file": str(path), "error": " ".join(str(exc).split())})
     units = {n: indicator_units(machine, n) for n in names}
-    return {"kind": "indicators", "machine": machine.name,
-            "machine_file": None if machine_file is None else str(machine_file),
-            "shaft": shaft, "tacho_shaft": machine.reference_shaft, "shaft_speed_ratio": ratio,
-            "units": {"speeds": "Hz (revolutions per second)", "indicators": units},
-            "records": records}
+    payload = {"kind": "indicators", "machine": machine.name,
+               "machine_file": None if machine_file is None else str(machine_file),
+               "shaft": shaft, "tacho_shaft": machine.reference_shaft,
+               "shaft_speed_ratio": ratio,
+               "units": {"speeds": "Hz (revolutions per second)", "indicators": units},
+               "records": records}
+    if errors == "collect":
+        payload["failures"] = failures
+    return payload
+
+
+def check_speed_hints(speed_hints: Mapping[str, float] | None, machine) -> dict[str, float]:
+    """``speed_hints`` checked: speeds within the physical bounds, and none for a machine
+    with a tacho (its speed is read, never searched)."""
+    if not speed_hints:
+        return {}
+    if machine.tacho is not None:
+        raise GearshotError(f"a speed hint is for records without a tacho; machine "
+                            f"{machine.name!r} has one (its [tacho] gives the speed)")
+    return {str(k): check_speed(v, f"speed hint of {str(k)!r}") for k, v in
+            speed_hints.items()}
 
 
 def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
@@ -183,13 +221,16 @@ def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
 
 
 def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
-                 baselines: dict[str, float | None], ratio: float) -> list[dict[str, Any]]:
+                 baselines: dict[str, float | None], ratio: float,
+                 hint: float | None = None) -> list[dict[str, Any]]:
     """The payload records of one file: one per sensor."""
     from ..features import available_features
     from ..io import Recording
+    from ..io._vibration import SPEED_HINT_KEY
     from ..io.input_health import check_input
 
-    rec = Recording.read(path, machine=machine)
+    rec = Recording.read(path, machine=machine,
+                         metadata=None if hint is None else {SPEED_HINT_KEY: hint})
     checks = {n: check_input(rec.channel(n).acceleration, units=machine.sensor(n).unit)
               for n in names}
     try:

@@ -230,6 +230,12 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
     """
     from .files import expand_recordings
 
+    ignored = (["gear_teeth", "pinion_teeth"] if machine is not None
+               else ["cycles_per_segment", "sensor"])
+    for name in ignored:   # an option the chosen path would silently ignore
+        if locals()[name] is not None:
+            raise GearshotError(f"{name}={locals()[name]!r} does not apply "
+                                f"{'with' if machine is not None else 'without'} machine")
     if machine is not None:
         from ..machine import Machine
         from .predict_machine import predict_from_machine

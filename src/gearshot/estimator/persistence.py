@@ -90,6 +90,7 @@ def load_estimator(path: str | os.PathLike[str], *, trusted: bool = False) -> An
         raise GearshotError(f"estimator file {str(path)!r} does not exist")
     if not zipfile.is_zipfile(path):
         return _load_pickle(path, trusted)
+    _check_schema_size(path)
     import skops.io as sio
 
     try:
@@ -108,6 +109,27 @@ def load_estimator(path: str | os.PathLike[str], *, trusted: bool = False) -> An
         raise GearshotError(f"{str(path)!r} is not a readable gearshot estimator "
                             f"({type(exc).__name__}: {exc})") from None
     return _checked(path, payload, _FORMAT)
+
+
+#: Largest ``schema.json`` member of a skops file read (a saved estimator's is tens of kB):
+#: a larger one is refused from its declared size, before any of it is read.
+MAX_SCHEMA_BYTES = 64 * 2**20
+
+
+def _check_schema_size(path: Path) -> None:
+    """Refuse a skops file whose ``schema.json`` declares more than
+    :data:`MAX_SCHEMA_BYTES` (from the zip's directory: nothing is decompressed)."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            sizes = [info.file_size for info in archive.infolist()
+                     if info.filename == "schema.json"]
+    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+        raise GearshotError(f"{str(path)!r} is not a readable gearshot estimator "
+                            f"({type(exc).__name__}: {exc})") from None
+    if sizes and max(sizes) > MAX_SCHEMA_BYTES:
+        raise GearshotError(f"{str(path)!r} declares a schema.json of {max(sizes)} bytes "
+                            f"(more than {MAX_SCHEMA_BYTES}); not a gearshot estimator, "
+                            f"not read")
 
 
 def _load_pickle(path: Path, trusted: bool) -> Any:

@@ -12,9 +12,11 @@ import pandas as pd
 
 from .._atomic import atomic_path
 from .._errors import GearshotError
+from .._validation import check_attenuation
 from .variants import RIG_VARIANTS, SIMULATED_VARIANTS, variant_params
 
-__all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summarize"]
+__all__ = ["evaluate_variants", "simulated_experiment", "rig_experiment", "summarize",
+           "check_selection_tf"]
 
 
 def evaluate_variants(fit_args, test_sa, test_size, *, variants, selection_tf,
@@ -142,6 +144,37 @@ def _run_specs(specs, task, results_dir: Path, client, description: str) -> pd.D
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
+def _held_out(bank_spec: dict, selection_tf) -> tuple[str, list[str]]:
+    """The held-out TF's name and the others' names of the bank of ``bank_spec``."""
+    names = list(_bank(bank_spec).names)
+    held = selection_tf if selection_tf is not None else names[-1]
+    if held not in names:
+        shown = names if len(names) <= 8 else names[:4] + ["..."] + names[-2:]
+        raise GearshotError(f"selection_tf {held!r} is not in the bank {shown}")
+    return held, [n for n in names if n != held]
+
+
+def check_selection_tf(frf_folder=None, selection_tf=None, *, seed=0) -> str:
+    """The name of the TF :func:`simulated_experiment` holds out for feature selection
+    (``selection_tf``, default the bank's last), checked before any work: a
+    :class:`~gearshot.GearshotError` when the bank has no TF of that name.
+
+    Parameters
+    ----------
+    frf_folder : path, optional
+        Folder of measured FRFs; default the synthetic bank of 24.
+    selection_tf : str, optional
+    seed : int
+        The synthetic bank's seed (the experiment's).
+
+    Returns
+    -------
+    str
+    """
+    spec = dict(frf_folder=str(frf_folder) if frf_folder else None, seed=seed)
+    return _held_out(spec, selection_tf)[0]
+
+
 def simulated_experiment(store, *, speeds, loads, grade=7, frf_folder=None,
                          selection_tf=None, attenuations_db=(10.0,), variants=SIMULATED_VARIANTS,
                          seed=0, results_dir=None, client=None):
@@ -172,13 +205,10 @@ def simulated_experiment(store, *, speeds, loads, grade=7, frf_folder=None,
         One row per (speed, load, tf, attenuation, variant) with its MAE.
     """
     store = Path(store)
+    for a in attenuations_db:
+        check_attenuation(a, "attenuations_db[]")
     bank_spec = dict(frf_folder=str(frf_folder) if frf_folder else None, seed=seed)
-    bank = _bank(bank_spec)
-    names = list(bank.names)
-    held = selection_tf if selection_tf is not None else names[-1]
-    if held not in names:
-        raise GearshotError(f"selection_tf {held!r} is not in the bank {names}")
-    tfs = [n for n in names if n != held]
+    held, tfs = _held_out(bank_spec, selection_tf)
     specs = [dict(store=str(store), speed=float(s), load=float(ld), grade=int(grade),
                   attenuation_db=float(a), tfs=tfs, selection_tf=held,
                   variants=list(variants), **bank_spec)

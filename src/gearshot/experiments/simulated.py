@@ -8,7 +8,7 @@ import numpy as np
 import xarray as xr
 
 from .._errors import GearshotError
-from .._validation import check_in_range, check_int
+from .._validation import check_attenuation, check_in_range, check_int
 from ..transfer import mean_rms, propagate
 
 __all__ = ["SimulatedDataset", "simulated_dataset"]
@@ -84,7 +84,7 @@ def simulated_dataset(sa, fault_size, tf, *, grade=7, attenuation_db=10.0,
     y = np.asarray(fault_size, float)
     n_points = sa.shape[1]
     grade = check_int(grade, "grade", minimum=1, maximum=12)
-    attenuation_db = check_in_range(attenuation_db, "attenuation_db", 0, 200)
+    attenuation_db = check_attenuation(attenuation_db, "attenuation_db")
     noise_fraction = check_in_range(noise_fraction, "noise_fraction", 0, 10)
     target_fraction = check_in_range(target_fraction, "target_fraction", 0, 1,
                                      low_inclusive=False, high_inclusive=False)

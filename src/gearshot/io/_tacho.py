@@ -4,8 +4,9 @@ revolutions of one SA cycle of a shaft or a gear pair."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from fractions import Fraction
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -36,6 +37,7 @@ class TachoRecording:
     origin: str | None
     channel_names: tuple[str, ...]
     machine: Machine | None
+    extras: Mapping[str, Any]
 
     @property
     def duration(self) -> float:

@@ -9,9 +9,16 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
+from .._validation import check_speed
 from ._tacho import SPEED_TOLERANCE, TachoRecording
 
-__all__ = ["VibrationRecording"]
+__all__ = ["VibrationRecording", "SPEED_HINT_KEY"]
+
+#: Metadata key of a recording's speed hint: the nominal speed (Hz) of the shaft tracked in
+#: the vibration, for a record without a tacho (``Recording.read(..., metadata={
+#: "speed_hint_hz": 30})``, ``gearshot indicators FILE@30`` or ``--speed-hint 30``). The
+#: speed is searched within ±10 % of it, before the machine file's ``[speed] range_hz``.
+SPEED_HINT_KEY = "speed_hint_hz"
 
 
 class VibrationRecording(TachoRecording):
@@ -47,7 +54,8 @@ class VibrationRecording(TachoRecording):
             Mesh orders of the tracked shaft, its own gear first.
         speed_range : (float, float), optional
             Speeds of the tracked shaft searched, rev/s. Default: the machine's
-            ``range_hz``, else the nominal ``speed`` ±10 % (converted to that shaft).
+            ``range_hz``, else the nominal ``speed`` ±10 % (converted to that shaft). A
+            speed hint in the metadata (:data:`SPEED_HINT_KEY`) comes first: ±10 % of it.
         bandwidth : float, optional
             Band kept around the tracked harmonic, shaft orders (see
             :func:`gearshot.signal.demodulate_angle`). Default: half the rate of the
@@ -87,6 +95,10 @@ class VibrationRecording(TachoRecording):
             slowest = 1.0 if m is None else min(float(m.speed_ratio(s, shaft))
                                                 for s in m.shafts)
             bandwidth = min(0.25, 0.5 * slowest)
+        hint = self.extras.get(SPEED_HINT_KEY) if speed_range is None else None
+        if hint is not None:   # the record's own nominal speed of this shaft, Hz
+            hint = check_speed(hint, SPEED_HINT_KEY)
+            speed_range = (hint * (1 - SPEED_TOLERANCE), hint * (1 + SPEED_TOLERANCE))
         if speed_range is None and vs is not None and vs.shaft == shaft:
             speed_range = vs.speed_range
         if speed_range is None:

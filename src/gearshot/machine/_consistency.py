@@ -8,7 +8,7 @@ from fractions import Fraction
 from typing import Any
 
 from .._errors import GearshotError
-from .._validation import describe
+from .._validation import MAX_POINTS, describe
 from ._values import int_key, unique_names
 from .parts import FileLayout, GearStage, MonitoredGear, Sensor, Tacho, VibrationSpeed
 
@@ -111,7 +111,8 @@ def check_monitored(monitored: MonitoredGear | None, shafts: Sequence[str],
 def check_analysis(samples_per_cycle: Any, cycles_per_segment: Any,
                    shaft_orders: Sequence[Any], n_sidebands: Any, antialias: Any) -> None:
     """The ``[analysis]`` values, each under its ``analysis.`` key."""
-    int_key(samples_per_cycle, "analysis.samples_per_cycle", minimum=16)
+    int_key(samples_per_cycle, "analysis.samples_per_cycle", minimum=16,
+            maximum=MAX_POINTS)
     if cycles_per_segment is not None:
         int_key(cycles_per_segment, "analysis.cycles_per_segment")
     for o in shaft_orders:

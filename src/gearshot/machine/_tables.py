@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from .._errors import GearshotError
-from .._validation import describe
+from .._validation import MAX_POINTS, describe
 from ._values import (
     DELIMITERS,
     check_keys,
@@ -55,7 +55,8 @@ def machine_fields(data: Mapping[str, Any]) -> dict[str, Any]:
         name=name, shafts=tuple(name_key(s, "shafts[]") for s in shafts),
         stages=stages, tacho=tacho, sensors=sensors, layout=layout, monitored=monitored,
         samples_per_cycle=int_key(at.get("samples_per_cycle", 2048),
-                                  "analysis.samples_per_cycle", minimum=16),
+                                  "analysis.samples_per_cycle", minimum=16,
+            maximum=MAX_POINTS),
         cycles_per_segment=cps,
         shaft_orders=tuple(int_key(o, "analysis.shaft_orders[]") for o in orders),
         n_sidebands=int_key(at.get("n_sidebands", 2), "analysis.n_sidebands", minimum=0),
@@ -161,7 +162,8 @@ def _file(data: Mapping[str, Any]) -> FileLayout | None:
         raise GearshotError(f"file.header must be true or false; got {describe(header)}")
     return FileLayout(tuple(name_key(c, "file.columns[]") for c in cols),
                       rate_key(ft["fs"], "file.fs"), DELIMITERS[delim], header,
-                      int_key(ft.get("skip_rows", 0), "file.skip_rows", minimum=0))
+                      int_key(ft.get("skip_rows", 0), "file.skip_rows", minimum=0,
+                              maximum=10**9))
 
 
 def _monitored(data: Mapping[str, Any]) -> MonitoredGear | None:

@@ -21,13 +21,20 @@ DELIMITERS = {"whitespace": None, "space": None, ",": ",", "comma": ",", ";": ";
 _PREFIX = {"": 1.0, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6, "n": 1e-9, "k": 1e3}
 
 
-def int_key(value: Any, key: str, *, minimum: int = 1) -> int:
-    """``value`` as an int >= ``minimum`` (a bool or a float is refused), else an error
-    naming ``key``."""
+#: Largest integer a machine file may give (teeth, orders, cycles, sidebands): far above
+#: any gearbox, far below what would overflow an array size or a float.
+MAX_INT_KEY = 100_000
+
+
+def int_key(value: Any, key: str, *, minimum: int = 1, maximum: int = MAX_INT_KEY) -> int:
+    """``value`` as an int in ``minimum … maximum`` (a bool or a float is refused), else an
+    error naming ``key``."""
     if isinstance(value, bool) or not isinstance(value, int):
         raise GearshotError(f"{key} must be an integer; got {describe(value)}")
     if value < minimum:
         raise GearshotError(f"{key} must be >= {minimum}; got {value}")
+    if value > maximum:
+        raise GearshotError(f"{key} must be <= {maximum}; got {describe(value)}")
     return int(value)
 
 

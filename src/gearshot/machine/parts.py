@@ -170,7 +170,7 @@ class FileLayout:
                                 f"{self.delimiter!r}")
         if not isinstance(self.header, bool):
             raise GearshotError(f"file.header must be true or false; got {describe(self.header)}")
-        int_key(self.skip_rows, "file.skip_rows", minimum=0)
+        int_key(self.skip_rows, "file.skip_rows", minimum=0, maximum=10**9)
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import GearshotError
-from .._validation import check_in_range, check_int
+from .._validation import ATTENUATION_DB_RANGE, check_in_range, check_int
 from ..paper import GEAR_TEETH, PINION_TEETH
 
 __all__ = ["RigReality", "draw_reality", "override_reality"]
@@ -176,7 +176,7 @@ def draw_reality(rng: np.random.Generator, *, n_tfs: int = 1,
 
 
 _RANGES = {  # field -> (low, high) accepted by with_reality / reality_overrides
-    "snr_db": (0.0, 200.0), "attenuation_db": (-60.0, 200.0), "speed_drift": (0.0, 0.05),
+    "snr_db": (0.0, 200.0), "attenuation_db": ATTENUATION_DB_RANGE, "speed_drift": (0.0, 0.05),
     "speed_ripple": (0.0, 0.05), "load_ripple": (0.0, 0.5), "motor_level": (0.0, 10.0),
     "extra_level": (0.0, 10.0), "impact_level": (0.0, 10.0), "tacho_jitter": (0.0, 0.01),
     "fault_center": (0.0, 1.0), "fault_depth": (0.01, 1.0), "damping_factor": (0.1, 10.0),

@@ -21,6 +21,7 @@ from .._typing import ComplexArray, FloatArray
 from .._validation import (
     MAX_POINTS,
     as_signal_array,
+    check_fs,
     check_in_range,
     check_int,
     check_positive,
@@ -107,8 +108,8 @@ def bandlimited_resynthesis(x: ArrayLike, fs: float, *, cutoff: float, passband:
     True
     """
     x = as_signal_array(x, "x", min_length=4)
-    fs = check_positive(fs, "fs")
-    cutoff = check_positive(cutoff, "cutoff")
+    fs = check_fs(fs, "fs")
+    cutoff = check_fs(cutoff, "cutoff")
     rate = check_positive(rate, "rate")
     if x.shape[-1] * rate / fs > 16 * MAX_POINTS:
         raise GearshotError(f"rate={rate:g} Hz would re-synthesize {x.shape[-1]} samples at "
@@ -171,8 +172,8 @@ def antialias_filter(x: ArrayLike, fs: float, *, cutoff: float, passband: float 
     (4000,)
     """
     x = as_signal_array(x, "x", min_length=4)
-    fs = check_positive(fs, "fs")
-    cutoff = check_positive(cutoff, "cutoff")
+    fs = check_fs(fs, "fs")
+    cutoff = check_fs(cutoff, "cutoff")
     passband = check_in_range(passband, "passband", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
     up = check_int(upsample, "upsample", minimum=1, maximum=64)

@@ -52,12 +52,14 @@ def as_ratio(value: RatioLike, name: str = "revs_per_cycle") -> Fraction:
         elif isinstance(value, (Fraction, int, np.integer, str)):
             frac = Fraction(value) if not isinstance(value, np.integer) else Fraction(int(value))
         elif isinstance(value, (float, np.floating)):
+            if not np.isfinite(value):
+                raise TypeError
             frac = Fraction(float(value)).limit_denominator(10_000)
             if abs(float(frac) - float(value)) > 1e-12 * abs(float(value)):
                 raise TypeError
         else:
             raise TypeError
-    except (TypeError, ValueError, ZeroDivisionError):
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
         raise GearshotError(f"{name} must be an exact ratio (Fraction, int, 'p/q' or (p, q)); "
                             f"got {value!r}") from None
     if frac <= 0:

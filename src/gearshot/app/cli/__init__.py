@@ -18,7 +18,8 @@ import typer
 from ..._atomic import os_error_text
 from ..._errors import GearshotError
 from . import build, estimate, experiment  # noqa: F401  (they register the commands)
-from ._apps import app, experiment_app
+from ._apps import VERBOSITY, app, experiment_app
+from ._options import empty_value
 
 __all__ = ["app", "experiment_app", "main"]
 
@@ -49,7 +50,7 @@ def _click_error(exc: Exception) -> None:
             exc.show()       # `gearshot` or `gearshot experiment` alone: the help
             sys.exit(exc.exit_code)
         _error(_usage_line(exc), exc.exit_code)
-    if os.environ.get("GEARSHOT_DEBUG"):
+    if os.environ.get("GEARSHOT_DEBUG") or VERBOSITY["verbose"]:
         raise exc
     _error(f"unexpected {type(exc).__name__}: {exc} (a bug: please report it; "
            f"GEARSHOT_DEBUG=1 shows the traceback)", 3)
@@ -60,6 +61,10 @@ def main() -> None:
     from ..files import spread_file_options
 
     try:
+        empty = empty_value(sys.argv[1:])
+        if empty is not None:
+            raise GearshotError(f"{empty} is empty; give a path or value (an empty path "
+                                f"would silently mean the current folder)")
         app(args=spread_file_options(sys.argv[1:]), prog_name="gearshot",
             standalone_mode=False)
     except GearshotError as exc:

@@ -15,13 +15,14 @@ import typer
 
 from ..._atomic import check_writable, write_json_atomic
 from ..._errors import GearshotError
-from ..._validation import check_load, check_speed
+from ..._validation import check_attenuation, check_load, check_speed
 from ...paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH
 
 __all__ = ["NHealthy", "NFaulty", "Scheduler", "Workers", "RigGrade", "ResultsJson",
            "FiguresOut", "HELP_PARAM", "MAX_DURATION", "MAX_COUNT", "write_json", "early",
            "check_duration", "check_condition", "check_frf_folder", "check_count",
-           "check_counts", "check_seed"]
+           "check_counts", "check_seed", "given", "refuse_together", "only_with",
+           "check_store_folder", "check_attenuations", "empty_value"]
 
 HELP_N_HEALTHY = "Simulated healthy signals per grade and condition."
 HELP_N_FAULTY = ("Simulated faulty signals per grade and condition (sizes drawn uniformly "
@@ -117,3 +118,63 @@ def check_counts(n_healthy: int, n_faulty: int, workers: int) -> None:
 def check_seed(seed: int, option: str = "--seed") -> None:
     """A seed numpy takes (0 … 2**32 - 1)."""
     check_count(seed, option, maximum=2**32 - 1)
+
+
+def given(ctx: typer.Context, option: str) -> bool:
+    """Whether ``option`` (as spelt on the command line, ``"--speed"``) was given by the
+    user rather than left at its default."""
+    for param in ctx.command.params:
+        if option in param.opts or option in getattr(param, "secondary_opts", ()):
+            source = ctx.get_parameter_source(param.name or "")
+            # by name: typer's parser is its own copy of click's, with its own enum
+            return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
+    raise GearshotError(f"no option {option!r} on {ctx.command_path}")  # a wrong call
+
+
+def refuse_together(ctx: typer.Context, first: str, second: str, why: str) -> None:
+    """Refuse ``first`` and ``second`` given together (one would be ignored or
+    overridden): a line naming both and ``why``."""
+    if given(ctx, first) and given(ctx, second):
+        raise GearshotError(f"{first} and {second} cannot be given together: {why}")
+
+
+def only_with(ctx: typer.Context, option: str, needed: str, why: str = "") -> None:
+    """Refuse ``option`` given without ``needed`` (it would be silently ignored)."""
+    if given(ctx, option) and not given(ctx, needed):
+        raise GearshotError(f"{option} applies only with {needed}"
+                            + (f": {why}" if why else "") + f"; remove {option} or give "
+                            f"{needed}")
+
+
+def empty_value(args: list[str]) -> str | None:
+    """The option (or ``"an argument"``) given an empty value in ``args`` -- an empty path
+    would silently mean the current folder -- or None."""
+    for i, arg in enumerate(args):
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            return arg[:-1]
+        if arg == "" or (arg.strip() == "" and arg):
+            before = args[i - 1] if i > 0 else ""
+            return before if before.startswith("-") and "=" not in before else "an argument"
+    return None
+
+
+def check_store_folder(store: Path | None, option: str = "--store") -> None:
+    """A database store is a new or empty folder or a gearshot database (its
+    ``manifest.json`` or ``blocks``): never a folder of other files (a campaign's
+    recordings, a home folder) that a build would mix a store into."""
+    if store is None or not store.is_dir():
+        return
+    if (store / "manifest.json").exists() or (store / "blocks").is_dir():
+        return
+    held = sorted(p.name for p in store.iterdir())
+    if held:
+        shown = ", ".join(held[:3]) + (", ..." if len(held) > 3 else "")
+        raise GearshotError(f"{option} {str(store)!r} is a folder of other files ({shown}), "
+                            f"not a gearshot database; give a new or empty folder")
+
+
+def check_attenuations(values: Iterable[float], option: str = "--attenuation-db") -> None:
+    """Every path attenuation within the bounds of every command and API function
+    (:data:`gearshot._validation.ATTENUATION_DB_RANGE`)."""
+    for v in values:
+        check_attenuation(v, option)

@@ -7,6 +7,7 @@ from typing import Any
 
 import typer
 
+from ..._errors import GearshotError
 from ...fault_registry import FAULT_TYPE_NAMES
 from ...paper import (
     RIG_DURATION,
@@ -26,7 +27,11 @@ from ._options import (
     check_counts,
     check_duration,
     check_frf_folder,
+    check_seed,
+    check_store_folder,
     early,
+    given,
+    refuse_together,
 )
 
 __all__ = ["demo", "simulate", "rig"]
@@ -48,6 +53,8 @@ def demo(
                               "gives the mean ± std over them."),
 ) -> None:
     """Build a small database, record a virtual rig, fit, and report (≈ 2–3 min)."""
+    check_seed(seed)
+    check_count(draws, "--draws", minimum=1, maximum=1000)
     early(out, "--out", folder=True)
     from ..demo import run_demo
 
@@ -56,6 +63,7 @@ def demo(
 
 @app.command()
 def simulate(
+    ctx: typer.Context,
     store: Path | None = typer.Option(None, "--store", help="Zarr store (default under "
                                          "gearshot's data home)."),
     speed: list[float] = typer.Option([RIG_SPEED], "--speed", help="Input speed(s), rps."),
@@ -81,18 +89,32 @@ def simulate(
     from ...paper import PAPER_LOADS, PAPER_SPEEDS
     from ..simulate import default_store, simulate_database, simulate_machine_database
 
+    for other in ("--machine", "--speed", "--load"):
+        refuse_together(ctx, "--paper", other, "--paper builds the paper pair at all the "
+                        "paper's speeds and loads")
+    if machine is not None:
+        from ...machine import Machine
+
+        Machine.from_toml(machine)       # a bad machine file first, named
+    if machine is not None and not given(ctx, "--speed"):
+        raise GearshotError("--machine needs --speed: the tacho shaft's speed(s) in Hz at "
+                            "which the machine runs (the default, 15, is the paper rig's "
+                            "input speed in rps); e.g. --speed 30 --speed 50")
     check_counts(n_healthy, n_faulty, workers)
     check_condition(speed, load)
+    check_seed(seed)
     common: dict[str, Any] = dict(grades=grade, n_healthy=n_healthy, n_faulty=n_faulty, seed=seed,
                                   fault_types=fault_type, paired=bool(paired),
                                   scheduler=scheduler, workers=workers)
     if machine is not None:
+        check_store_folder(store)
         early(store, "--store", folder=True)
         store, line = simulate_machine_database(machine, store, speeds=speed, loads=load,
                                                 **common)
         typer.echo(line)
     else:
         store = store or default_store()
+        check_store_folder(store)
         early(store, "--store", folder=True)
         speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
         simulate_database(store, speeds=speeds, loads=loads, **common)
@@ -125,6 +147,7 @@ def rig(
     check_rig_grade(rig_grade)
     check_count(healthy, "--healthy")
     check_count(repetitions, "--repetitions")
+    check_seed(seed)
     early(folder, "FOLDER", folder=True)
     index = make_rig(seed, frf_folder, rig_grade).campaign(
         folder, speed=speed, load=load, duration=duration, healthy=healthy,

@@ -13,7 +13,7 @@ import typer
 
 from ..._errors import GearshotError
 from ._apps import app
-from ._options import check_seed, early, write_json
+from ._options import check_seed, early, only_with, refuse_together
 
 __all__ = ["predict", "indicators", "report", "FAULTY_SIZE_HELP"]
 
@@ -58,6 +58,10 @@ _HELP = {
                "intervals.",
     "tolerance": "With --machine: largest relative distance between a recording's tacho "
                  "speed and the database condition (beyond it the recording is refused).",
+    "speed_hint": "Nominal speed (Hz) of the machine's reference shaft for every record "
+                  "without a tacho and without its own FILE@HZ: the speed is searched "
+                  "within ±10 % of it (instead of the machine file's [speed] range_hz), so "
+                  "that records at several nominal speeds need no machine file each.",
     "labels": "CSV with columns file, label (and optionally cell): rank the indicators by "
               "how well they separate healthy (label 0, healthy or good) from the other "
               "labels, AUC per cell and overall.",
@@ -66,6 +70,7 @@ _HELP = {
 
 @app.command()
 def predict(
+    ctx: typer.Context,
     database: Path = typer.Option(..., "--database", help=_HELP["database"]),
     healthy: list[str] = typer.Option(..., "--healthy", help=_HELP["healthy"]),
     faulty: Path = typer.Option(..., "--faulty", help=_HELP["faulty"]),
@@ -87,6 +92,12 @@ def predict(
     speed_tolerance: float = typer.Option(0.05, "--speed-tolerance", help=_HELP["tolerance"]),
 ) -> None:
     """Fit from a database + healthy recordings + one faulty recording; estimate sizes."""
+    for teeth in ("--gear-teeth", "--pinion-teeth"):
+        refuse_together(ctx, "--machine", teeth, "the machine file gives the monitored "
+                        "gear's teeth and its train")
+    for option in ("--cycles-per-segment", "--sensor", "--holdout", "--speed-tolerance"):
+        only_with(ctx, option, "--machine", "recordings without a machine file are the "
+                  "paper rig's, one sensor, every segment estimated")
     if out.suffix.lower() not in (".csv", ".json"):
         raise GearshotError(f"--out {str(out)!r} must end in .csv or .json (the formats "
                             f"predict writes); got suffix {out.suffix!r}")
@@ -111,7 +122,9 @@ def predict(
 @app.command()
 def indicators(
     recordings: list[str] = typer.Argument(..., help="Recording files, folders or glob "
-                                           "patterns (the original zips are fine)."),
+                                           "patterns (the original zips are fine); "
+                                           "FILE@HZ gives a record without a tacho its "
+                                           "nominal reference-shaft speed (a speed hint)."),
     machine: Path = typer.Option(..., "--machine", help="Machine description (TOML)."),
     shaft: str = typer.Option(..., "--shaft", help="Shaft whose revolution is the SA cycle."),
     sensor: list[str] = typer.Option([], "--sensor", help="Sensor name(s), repeat the "
@@ -125,16 +138,23 @@ def indicators(
                                        "against their residual variance (files up to the "
                                        "next option)."),
     labels: Path | None = typer.Option(None, "--labels", help=_HELP["labels"]),
+    speed_hint: float | None = typer.Option(None, "--speed-hint", help=_HELP["speed_hint"]),
 ) -> None:
-    """Condition indicators of one shaft per recording and sensor (--labels: a ranking)."""
+    """Condition indicators of one shaft per recording and sensor (--labels: a ranking).
+
+    A batch goes on past a record that fails (each failure one line); the others are
+    written and the exit status is 2 at the end. The outputs (--json, --out) are written
+    all or none.
+    """
     from ...machine import Machine
     from ..files import expand_recordings
-    from ..indicators import format_indicators, indicator_figures, record_indicators
+    from ..indicators import check_speed_hints, format_indicators, record_indicators
 
     mach = Machine.from_toml(machine)
     early(json_out, "--json")
     early(out, "--out", folder=True)
-    files = expand_recordings(recordings, "RECORDINGS")
+    files, hints = _with_speed_hints(recordings, speed_hint)
+    check_speed_hints(hints, mach)
     base = expand_recordings(baseline, "--baseline")
     label_table = None
     if labels is not None:
@@ -142,16 +162,81 @@ def indicators(
 
         label_table = read_labels(labels, [f.name for f in files])
     payload = record_indicators(files, mach, shaft=shaft, sensors=sensor or None,
-                                baseline_paths=base, machine_file=machine)
+                                baseline_paths=base, machine_file=machine, speed_hints=hints,
+                                errors="collect")
+    failures = payload.pop("failures")
+    if len(files) == 1 and failures:     # one record: its error is the one line
+        raise GearshotError(failures[0]["error"])
+    for failure in failures:
+        name = Path(failure["file"]).name
+        text = failure["error"] if name in failure["error"] else f"{name}: {failure['error']}"
+        typer.secho(f"gearshot: error: {text}", err=True, fg="red")
+    if not payload["records"]:
+        raise GearshotError(f"none of the {len(files)} recording(s) could be analysed "
+                            f"(each failure above); nothing written")
+    if failures:
+        payload["failures"] = failures
     typer.echo(format_indicators(payload))
-    title = f"{mach.name}, shaft {shaft}"
-    if label_table is not None:
-        _ranking(payload, label_table, out, title)
+    _write_indicator_outputs(payload, label_table, json_out, out,
+                             f"{mach.name}, shaft {shaft}")
+    if failures:
+        raise GearshotError(f"{len(failures)} of {len(files)} recording(s) failed (each "
+                            f"above); the other {len(files) - len(failures)} written")
+
+
+def _with_speed_hints(items: list[str], speed_hint: float | None
+                      ) -> tuple[list[Path], dict[str, float]]:
+    """The recording files of ``items`` and their speed hints: ``FILE@HZ`` (a path that
+    does not exist as typed, ending in ``@`` and a number) gives its files HZ; the others
+    get ``--speed-hint`` (when given)."""
+    from ..files import expand_recordings
+
+    files: list[Path] = []
+    hints: dict[str, float] = {}
+    for item in items:
+        hint = speed_hint
+        base, at, hz = item.rpartition("@")
+        if at and base and not Path(item).exists():
+            try:
+                hint = float(hz)
+            except ValueError:
+                raise GearshotError(f"RECORDINGS {item!r}: the speed hint after '@' must be "
+                                    f"a number (Hz); got {hz!r}") from None
+            item = base
+        for f in expand_recordings([item], "RECORDINGS"):
+            if f not in files:
+                files.append(f)
+                if hint is not None:
+                    hints[str(f)] = hint
+    return files, hints
+
+
+def _write_indicator_outputs(payload: dict, label_table, json_out: Path | None,
+                             out: Path | None, title: str) -> None:
+    """The ranking (with --labels), the JSON and the figures, all or none: every file is
+    written into a temporary first (the figures into a staging folder inside ``out``) and
+    moved into place only once all are written."""
+    import contextlib
+
+    from ..._atomic import atomic_path, commit_staged, staging_dir
+    from ..indicators import indicator_figures
+
+    with contextlib.ExitStack() as stack:
+        staged = None if out is None else stack.enter_context(staging_dir(out))
+        if label_table is not None:
+            _ranking(payload, label_table, staged, title)
+        names = [] if staged is None else [
+            p.name for p in indicator_figures(payload, staged, title=title)]
+        if staged is not None and label_table is not None:
+            names += ["ranking.csv", "ranking.png"]
+        if json_out is not None:   # its rename, the last step, happens when the stack ends
+            tmp = stack.enter_context(atomic_path(json_out, make_parents=True))
+            tmp.write_text(json.dumps(payload, indent=2, default=float))
+        if staged is not None and out is not None:
+            commit_staged(staged, out, names)
     if json_out is not None:
-        write_json(json_out, payload)
         typer.echo(f"indicators written to {json_out}")
     if out is not None:
-        indicator_figures(payload, out, title=title)
         typer.echo(f"figures written to {out}")
 
 

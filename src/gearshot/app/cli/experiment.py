@@ -22,13 +22,16 @@ from ._options import (
     RigGrade,
     Scheduler,
     Workers,
+    check_attenuations,
     check_condition,
     check_count,
     check_counts,
     check_duration,
     check_frf_folder,
     check_seed,
+    check_store_folder,
     early,
+    refuse_together,
     write_json,
 )
 
@@ -51,6 +54,7 @@ HELP_FAMILY_PAIRED = ("Use the database with healthy twins (default; the estimat
 
 @experiment_app.command("simulated")
 def experiment_simulated(
+    ctx: typer.Context,
     store: Path | None = typer.Option(None, "--store", help="Database store (built if "
                                          "missing)."),
     speed: list[float] = typer.Option([RIG_SPEED], "--speed", help="Input speed(s), rps "
@@ -75,16 +79,31 @@ def experiment_simulated(
     workers: Workers = 2,
 ) -> None:
     """Sec. 4.1: simulated signals through measured TFs; before DA / RMS only / full."""
+    for other in ("--speed", "--load"):
+        refuse_together(ctx, "--full", other, "--full runs the paper's 26 speeds × 4 loads")
     check_frf_folder(frf_folder, minimum=2)      # one held out for selection, one to test
     if not full:
         check_condition(speed, load)
     if not 1 <= grade <= 12:
         raise GearshotError(f"--grade must be 1 … 12; got {grade}")
+    check_attenuations(attenuation_db)
+    check_seed(seed)
+    check_counts(n_healthy, n_faulty, workers)
+    # each dataset splits the healthy signals (training, target, test) and the faulty
+    # ones (training, test and the example): gearshot.experiments.simulated_dataset
+    check_count(n_healthy, "--n-healthy", minimum=8, maximum=100_000)
+    check_count(n_faulty, "--n-faulty", minimum=4, maximum=100_000)
+    check_store_folder(store)
     early(json_out, "--json")
     early(out, "--out", folder=True)
     early(store, "--store", folder=True)
-    check_counts(n_healthy, n_faulty, workers)
+    from ...experiments import check_selection_tf
     from ..experiment_runs import run_simulated_experiment
+
+    try:
+        check_selection_tf(frf_folder, selection_tf, seed=seed)
+    except GearshotError as exc:
+        raise GearshotError(f"--selection-tf: {exc}") from None
 
     run = run_simulated_experiment(store, speeds=speed, loads=load, grade=grade,
                                    attenuations_db=attenuation_db, frf_folder=frf_folder,
@@ -133,8 +152,11 @@ def experiment_rig(
     check_condition([speed], [load])
     check_rig_grade(rig_grade)
     check_seed(seed)
+    if attenuation_db is not None:
+        check_attenuations([attenuation_db])
     check_count(repeats, "--repeats", minimum=1, maximum=1000)
     check_counts(n_healthy, n_faulty, workers)
+    check_store_folder(store)
     for path, option in ((json_out, "--json"), (out, "--out"), (store, "--store"),
                          (campaign, "--campaign")):
         early(path, option, folder=option != "--json")
@@ -158,6 +180,7 @@ def experiment_rig(
 
 @experiment_app.command("rig-family")
 def experiment_rig_family(
+    ctx: typer.Context,
     seed_range: str = typer.Option("dev", "--range", help=HELP_RANGE),
     seeds: list[int] = typer.Option([], "--seed", help="Explicit rig seed(s) instead of "
                                     "--range (results file 'seeds.jsonl')."),
@@ -186,6 +209,7 @@ def experiment_rig_family(
     from ...experiments import family
     from ..experiment_runs import family_results_file, run_rig_family
 
+    refuse_together(ctx, "--range", "--seed", "--seed names the rigs instead of a range")
     pool = _family_seeds(seed_range, seeds, n_rigs, frf_folder, variants)
     for value, option in ((draws, "--draws"), (segments, "--segments"),
                           (repetitions, "--repetitions")):
