@@ -103,7 +103,6 @@ def contract() -> dict[str, int]:
              ["--machine", "--pinion-teeth"]),
             (pred + ["--cycles-per-segment", "10"], ["--cycles-per-segment", "--machine"]),
             (pred + ["--sensor", "acc_input"], ["--sensor", "--machine"]),
-            (pred + ["--holdout", "0.3"], ["--holdout", "--machine"]),
             (pred + ["--speed-tolerance", "0.1"], ["--speed-tolerance", "--machine"]),
             (["experiment", "rig-family", "--range", "heldout", "--seed", "5"],
              ["--range", "--seed"]),

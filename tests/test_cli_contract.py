@@ -114,8 +114,6 @@ IGNORED = {
                                      ["--cycles-per-segment", "--machine"]),
     "predict --sensor": (lambda t: _predict(t, "--sensor", "acc_input"),
                          ["--sensor", "--machine"]),
-    "predict --holdout": (lambda t: _predict(t, "--holdout", "0.3"),
-                          ["--holdout", "--machine"]),
     "predict --speed-tolerance": (lambda t: _predict(t, "--speed-tolerance", "0.1"),
                                   ["--speed-tolerance", "--machine"]),
     "rig-family --range --seed": (lambda t: ["experiment", "rig-family", "--range",

@@ -95,7 +95,7 @@ def predict(
     for teeth in ("--gear-teeth", "--pinion-teeth"):
         refuse_together(ctx, "--machine", teeth, "the machine file gives the monitored "
                         "gear's teeth and its train")
-    for option in ("--cycles-per-segment", "--sensor", "--holdout", "--speed-tolerance"):
+    for option in ("--cycles-per-segment", "--sensor", "--speed-tolerance"):
         only_with(ctx, option, "--machine", "recordings without a machine file are the "
                   "paper rig's, one sensor, every segment estimated")
     if out.suffix.lower() not in (".csv", ".json"):
