@@ -56,7 +56,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     pandas.DataFrame
         ``recording, role, segment, predicted, low, high, comparability, comparable``
         (roles: :data:`ROLES`; the last two from
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`: its p-value and
+        whether it is at least the stated false-alarm rate).
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
@@ -93,7 +94,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
                                         role=_roles(path, len(sa), fitted, faulty),
                                         segment=np.arange(len(sa)),
                                         predicted=est.predict(sa), low=low, high=high,
-                                        comparability=comp.score,
+                                        comparability=comp.p_value,
                                         comparable=comp.comparable)))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load

@@ -66,9 +66,9 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
 
 
 def _comparability_columns(est, sas) -> tuple[np.ndarray, np.ndarray]:
-    """The ``comparability`` (score) and ``comparable`` columns of a predict table."""
+    """The ``comparability`` (p-value) and ``comparable`` columns of a predict table."""
     result = est.comparability(sas)
-    return result.score, result.comparable
+    return result.p_value, result.comparable
 
 
 def predict_from_machine(machine, database, healthy: Sequence[str | Path],
@@ -135,9 +135,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
-        ``comparability``/``comparable``: the score of
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
-        segment looks like the fitted machine; ``speed_source``: ``tacho`` or
+        ``comparability``/``comparable``: the p-value of
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` (the share of the
+        fitted machine's healthy segments that look at least as far from it) and whether
+        it is at least the stated false-alarm rate (0.01); ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
         ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
         ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
