@@ -219,6 +219,14 @@ def main() -> None:
         n="size", flagged=lambda c: 1 - c.mean()).unstack("kind")["flagged"]
     with pd.option_context("display.width", 250):
         print(per.to_string(float_format=lambda v: f"{v:.2f}"))
+    rig = table[table.setting.str.startswith("rig")]
+    if len(rig):
+        state = np.where(rig.record.str.contains("size 0.0|healthy"), "healthy state",
+                         "faulty state")
+        print("virtual rigs, by the state of the scored record:")
+        print(rig.assign(state=state).groupby(["kind", "state"], sort=False).comparable.agg(
+            segments="size", flagged=lambda c: 1 - c.mean()).to_string(
+                float_format=lambda v: f"{v:.1%}"))
     _cost(args.size)
     print(f"per-segment table: {out}; {time.perf_counter() - t0:.0f} s")
 
