@@ -210,7 +210,10 @@ def write_predictions(frame: pd.DataFrame, out: str | Path) -> Path:
 
 
 def comparable_summary(frame: pd.DataFrame) -> str:
-    """One line counting the comparable segments of a predict table (issue #19)."""
+    """One line counting the comparable segments of a predict table (issue #19), and saying
+    when the fit had too few healthy segments to calibrate comparability."""
+    from ..estimator.comparability import MIN_HEALTHY
+
     if "comparable" not in frame or not len(frame):
         return "comparable: no segment estimated"
     n_yes = int(frame["comparable"].sum())
@@ -219,6 +222,9 @@ def comparable_summary(frame: pd.DataFrame) -> str:
     if n_no:
         line += (" (they do not look like the fitted machine — another build, speed, load "
                  "or sensor? — do not act on their estimates)")
+    if "comparability" in frame and frame["comparability"].isna().all():
+        line += (f"; comparability is not calibrated: the fit holds fewer than {MIN_HEALTHY} "
+                 f"healthy segments")
     return line
 
 
