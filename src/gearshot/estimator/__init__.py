@@ -5,6 +5,7 @@
 ``uncertainty``                grade weights and prediction intervals (not paper steps)
 ``zero_shot``                  grade choice from healthy data alone
 ``comparability``              is a segment in the fitted machine's distribution (#19, #29)
+``regular_part``               the regular part's description that comparability tests
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
 ``EstimatorOptions``            its research settings (one constructor parameter)
 ``save_estimator`` / ``load``  persistence with version metadata
