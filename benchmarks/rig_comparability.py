@@ -15,7 +15,8 @@ repetitions 0-4 and segment 0 of the size-0.6 repetition 0. Then scored:
   hidden parameter drawn anew), another speed (25 rps) and another load (20 N m) of the
   same rig -- healthy repetition 0 and size 0.6 repetition 0 each; should be flagged.
 
-Nothing is chosen here: the threshold (3.0) was chosen on the PHM09 development cells.
+Nothing is chosen here (issue #19's threshold was chosen on the PHM09 development cells;
+issue #29's test is designed on the labelled matrix of ``comparability_matrix.py``).
 
     GEARSHOT_DATA=... PYTHONPATH=src python benchmarks/rig_comparability.py --seeds 701 702 703
 """

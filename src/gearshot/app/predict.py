@@ -67,7 +67,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         ``recording, role, segment, predicted, low, high, comparability, comparable,
         input_check, fit_check, trusted`` (roles: :data:`ROLES`;
         ``comparability``/``comparable`` from
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`; ``input_check``:
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`: its p-value and
+        whether it is at least the stated false-alarm rate; ``input_check``:
         ``"ok"`` or the failed check of :mod:`gearshot.io.input_health`, per recording and
         segment, with ``predicted``/``low``/``high`` withdrawn (NaN) on a failed row;
         ``fit_check`` the fit's verdict, the same in every row; ``trusted``:
@@ -134,7 +135,7 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
     comp = est.comparability(sa)
     rows = pd.DataFrame(dict(recording=str(path), role=roles,
                              segment=start + np.arange(len(sa)), predicted=est.predict(sa),
-                             low=low, high=high, comparability=comp.score,
+                             low=low, high=high, comparability=comp.p_value,
                              comparable=comp.comparable))
     return mark_rows(rows, input_check_column(**health[_key(path)], rows=rows["segment"]))
 
@@ -276,7 +277,10 @@ def write_predictions(frame: pd.DataFrame, out: str | Path) -> Path:
 
 
 def comparable_summary(frame: pd.DataFrame) -> str:
-    """One line counting the comparable segments of a predict table (issue #19)."""
+    """One line counting the comparable segments of a predict table (issue #19), and saying
+    when the fit had too few healthy segments to calibrate comparability."""
+    from ..estimator.comparability import MIN_HEALTHY
+
     if "comparable" not in frame or not len(frame):
         return "comparable: no segment estimated"
     n_yes = int(frame["comparable"].sum())
@@ -285,6 +289,9 @@ def comparable_summary(frame: pd.DataFrame) -> str:
     if n_no:
         line += (" (they do not look like the fitted machine — another build, speed, load "
                  "or sensor? — do not act on their estimates)")
+    if "comparability" in frame and frame["comparability"].isna().all():
+        line += (f"; comparability is not calibrated: the fit holds fewer than {MIN_HEALTHY} "
+                 f"healthy segments")
     return line
 
 

@@ -83,9 +83,9 @@ def _require_fit_input(info: dict, path, role: str) -> None:
 
 
 def _comparability_columns(est, sas) -> tuple[np.ndarray, np.ndarray]:
-    """The ``comparability`` (score) and ``comparable`` columns of a predict table."""
+    """The ``comparability`` (p-value) and ``comparable`` columns of a predict table."""
     result = est.comparability(sas)
-    return result.score, result.comparable
+    return result.p_value, result.comparable
 
 
 def predict_from_machine(machine, database, healthy: Sequence[str | Path],
@@ -155,9 +155,10 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         ``chosen`` (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
-        ``comparability``/``comparable``: the score of
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
-        segment looks like the fitted machine; ``speed_source``: ``tacho`` or
+        ``comparability``/``comparable``: the p-value of
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` (the share of the
+        fitted machine's healthy segments that look at least as far from it) and whether
+        it is at least the stated false-alarm rate (0.01); ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
         ``vibration``; ``input_check``: ``"ok"`` or the failed check of
         :mod:`gearshot.io.input_health`, per recording and segment, with the row's

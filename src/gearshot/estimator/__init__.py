@@ -4,7 +4,8 @@
 ``steps``                      the paper's steps 1–8, in order, one function each
 ``uncertainty``                grade weights and prediction intervals (not paper steps)
 ``zero_shot``                  grade choice from healthy data alone
-``comparability``              does a segment look like the fitted machine (issue #19)
+``comparability``              is a segment in the fitted machine's distribution (#19, #29)
+``regular_part``               the regular part's description that comparability tests
 ``fit_check``                  the fit's own hold-outs read back: its verdict (issue #29)
 ``OneFaultShotEstimator``      the steps as a scikit-learn regressor
 ``EstimatorOptions``            its research settings (one constructor parameter)

@@ -201,8 +201,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     setting_models_ : list of KnnModel
         One model per entry of ``calibration_["settings"]``.
     comparability_reference_ : ComparabilityReference
-        The fitted machine's harmonic profiles (healthy mean, the example's direction,
-        healthy spread) that :meth:`comparability` measures segments against
+        The fitted machine's regular-part states (the healthy SAs' features, their local
+        spread, the example's effect) and the leave-one-out calibration that
+        :meth:`comparability` tests segments against
         (:mod:`gearshot.estimator.comparability`).
     mesh_orders_ : tuple of int
         The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).

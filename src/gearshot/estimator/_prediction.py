@@ -78,30 +78,33 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
                     zip(self.calibration_["settings"], self.setting_models_)),
                    np.zeros(len(X)))
 
-    def comparability(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
-        """Whether target SAs look like the fitted machine (know when not to answer).
+    def comparability(self, sa: ArrayLike, false_alarm_rate: float | None = None
+                      ) -> Comparability:
+        """Whether target SAs come from the fitted machine (know when not to answer).
 
-        Compares each SA's regular part — the unit-norm amplitudes of its mesh-harmonic
-        orders (:func:`~gearshot.estimator.comparability.harmonic_profile`) — with the
-        fitted machine's states: the healthy SAs' mean profile, moved toward the faulty
-        example's profile as a fault grows to size 1. The score is the distance from
-        those states in units of the healthy SAs' own spread; a segment of another build,
-        another speed or load than the database's, or another sensor lies far from them
-        and is not comparable: its estimate should not be acted on.
+        An out-of-distribution test of each SA's regular part
+        (:func:`~gearshot.estimator.comparability.regular_features`: level, mesh
+        harmonics, shaft orders, background and sidebands in octave bands, kurtosis),
+        standardised by the fitted healthy SAs and measured from the fitted machine's
+        states (the healthy mean moved toward the faulty example as a fault grows),
+        calibrated on the healthy SAs' own leave-one-out scores. A segment of another
+        load, speed, build, gearbox or sensor lies outside and is not comparable: its
+        estimate should not be acted on.
 
         Parameters
         ----------
         sa : array_like (n_signals, n_points) or (n_points,)
-        threshold : float > 0, optional
-            Largest score of a comparable segment; default
-            :data:`~gearshot.estimator.comparability.DEFAULT_THRESHOLD` (3.0, chosen on
-            the PHM 2009 spur subset's 30 Hz cells, benchmarks/RESULTS.md).
+            SAs in the units of the fit's (the level is compared).
+        false_alarm_rate : float in (0, 1), optional
+            Share of the fitted machine's healthy segments flagged; default
+            :data:`~gearshot.estimator.comparability.DEFAULT_FALSE_ALARM` (0.01).
 
         Returns
         -------
         Comparability
-            ``score`` (n_signals,), ``comparable`` (bool, ``score <= threshold``) and
-            ``threshold``.
+            ``score``, ``p_value``, ``comparable`` (``p_value >= false_alarm_rate``) per
+            segment, and ``record_p_value``/``record_comparable`` for the SAs judged
+            together as one recording.
         """
         self._check_fitted("comparability")
         reference: ComparabilityReference | None = getattr(self, "comparability_reference_",
@@ -109,7 +112,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         if reference is None:  # an estimator saved before comparability existed
             raise GearshotError("this estimator was fitted by an older gearshot without "
                                 "a comparability reference; fit it again")
-        return reference.evaluate(sa, threshold)
+        return reference.evaluate(sa, false_alarm_rate)
 
     def trust(self, sa: ArrayLike, input_check: Any = None, *,
               coverage: float = 0.9) -> Any:
@@ -129,7 +132,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         pandas.DataFrame
             One row per SA: ``predicted, low, high`` (:meth:`predict`,
             :meth:`predict_interval`), ``comparability, comparable``
-            (:meth:`comparability`), ``input_check``, ``fit_check`` (the fit's verdict,
+            (:meth:`comparability`: its p-value and verdict), ``input_check``, ``fit_check`` (the fit's verdict,
             ``fit_check_.verdict``: "passed" or the reason) and ``trusted``: the input
             check is "ok", the segment is comparable and the fit check passed.
         """
@@ -141,7 +144,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         low, high = self.predict_interval(arr, coverage=coverage)
         comp = self.comparability(arr)
         frame = pd.DataFrame(dict(predicted=self.predict(arr), low=low, high=high,
-                                  comparability=comp.score, comparable=comp.comparable))
+                                  comparability=comp.p_value, comparable=comp.comparable))
         frame["input_check"] = "ok" if input_check is None else _per_row(
             input_check, len(arr), "input_check")
         check: FitCheck | None = getattr(self, "fit_check_", None)

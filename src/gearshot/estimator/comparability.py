@@ -1,90 +1,104 @@
-"""Know when not to answer: does a segment look like the fitted machine?
+"""Know when not to answer: does a segment come from the fitted machine's distribution?
 
-A fault changes a gear's *difference* signal (what is left once the mesh harmonics are
-removed); the *regular* part — the amplitudes of the mesh orders and their harmonics —
-is set by the machine itself: its build (the gears' profiles, the assembly), its speed and
-load, and the path to the sensor. A segment whose regular part matches none of the fitted
-machine's states does not come from the machine the estimator was fitted on, and its
+A fault changes a gear's *difference* signal; the *regular* part of a synchronous average is
+set by the machine itself: its build, its speed and load, the path to the sensor. A segment
+whose regular part lies outside what the fitted machine's own healthy segments (and the one
+faulty example) show does not come from the machine the estimator was fitted on, and its
 estimate must not be trusted.
 
-The regular part is summarised by the **harmonic profile** (:func:`harmonic_profile`): the
-amplitude spectrum of an SA at the exact mesh-harmonic orders ``k * m`` of every mesh ``m``
-up to the Nyquist order, divided by its Euclidean norm (so the overall level, which a fault
-and the sensor gain change, drops out; phases are left out because the SA's start angle is
-only known up to one tacho pulse).
+**Description** (:func:`regular_features`, one row per SA; the groups of
+:data:`FEATURE_GROUPS`): the SA's level ``log10 RMS`` (a load, a speed, a sensor or a gain
+changes it); and, relative to that level (``log10`` amplitude minus ``log10 RMS``): the
+amplitude at every mesh-harmonic order ``k m`` below Nyquist (:func:`harmonic_orders`), at
+shaft orders 1-3, the background (the spectrum without the mesh harmonics, their ±1, ±2
+sidebands and shaft orders 1-3) in octave bands of order from 4 to Nyquist (the transfer
+path's shape, which moves in order with speed), the ±1, ±2 sidebands of the mesh
+harmonics in the same octave bands; and the SA's kurtosis.
 
-The fitted machine's states are a segment of a line in profile space
-(:class:`ComparabilityReference`): the healthy recordings' mean profile ``h``, moved toward
-the faulty example's profile ``e`` as a fault grows, ``h + t (e - h)`` for ``t`` in
-``[0, 1 / faulty_size]`` (the example's effect on the regular part scaled linearly from its
-size to the largest, 1). The **comparability score** of a segment is its distance from that
-segment of line, in units of the healthy recordings' own spread (the root-mean-square
-leave-one-out distance of each healthy profile from the mean of the others). A segment is
-**comparable** when its score is at most the threshold, :data:`DEFAULT_THRESHOLD` = 3.0,
-chosen on the development cells of the PHM 2009 spur subset (30 Hz; issue #19,
-``benchmarks/RESULTS.md``). Without an example (zero-shot) the line shrinks to ``h``.
+**Distance.** Each feature is standardised by the healthy SAs' mean and their *local*
+spread: the RMS difference of each healthy SA from its nearest healthy neighbour, divided
+by ``sqrt(2)`` (at least :data:`MIN_STD`): healthy SAs pooled from several recordings (two
+builds, two runs) keep the spread of one recording instead of the spread between them.
+The fitted machine's states are the healthy SAs themselves, each moved toward the faulty
+example as a fault grows: ``h_i + t_g v_g`` for every feature group ``g`` and
+``0 <= t_g <= 1 / faulty_size``, where ``v`` is the example's standardised features minus
+the mean of the healthy SAs nearest to it (the nearer half); a fault moves each group by its
+own amount (a chip raises the shaft orders and sidebands more in one run than in another),
+never against the example's direction nor beyond the example's effect scaled to size 1.
+The **score** of a segment is its distance from the nearest of those states: the
+root-mean-square over features of the residual, each squared residual divided by its
+variance at that state, ``1 + t_g**2 (1 + (k v_j)**2)``: the example is one noisy SA (the
+``t_g**2``), and its effect on each feature is known only to a fraction
+``k =`` :data:`FAULT_SHAPE_UNCERTAINTY` (a fault of another size does not move every feature
+in exact proportion). Zero-shot (no example): the distance from the nearest healthy SA.
+
+**Calibration.** At fit time every healthy SA is scored by the reference fitted without it
+(leave-one-out); the logarithms of those scores define a normal model of a healthy segment's
+log-score. A segment's **p-value** is the upper tail of that model at its log-score, and it
+is **comparable** when its p-value is at least the stated false-alarm rate,
+:data:`DEFAULT_FALSE_ALARM` = 0.01 (1 % of the fitted machine's own healthy segments are
+expected to be flagged). Fewer than :data:`MIN_HEALTHY` healthy SAs cannot be calibrated:
+then no segment is comparable.
+
+The comparable decision of a *recording* takes all its segments together (the median score):
+another load, speed or build differs for the whole record.
+
+Development and held-out results (labelled matrix of PHM09 pairs and virtual rigs):
+``benchmarks/comparability_matrix.py``, ``benchmarks/RESULTS.md`` "Trust: comparability".
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import cast
 
 import numpy as np
-import scipy.fft
+import scipy.special
 from numpy.typing import ArrayLike, NDArray
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range, check_positive
+from .._validation import as_signal_array, check_in_range
 from ..signal.orders import check_mesh_orders
+from .regular_part import (
+    FEATURE_GROUPS,
+    harmonic_orders,
+    harmonic_profile,
+    healthy_spread,
+    regular_features,
+)
 
-__all__ = ["DEFAULT_THRESHOLD", "Comparability", "ComparabilityReference",
-           "harmonic_orders", "harmonic_profile", "healthy_spread", "fit_comparability"]
+__all__ = ["DEFAULT_FALSE_ALARM", "FAULT_SHAPE_UNCERTAINTY", "FEATURE_GROUPS", "MIN_HEALTHY",
+           "MIN_STD",
+           "Comparability", "ComparabilityReference", "fit_comparability",
+           "harmonic_orders", "harmonic_profile", "healthy_spread", "regular_features"]
 
 FloatArray = NDArray[np.float64]
 
-#: Largest comparability score of a comparable segment (healthy spreads from the fitted
-#: machine's states). Chosen on the development cells (30 Hz) of the PHM 2009 spur subset,
-#: both sensors: the geometric mean of the largest same-build score (2.32) and the
-#: smallest other-build score (3.90); reported on the 40 Hz cells (benchmarks/RESULTS.md).
-DEFAULT_THRESHOLD = 3.0
+#: Stated false-alarm rate: the share of the fitted machine's own healthy segments the
+#: calibrated test flags (a segment is comparable when its p-value is at least this).
+DEFAULT_FALSE_ALARM = 0.01
 
-#: Smallest healthy spread used as the score's unit (profiles are unit vectors): healthy
-#: SAs that are exact copies of each other would otherwise make every other segment
-#: infinitely far.
-MIN_SPREAD = 1e-6
+#: Fewest healthy SAs that calibrate the test: the leave-one-out scores of fewer are too
+#: unsteady (3 healthy SAs of PHM09 spur3 30 Hz High: a threshold of 16 and 78 on the two
+#: sensors, against 2.7 with the development fits' 9).
+MIN_HEALTHY = 6
 
+#: Smallest standard deviation of a feature (log10 units; kurtosis units for kurtosis):
+#: identical healthy SAs would otherwise make every other segment infinitely far.
+MIN_STD = 1e-3
 
-def harmonic_orders(n_points: int, mesh_order: int | Sequence[int]) -> np.ndarray:
-    """The distinct mesh-harmonic orders ``k * m`` (every mesh ``m``, ``k ≥ 1``) below the
-    Nyquist order of an ``n_points`` cycle, sorted."""
-    meshes = check_mesh_orders(mesh_order, n_points)
-    nyquist = n_points // 2
-    return np.unique(np.concatenate([np.arange(m, nyquist, m) for m in meshes]))
+#: Relative uncertainty of the example's effect on each feature: a fault of another size
+#: moves every feature toward the example's value, but not in exact proportion (measured
+#: on virtual rigs: a size-0.3 fault moves the level 18 % and the background 43 % of the
+#: way to a size-0.6 example). Chosen on the development part of the matrix (0, 0.05,
+#: 0.1, 0.25, 0.5, 1 tried: the smallest value that keeps a smaller fault of the
+#: development rig comparable).
+FAULT_SHAPE_UNCERTAINTY = 0.25
 
+#: Smallest spread of the leave-one-out log-scores (natural-log units).
+MIN_LOG_SPREAD = 0.05
 
-def harmonic_profile(sa: ArrayLike, mesh_order: int | Sequence[int]) -> FloatArray:
-    """Unit-norm amplitudes of SAs at their mesh-harmonic orders (the regular part).
-
-    Parameters
-    ----------
-    sa : array_like (n_signals, n_points) or (n_points,)
-        Synchronous averages, one cycle each.
-    mesh_order : int or sequence of int
-        Mesh order(s) of the cycle (:meth:`gearshot.Machine.mesh_orders`).
-
-    Returns
-    -------
-    ndarray (n_signals, n_orders)
-        ``|DFT(sa)|`` at :func:`harmonic_orders`, each row divided by its norm (a row
-        without any harmonic content stays zero).
-    """
-    arr = np.atleast_2d(as_signal_array(sa, "sa", max_ndim=2, min_length=4))
-    orders = harmonic_orders(arr.shape[-1], mesh_order)
-    amp = np.abs(scipy.fft.rfft(arr, axis=-1))[:, orders]
-    norm = np.linalg.norm(amp, axis=1, keepdims=True)
-    return cast(FloatArray, np.divide(amp, norm, out=np.zeros_like(amp), where=norm > 0))
+_TINY = 1e-30
 
 
 @dataclass(frozen=True)
@@ -94,16 +108,33 @@ class Comparability:
     Attributes
     ----------
     score : ndarray (n_signals,)
-        Distance of each segment's harmonic profile from the fitted machine's states, in
-        healthy spreads (about 1 for a healthy segment of the fitted machine).
+        Distance of each segment's regular part from the fitted machine's states, in the
+        healthy SAs' local spreads (RMS over features; about 1 for a healthy segment of the
+        fitted machine).
+    p_value : ndarray (n_signals,)
+        Probability that a healthy segment of the fitted machine scores at least as high
+        (the calibrated model of the leave-one-out healthy scores); NaN when the
+        reference is not calibrated.
     comparable : ndarray of bool (n_signals,)
-        ``score <= threshold``.
+        ``p_value >= false_alarm_rate`` (equivalently ``score <= threshold``).
+    false_alarm_rate : float
     threshold : float
+        The score at which the p-value equals the false-alarm rate (0 when the reference
+        is not calibrated: no segment is then comparable).
+    record_p_value : float
+        The p-value of the segments' median score: all segments judged together as one
+        recording (another load, speed or build differs for the whole record).
+    record_comparable : bool
+        ``record_p_value >= false_alarm_rate``.
     """
 
     score: FloatArray
+    p_value: FloatArray
     comparable: NDArray[np.bool_]
+    false_alarm_rate: float
     threshold: float
+    record_p_value: float
+    record_comparable: bool
 
 
 @dataclass(frozen=True)
@@ -114,95 +145,188 @@ class ComparabilityReference:
     ----------
     mesh_order : tuple of int
     n_points : int
-    healthy_mean : ndarray (n_orders,)
-        Mean harmonic profile of the healthy SAs.
-    fault_direction : ndarray (n_orders,)
-        Example profile minus ``healthy_mean`` (zeros without an example).
+    groups : tuple of str
+        The feature group of each column of :func:`regular_features`.
+    mean, std : ndarray (n_features,)
+        The healthy SAs' feature mean and local spread (at least :data:`MIN_STD`).
+    anchors : ndarray (n_healthy, n_features)
+        The healthy SAs' standardised features (the fitted machine's healthy states).
+    fault_direction : ndarray (n_features,)
+        The faulty example's standardised features minus the mean of its nearer half of
+        the anchors (zeros without an example).
     max_step : float
         Largest multiple of ``fault_direction`` a fault can reach (``1 / faulty_size``).
-    spread : float
-        RMS leave-one-out distance of the healthy profiles (the score's unit).
-    threshold : float
+    log_score_mean, log_score_std : float
+        Normal model of a healthy segment's ``log(score)``, from the leave-one-out scores
+        of the healthy SAs (NaN when fewer than :data:`MIN_HEALTHY` SAs: not calibrated).
+    false_alarm_rate : float
     """
 
     mesh_order: tuple[int, ...]
     n_points: int
-    healthy_mean: FloatArray
+    groups: tuple[str, ...]
+    mean: FloatArray
+    std: FloatArray
+    anchors: FloatArray
     fault_direction: FloatArray
     max_step: float
-    spread: float
-    threshold: float
+    log_score_mean: float
+    log_score_std: float
+    false_alarm_rate: float
 
-    def distance(self, profiles: ArrayLike) -> FloatArray:
-        """Distance of profiles from the segment of line ``healthy_mean + t *
-        fault_direction``, ``0 ≤ t ≤ max_step`` (profile units, not spreads)."""
-        p = np.atleast_2d(np.asarray(profiles, dtype=float)) - self.healthy_mean
-        v = self.fault_direction
-        vv = float(v @ v)
-        t = np.clip(p @ v / vv, 0.0, self.max_step) if vv > 0 else np.zeros(len(p))
-        return np.asarray(np.linalg.norm(p - t[:, None] * v, axis=1), dtype=float)
+    @property
+    def calibrated(self) -> bool:
+        """Whether the healthy scores calibrate the test (at least :data:`MIN_HEALTHY`)."""
+        return bool(np.isfinite(self.log_score_mean))
 
-    def evaluate(self, sa: ArrayLike, threshold: float | None = None) -> Comparability:
-        """Score SAs (see :class:`Comparability`); ``threshold`` overrides the fitted one."""
+    def distance(self, features: ArrayLike) -> FloatArray:
+        """Score of :func:`regular_features` rows (see the module docstring)."""
+        z = (np.atleast_2d(np.asarray(features, dtype=float)) - self.mean) / self.std
+        return _distance(z, self.anchors, self.fault_direction, self.max_step,
+                         _group_masks(self.groups))
+
+    def p_value(self, score: ArrayLike) -> FloatArray:
+        """Upper-tail probability of scores under the healthy log-score model."""
+        s = np.asarray(score, dtype=float)
+        if not self.calibrated:
+            return np.full(s.shape, np.nan)
+        z = (np.log(np.maximum(s, _TINY)) - self.log_score_mean) / self.log_score_std
+        return np.asarray(scipy.special.ndtr(-z), dtype=float)
+
+    def threshold(self, false_alarm_rate: float) -> float:
+        """The score whose p-value is ``false_alarm_rate`` (0 when not calibrated)."""
+        if not self.calibrated:
+            return 0.0
+        return float(np.exp(self.log_score_mean
+                            + self.log_score_std * scipy.special.ndtri(1 - false_alarm_rate)))
+
+    def evaluate(self, sa: ArrayLike, false_alarm_rate: float | None = None
+                 ) -> Comparability:
+        """Score SAs (see :class:`Comparability`); ``false_alarm_rate`` overrides the
+        fitted one."""
         arr = np.atleast_2d(as_signal_array(sa, "sa", max_ndim=2))
         if arr.shape[-1] != self.n_points:
             raise GearshotError(f"sa has {arr.shape[-1]} points per cycle; the estimator "
                                 f"was fitted on {self.n_points}")
-        thr = self.threshold if threshold is None else check_positive(threshold,
-                                                                      "threshold")
-        score = self.distance(harmonic_profile(arr, list(self.mesh_order))) / self.spread
-        return Comparability(score, score <= thr, float(thr))
+        alpha = (self.false_alarm_rate if false_alarm_rate is None else
+                 check_in_range(false_alarm_rate, "false_alarm_rate", 0.0, 1.0,
+                                low_inclusive=False, high_inclusive=False))
+        score = self.distance(regular_features(arr, list(self.mesh_order))[0])
+        p = self.p_value(score)
+        record_p = float(self.p_value(np.median(score)))
+        comparable = np.asarray(p >= alpha, dtype=bool)  # NaN (not calibrated): False
+        return Comparability(score, p, comparable, float(alpha), self.threshold(alpha),
+                             record_p, bool(record_p >= alpha))
 
 
-def healthy_spread(profiles: FloatArray) -> float:
-    """RMS leave-one-out distance of each healthy profile from the mean of the others (the
-    unit of the comparability score), at least :data:`MIN_SPREAD`; needs 2 profiles."""
-    n = len(profiles)
-    loo = (n * profiles.mean(axis=0) - profiles) / (n - 1)  # the mean of the others
-    return max(float(np.sqrt(np.mean(np.sum((profiles - loo) ** 2, axis=1)))), MIN_SPREAD)
+def _group_masks(groups: tuple[str, ...]) -> list[NDArray[np.bool_]]:
+    labels = np.asarray(groups)
+    return [labels == g for g in dict.fromkeys(groups)]
+
+
+def _local_spread(features: FloatArray) -> FloatArray:
+    """RMS difference of each row from its nearest other row (in pooled standard
+    deviations) over ``sqrt(2)``, per column, at least :data:`MIN_STD`."""
+    pooled = np.sqrt(features.var(axis=0, ddof=1) + MIN_STD ** 2)
+    z = features / pooled
+    gap = np.sum((z[:, None, :] - z[None, :, :]) ** 2, axis=-1)
+    np.fill_diagonal(gap, np.inf)
+    nearest = features[np.argmin(gap, axis=1)]
+    return np.asarray(np.sqrt(np.mean((features - nearest) ** 2, axis=0) / 2
+                              + MIN_STD ** 2), dtype=float)
+
+
+def _distance(z: FloatArray, anchors: FloatArray, direction: FloatArray,
+              max_step: float, masks: list[NDArray[np.bool_]]) -> FloatArray:
+    """Distance of standardised rows ``z`` from the nearest state ``anchor + t_g v_g``."""
+    offset = z[:, None, :] - anchors[None, :, :]        # (m, n_anchors, d)
+    total = np.zeros(offset.shape[:2])
+    for mask in masks:
+        v = direction[mask]
+        part = offset[..., mask]
+        vv = float(v @ v)
+        t = np.clip(part @ v / vv, 0.0, max_step) if vv > 0 else np.zeros(total.shape)
+        resid = part - t[..., None] * v
+        var = 1.0 + t[..., None] ** 2 * (1.0 + (FAULT_SHAPE_UNCERTAINTY * v) ** 2)
+        total += np.sum(resid ** 2 / var, axis=-1)
+    return np.asarray(np.sqrt(total.min(axis=1) / z.shape[1]), dtype=float)
+
+
+def _states(features: FloatArray, example: FloatArray | None
+            ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Mean, local spread, anchors and fault direction of healthy feature rows."""
+    mean = features.mean(axis=0)
+    std = _local_spread(features)
+    anchors = (features - mean) / std
+    direction = np.zeros_like(mean)
+    if example is not None:
+        ez = (example - mean) / std
+        gap = np.sum((anchors - ez) ** 2, axis=1)
+        direction = ez - anchors[gap <= np.median(gap)].mean(axis=0)
+    return mean, std, anchors, direction
+
+
+def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
+                          max_step: float, masks: list[NDArray[np.bool_]]) -> FloatArray:
+    """Each healthy row scored by the states fitted on the others."""
+    scores = np.empty(len(features))
+    for i in range(len(features)):
+        mean, std, anchors, direction = _states(np.delete(features, i, axis=0), example)
+        z = ((features[i] - mean) / std)[None, :]
+        scores[i] = _distance(z, anchors, direction, max_step, masks)[0]
+    return scores
 
 
 def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
                       faulty_example: ArrayLike | None = None,
                       faulty_size: float | None = None,
-                      threshold: float = DEFAULT_THRESHOLD) -> ComparabilityReference:
-    """Learn the fitted machine's states from its healthy SAs and the one faulty example.
+                      false_alarm_rate: float = DEFAULT_FALSE_ALARM
+                      ) -> ComparabilityReference:
+    """Learn the fitted machine's states and calibrate the test on its healthy SAs.
 
     Parameters
     ----------
     healthy_sa : array_like (n_healthy, n_points)
-        At least 2 healthy SAs of the fitted machine.
+        At least 2 healthy SAs of the fitted machine, in physical units (at least
+        :data:`MIN_HEALTHY` to calibrate the test; with fewer, no segment is comparable).
     mesh_order : int or sequence of int
     faulty_example : array_like (n_points,), optional
         The one faulty SA (none for zero-shot).
     faulty_size : float in (0, 1], optional
         Its size (needed with ``faulty_example``).
-    threshold : float > 0, default :data:`DEFAULT_THRESHOLD`
+    false_alarm_rate : float in (0, 1), default :data:`DEFAULT_FALSE_ALARM`
 
     Returns
     -------
     ComparabilityReference
     """
-    healthy = as_signal_array(healthy_sa, "healthy_sa", min_ndim=2, max_ndim=2, min_length=4)
+    healthy = as_signal_array(healthy_sa, "healthy_sa", min_ndim=2, max_ndim=2,
+                              min_length=64)
     if healthy.shape[0] < 2:
-        raise GearshotError(f"healthy_sa holds {healthy.shape[0]} SA(s); the healthy "
-                            f"spread needs at least 2")
-    threshold = check_positive(threshold, "threshold")
+        raise GearshotError(f"healthy_sa holds {healthy.shape[0]} SA(s); comparability "
+                            f"needs at least 2")
+    alpha = check_in_range(false_alarm_rate, "false_alarm_rate", 0.0, 1.0,
+                           low_inclusive=False, high_inclusive=False)
     n_points = healthy.shape[1]
     meshes = check_mesh_orders(mesh_order, n_points)
-    prof = harmonic_profile(healthy, list(meshes))
-    mean = prof.mean(axis=0)
-    spread = healthy_spread(prof)
-    direction, max_step = np.zeros_like(mean), 0.0
+    feats, groups = regular_features(healthy, list(meshes))
+    example, max_step = None, 0.0
     if faulty_example is not None:
         if faulty_size is None:
             raise GearshotError("faulty_size is required with faulty_example")
         size = check_in_range(faulty_size, "faulty_size", 0.0, 1.0, low_inclusive=False)
-        example = as_signal_array(faulty_example, "faulty_example", max_ndim=2).reshape(-1)
-        if example.size != n_points:
-            raise GearshotError(f"faulty_example has {example.size} points but healthy_sa "
+        ex = as_signal_array(faulty_example, "faulty_example", max_ndim=2).reshape(-1)
+        if ex.size != n_points:
+            raise GearshotError(f"faulty_example has {ex.size} points but healthy_sa "
                                 f"SAs have {n_points}")
-        direction = harmonic_profile(example, list(meshes))[0] - mean
+        example = regular_features(ex, list(meshes))[0][0]
         max_step = 1.0 / size
-    return ComparabilityReference(tuple(meshes), n_points, mean, direction, max_step,
-                                  spread, float(threshold))
+    mean, std, anchors, direction = _states(feats, example)
+    log_mean = log_std = float("nan")
+    if len(feats) >= MIN_HEALTHY:
+        loo = _leave_one_out_scores(feats, example, max_step, _group_masks(groups))
+        logs = np.log(np.maximum(loo, _TINY))
+        log_mean = float(logs.mean())
+        log_std = max(float(logs.std(ddof=1)), MIN_LOG_SPREAD)
+    return ComparabilityReference(tuple(meshes), n_points, groups, mean, std, anchors,
+                                  direction, max_step, log_mean, log_std, float(alpha))
