@@ -162,8 +162,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1])
     frame = _estimates(est, seg, cond, coverage)
-    frame.attrs["grade"] = getattr(est, "grade_", None)
-    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
+    from .predict import fit_attrs
+
+    frame.attrs.update(fit_attrs(est))
     return frame
 
 
