@@ -12,7 +12,8 @@ from pathlib import Path
 
 from .._cluster import IN_PROCESS_BLOCKS, dask_client
 
-__all__ = ["default_store", "simulate_database", "simulate_machine_database"]
+__all__ = ["default_store", "simulate_database", "simulate_machine_database",
+           "repair_store"]
 
 
 def default_store() -> Path:
@@ -37,6 +38,27 @@ def simulate_database(store: Path, *, speeds: Sequence[float], loads: Sequence[f
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grades,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
                        fault_types=list(fault_types), paired=paired)
+    return store
+
+
+def repair_store(store: Path | None, others: Sequence[str], *, scheduler: str | None = None,
+                 workers: int = 2, echo=print) -> Path:
+    """``gearshot simulate --repair --store S``: :func:`gearshot.sim.repair_database` on
+    ``S`` (the store's own build arguments, read from its blocks); ``others``: the other
+    build options given, refused (the repair takes its arguments from the store)."""
+    from .._errors import GearshotError
+    from ..sim import repair_database
+
+    if store is None:
+        raise GearshotError("--repair needs --store: the store to repair")
+    if others:
+        raise GearshotError(f"--repair takes the build's arguments from the store; do not "
+                            f"give {', '.join(others)} with it")
+    with dask_client(scheduler, workers, needed=False) as client:
+        done = repair_database(store, client=client)
+    echo(f"repaired: {'; '.join(done)}" if done else "nothing to repair: manifest and "
+         "blocks whole")
+    echo(f"database ready: {store}")
     return store
 
 

@@ -116,10 +116,12 @@ def read_manifest(store: Path) -> dict:
         if not isinstance(man, dict) or not {"speeds", "loads", "grades"} <= set(man):
             raise ValueError("not a gearshot manifest")
     except (OSError, ValueError) as exc:
+        text = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
         raise GearshotError(
-            f"store {str(store)!r}: manifest.json is damaged ({exc}); run build_database / "
-            f"`gearshot simulate` on this store with its original arguments: the manifest "
-            f"is restored from the blocks' copies (no block is rebuilt)") from None
+            f"store {str(store)!r}: manifest.json is damaged ({text}); run `gearshot "
+            f"simulate --repair --store {str(store)}`: it restores the manifest from the "
+            f"blocks' copies (or build_database / `gearshot simulate` on this store with "
+            f"its original arguments)") from None
     return man
 
 
@@ -138,7 +140,9 @@ def rebuild_hint(store: Path, man: dict, blocks=()) -> str:
            + ("" if man.get("paired") else " --no-paired"))   # paired is the default
     what = (f"it (re)builds {', '.join(blocks)} and reuses the other blocks" if blocks else
             "it restores manifest.json from the blocks' copies and rebuilds no block")
-    return f"run `{cmd}` (or build_database with the same arguments): {what}"
+    return (f"run `gearshot simulate --repair --store {str(store)}` (it checks every block "
+            f"in full and rebuilds exactly the damaged and missing ones), or `{cmd}` (or "
+            f"build_database with the same arguments): {what}")
 
 
 def prepare_store(store: Path, manifest: dict, progress: bool = True) -> None:
