@@ -80,11 +80,11 @@ def test_report_reads_predict_csv_new_json_and_bare_list(name, tmp_path):
 
 def test_report_reads_the_demo_ablations_csv(tmp_path):
     rows = pd.DataFrame({"variant": ["full", "full", "before_da", "before_da"],
-                         "repeat": [0, 1, 0, 1], "mae": [0.10, 0.12, 0.30, 0.34]})
+                         "repeat": [0, 1, 0, 1], "mae_percent": [10.0, 12.0, 30.0, 34.0]})
     rows.to_csv(tmp_path / "ablations.csv", index=False)
     text = report_from_any_json(tmp_path / "ablations.csv", tmp_path / "rep").read_text()
-    assert "| full | 11.0 |" in text or "full" in text
-    assert "11.0" in text   # the MAE in %, one unit
+    assert "**Full algorithm MAE: 11.0 %**" in text       # the MAE in %, one unit
+    assert "| before_da | 32.0 |" in text
     assert (tmp_path / "rep" / "report.html").is_file()
 
 

@@ -38,6 +38,9 @@ def write_report(folder, summary: dict, figures: dict) -> Path:
             lines += ["| variant | MAE [%] |", "|---|---|"]
             lines += [f"| {k} | {v:.1f} |" for k, v in summary["ablations"].items()]
         lines.append("")
+    for key in ("ablation_note", "grade_note"):
+        if summary.get(key):
+            lines += [str(summary[key]).replace("\n", "\n\n"), ""]
     for key in ("grade", "rig_grade", "selected_features", "n_neighbors", "feature_errors"):
         if key in summary:
             lines.append(f"* {key.replace('_', ' ')}: {summary[key]}")

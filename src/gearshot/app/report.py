@@ -100,11 +100,16 @@ def _load_csv(path: Path) -> tuple[str, Any]:
     cols = set(frame.columns)
     if {"recording", "predicted"} <= cols:
         return "predict", rows
+    if {"variant", "mae_percent"} <= cols and "mae" not in cols:   # the demo's, in %
+        rows = [{**r, "mae": r["mae_percent"] / 100
+                 if isinstance(r["mae_percent"], (int, float)) else r["mae_percent"]}
+                for r in rows]
+        return "rig", {"experiment": "rig", "rows": rows}
     if {"variant", "mae"} <= cols:
         return "rig", {"experiment": "rig", "rows": rows}
     raise GearshotError(f"{str(path)!r} is not a CSV gearshot writes (predict's table: "
                         f"recording, predicted, low, high ...; or ablations.csv: variant, "
-                        f"mae ...); its columns are {sorted(map(str, cols))[:8]}")
+                        f"mae_percent ...); its columns are {sorted(map(str, cols))[:8]}")
 
 
 def read_output(path) -> tuple[str, Any]:
