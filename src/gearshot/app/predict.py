@@ -230,7 +230,8 @@ def _inputs(database, healthy, faulty, faulty_size, frame, *, machine, speed, se
 
 #: The keys of the fit a predict JSON carries, when the frame's ``attrs`` hold them
 #: (``fit_check``: the frame's fit verdict, when a fit check ran).
-FIT_KEYS = ("grade", "calibration", "simulated_reference", "fit_check")
+FIT_KEYS = ("grade", "calibration", "simulated_reference", "fit_check", "load_source",
+            "load_choice")
 
 
 def _summary(frame: pd.DataFrame) -> dict:
