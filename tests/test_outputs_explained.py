@@ -113,3 +113,30 @@ def test_ranking_json_report_carries_the_note(tmp_path):
     text = report_from_any_json(tmp_path / "i.json", tmp_path / "rep").read_text()
     assert "separation = |2 AUC - 1|" in text
     assert "Records per cell (healthy/faulty): 30 Hz 2/1, 40 Hz 1/1." in text
+
+
+def test_demo_outputs_give_the_mae_in_percent_everywhere(tmp_path):
+    import json
+
+    from gearshot.app.demo import _write_outputs
+    from gearshot.app.report import report_from_any_json
+
+    results = pd.DataFrame({"variant": ["full", "full", "rms_only", "rms_only"],
+                            "repeat": [0, 1, 0, 1], "mae": [0.0512345678, 0.0612, 0.08, 0.1],
+                            "grade": [6, 7, 6, 7], "estimator": [None] * 4})
+    full_pred = pd.DataFrame({"true": [0.32, 0.56], "predicted": [0.312345678901, 0.5]})
+    summary = {"speed": 15.0, "load": 10.0, "seed": 0, "draws": 2, "mae_unit": "%",
+               "mae": 5.62, "mae_std": 0.71, "ablations": {"full": 5.62, "rms_only": 9.0},
+               "ablations_std": {"full": 0.71, "rms_only": 1.41}, "grade": 1,
+               "grade_note": "grade 1 is the smoothest grade ... edge of the search"}
+    _write_outputs(tmp_path, summary, {}, results, full_pred)
+    table = pd.read_csv(tmp_path / "ablations.csv")
+    assert "mae" not in table and list(table["mae_percent"]) == [5.123, 6.12, 8.0, 10.0]
+    assert "0.3123" in (tmp_path / "predictions.csv").read_text()
+    assert "0.312345678901" not in (tmp_path / "predictions.csv").read_text()
+    report = (tmp_path / "report.md").read_text()
+    assert "**Full algorithm MAE: 5.6 ± 0.7 %**" in report and "edge of the search" in report
+    assert json.loads((tmp_path / "results.json").read_text())["mae_unit"] == "%"
+    # the report command reads the same ablations.csv back, in %
+    text = report_from_any_json(tmp_path / "ablations.csv", tmp_path / "rep").read_text()
+    assert "| rms_only | 9.0 |" in text

@@ -183,7 +183,8 @@ def test_repair_rebuilds_a_deleted_block(store):
 
     ref = _reference(store)
     shutil.rmtree(store / "blocks" / "s1_l0_g0.zarr")
-    assert repair_database(store, progress=False) == []
+    assert repair_database(store, progress=False) == [
+        "1 missing block(s) to build: s1_l0_g0.zarr"]
     _assert_loads_as(store, ref)
 
 

@@ -135,7 +135,7 @@ def read_output(path) -> tuple[str, Any]:
         if kind is None:
             raise GearshotError(f"{str(path)!r} is not an output that gearshot writes (one "
                                 f"of: {KINDS_TEXT})")
-    KINDS[kind][0](payload, str(path))
+    KINDS[kind][0](payload, repr(str(path)))
     return kind, payload
 
 

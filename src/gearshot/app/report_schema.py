@@ -144,7 +144,6 @@ def check_rows(rows: Any, schema: dict[str, Field], where: str, name: str = "row
         check_fields(row, schema, where, f"{name}[{i}]")
 
 
-_SIZE = dict(low=0.0, high=1.0)
 
 #: One row of ``gearshot predict`` (CSV or JSON); trust columns of other commands are
 #: extra keys, read when present.
@@ -153,9 +152,9 @@ PREDICT_ROW = {
     "role": Field("str", required=False, choices=("healthy_fitted", "example", "faulty_rest",
                                                   "healthy_holdout", "test")),
     "segment": Field("int", required=False, low=0),
-    "predicted": Field("number", **_SIZE),
-    "low": Field("number", **_SIZE),
-    "high": Field("number", **_SIZE),
+    "predicted": Field("number", low=0.0, high=1.0),
+    "low": Field("number", low=0.0, high=1.0),
+    "high": Field("number", low=0.0, high=1.0),
     "comparability": Field("number", required=False, nullable=True),
     "comparable": Field("bool", required=False),
 }

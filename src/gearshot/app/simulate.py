@@ -97,7 +97,8 @@ def simulate_machine_database(machine_file: Path, store: Path | None, *,
                        fault_types=list(fault_types), paired=paired)
     mate_shaft, _ = mach.mate()
     ref_kind = "tacho" if mach.tacho is not None else "reference"
-    line = (f"monitored gear {pair.z_gear} teeth on the {mach.monitored.shaft} shaft (the "
+    shaft = mach.monitored.shaft if mach.monitored is not None else "monitored"
+    line = (f"monitored gear {pair.z_gear} teeth on the {shaft} shaft (the "
             f"fault's gear) meshing with {pair.z_pinion} teeth on the {mate_shaft} shaft; "
             f"conditions: {mach.reference_shaft} "
             f"({ref_kind}) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "

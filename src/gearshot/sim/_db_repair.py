@@ -112,19 +112,24 @@ def repair_database(store, *, client=None, progress: bool = True) -> list[str]:
         if wrong is not None:
             write_json_atomic(man, store / "manifest.json", sort_keys=False)
             done.append(f"{wrong}: restored from the blocks' copies")
-        damaged = []
+        damaged, missing = [], []
         for i in range(len(man["speeds"])):
             for j in range(len(man["loads"])):
                 for k in range(len(man["grades"])):
                     for ft in man.get("fault_types", ["ftff"]):
                         path = store / "blocks" / block_name(i, j, k, ft)
-                        problem = block_problem(path) if path.exists() else None
+                        if not path.exists():
+                            missing.append(path.name)
+                            continue
+                        problem = block_problem(path)
                         if problem is not None:
                             damaged.append(f"{path.name} ({problem})")
                             remove_tree(path)
         if damaged:
             done.append(f"removed {len(damaged)} damaged block(s) to rebuild: "
                         + "; ".join(damaged))
+        if missing:
+            done.append(f"{len(missing)} missing block(s) to build: {', '.join(missing)}")
     build_database(store, pair, speeds=man["speeds"], loads=man["loads"],
                    grades=man["grades"], n_healthy=man["n_healthy"],
                    n_faulty=man["n_faulty"], seed=man["seed"], n_points=man["n_points"],
