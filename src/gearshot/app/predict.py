@@ -11,9 +11,10 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_in_range
 from ..paper import GEAR_TEETH, PINION_TEETH
+from .fit_summary import fit_attrs
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
-           "predictions_payload", "fit_attrs", "FIT_KEYS",
+           "predictions_payload", "FIT_KEYS",
            "format_predictions", "comparable_summary", "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
@@ -100,19 +101,6 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame.attrs["speed"], frame.attrs["load"] = speed, load
     frame.attrs.update(fit_attrs(est))
     return frame
-
-
-def fit_attrs(est) -> dict:
-    """What a fitted estimator chose, for a predict table's ``attrs`` (and so its JSON's
-    ``fit``): ``grade``, ``calibration`` (strategy and the weighted settings' grades) and
-    ``simulated_reference``."""
-    calibration = getattr(est, "calibration_", None) or {}
-    settings = [{"grade": int(s["grade"]), "weight": float(s.get("weight", 1.0))}
-                for s in calibration.get("settings", []) if "grade" in s]
-    grade = getattr(est, "grade_", None)
-    return {"grade": None if grade is None else int(grade),
-            "calibration": {"strategy": calibration.get("strategy"), "settings": settings},
-            "simulated_reference": getattr(est, "simulated_reference_", None)}
 
 
 def _segments(files, healthy, faulty, kw):

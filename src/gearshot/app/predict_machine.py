@@ -162,7 +162,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1])
     frame = _estimates(est, seg, cond, coverage)
-    from .predict import fit_attrs
+    from .fit_summary import fit_attrs
 
     frame.attrs.update(fit_attrs(est))
     return frame

@@ -19,11 +19,13 @@ from ._block_read import read_block
 from ._db_checksums import ATTR, block_manifest, block_record
 from ._db_manifest import (
     block_name,
+    blocks_manifest,
     check_fault_models,
     pair_attrs,
     pair_from_manifest,
     read_manifest,
     rebuild_hint,
+    repair_command,
 )
 from ._integrity import block_content_problem, manifest_diff, manifest_digest
 
@@ -93,8 +95,6 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
 def _refuse_edited_manifest(store: Path, man: dict) -> None:
     """Raise when every block vouches for another build than ``manifest.json``: a condition
     missing from an edited manifest is tampering, not the caller's wrong argument."""
-    from ._db_repair import blocks_manifest, repair_command
-
     theirs, _, _ = blocks_manifest(store)
     if theirs is not None and theirs != man:
         raise GearshotError(f"store {str(store)!r}: manifest.json was changed after the "

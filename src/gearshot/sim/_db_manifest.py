@@ -25,7 +25,7 @@ from .geometry import GearPair
 
 __all__ = ["FORMAT", "PAIR_ATTRS", "block_name", "make_manifest", "pair_attrs",
            "pair_from_manifest", "check_fault_models", "read_manifest", "rebuild_hint",
-           "prepare_store"]
+           "prepare_store", "repair_command", "blocks_manifest"]
 
 FORMAT = 1
 
@@ -190,3 +190,18 @@ def _restore_or_refuse(store: Path, old: dict | None, manifest: dict, progress: 
     raise GearshotError(f"store {str(store)!r} holds a different build "
                         f"(differs in {', '.join(diff)}){hint}; use a new store "
                         f"(--store / store=)")
+
+
+def repair_command(store) -> str:
+    """The command that repairs ``store``: ``gearshot simulate --repair --store STORE``."""
+    return f"gearshot simulate --repair --store {str(store)}"
+
+
+def blocks_manifest(store: Path) -> tuple[dict | None, int, int]:
+    """The manifest the store's blocks vouch for: ``(manifest or None, blocks vouching,
+    blocks)``; None when no block vouches for one or they vouch for different builds."""
+    blocks = sorted((store / "blocks").glob("*.zarr")) if (store / "blocks").is_dir() else []
+    copies = [c for c in (block_manifest(b) for b in blocks) if c is not None]
+    if not copies or any(c != copies[0] for c in copies[1:]):
+        return None, len(copies), len(blocks)
+    return copies[0], len(copies), len(blocks)

@@ -15,16 +15,11 @@ from pathlib import Path
 
 from .._atomic import remove_tree, write_json_atomic
 from .._errors import GearshotError
-from ._db_checksums import block_manifest, block_problem
-from ._db_manifest import block_name, pair_from_manifest
+from ._db_checksums import block_problem
+from ._db_manifest import block_name, blocks_manifest, pair_from_manifest
 from ._integrity import manifest_diff, store_lock
 
-__all__ = ["repair_database", "repair_command", "blocks_manifest"]
-
-
-def repair_command(store) -> str:
-    """The command that repairs ``store``: ``gearshot simulate --repair --store STORE``."""
-    return f"gearshot simulate --repair --store {str(store)}"
+__all__ = ["repair_database"]
 
 
 def _file_manifest(store: Path) -> dict | None:
@@ -34,16 +29,6 @@ def _file_manifest(store: Path) -> dict | None:
     except (OSError, ValueError):
         return None
     return man if isinstance(man, dict) and {"speeds", "loads", "grades"} <= set(man) else None
-
-
-def blocks_manifest(store: Path) -> tuple[dict | None, int, int]:
-    """The manifest the store's blocks vouch for: ``(manifest or None, blocks vouching,
-    blocks)``; None when no block vouches for one or they vouch for different builds."""
-    blocks = sorted((store / "blocks").glob("*.zarr")) if (store / "blocks").is_dir() else []
-    copies = [c for c in (block_manifest(b) for b in blocks) if c is not None]
-    if not copies or any(c != copies[0] for c in copies[1:]):
-        return None, len(copies), len(blocks)
-    return copies[0], len(copies), len(blocks)
 
 
 def _chosen_manifest(store: Path) -> tuple[dict, str | None]:
