@@ -88,6 +88,43 @@ def test_report_reads_the_demo_ablations_csv(tmp_path):
     assert (tmp_path / "rep" / "report.html").is_file()
 
 
+def test_report_reads_the_ranking_csv(tmp_path):
+    from gearshot.app.ranking import indicator_ranking
+
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from test_outputs_explained import _labels, _payload
+
+    indicator_ranking(_payload(), _labels()).to_csv(tmp_path / "ranking.csv", index=False)
+    text = report_from_any_json(tmp_path / "ranking.csv", tmp_path / "rep").read_text()
+    assert text.startswith("# gearshot report: indicator ranking")
+    assert "separation = |2 AUC - 1|" in text and "| acc | rms |" in text
+    assert (tmp_path / "rep" / "ranking.png").stat().st_size > 0
+
+
+def test_report_reads_the_demo_predictions_csv(tmp_path):
+    pd.DataFrame({"true": [0.32, 0.32, 0.56], "predicted": [0.30, 0.36, 0.5],
+                  "variant": "full", "repeat": 0}).to_csv(tmp_path / "predictions.csv",
+                                                          index=False)
+    text = report_from_any_json(tmp_path / "predictions.csv", tmp_path / "rep").read_text()
+    assert "**MAE 4.0 %**" in text and "| 0.320 | 2 | 0.330 |" in text
+    assert (tmp_path / "rep" / "predicted_vs_true.png").is_file()
+
+
+@pytest.mark.parametrize("content", [
+    "sensor,indicator,auc_overall,separation,n_healthy,n_faulty\nacc,rms,1.5,0.5,2,1\n",
+    "sensor,indicator,auc_overall,separation,n_healthy,n_faulty,auc[30 Hz]\n"
+    "acc,rms,0.5,0.5,2,1,-1\n",
+    "true,predicted\n0.3,nan\n",
+    "true,predicted\n2,0.5\n",
+])
+def test_malformed_tables_are_refused_in_one_line(content, tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_text(content)
+    with pytest.raises(GearshotError) as info:
+        read_output(path)
+    assert "\n" not in str(info.value) and "t.csv" in str(info.value)
+
+
 def _row(**change):
     row = {"recording": "/d/a.zip", "role": "test", "segment": 0, "predicted": 0.3,
            "low": 0.1, "high": 0.5}
@@ -125,6 +162,7 @@ MALFORMED = {
                                                "rows": [_row()]}), ["inputs"]),
     "kind a list": (json.dumps({"kind": ["predict"], "rows": [_row()]}),
                     ["not an output"]),
+    "kind of a CSV table": (json.dumps({"kind": "ranking"}), ["not an output"]),
     "rig mae -5": (json.dumps({"experiment": "rig", "rows": [{"variant": "full",
                                                              "mae": -5}]}),
                    ["rows[0].mae", "-5"]),

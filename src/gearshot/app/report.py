@@ -16,14 +16,18 @@ from typing import Any
 
 from .._errors import GearshotError
 from . import report_schema as schema
+from . import report_tables
 from .markdown import md_table as _md_table
 from .markdown import write_markdown, write_report
 
 __all__ = ["write_report", "json_kind", "report_from_any_json", "read_output", "KINDS",
            "predict_rows"]
 
-KINDS_TEXT = ("predict --out X.csv or X.json, demo results.json or ablations.csv, experiment "
-              "simulated/rig --json, experiment rig-family --json, indicators --json")
+KINDS_TEXT = ("predict --out X.csv or X.json, demo results.json, ablations.csv or "
+              "predictions.csv, experiment simulated/rig --json, experiment rig-family "
+              "--json, indicators --json or its ranking.csv")
+#: The kinds a JSON declares (``kind`` or ``experiment``); the others are CSV tables.
+JSON_KINDS = ("predict", "demo", "simulated", "rig", "rig-family", "indicators")
 #: The largest output file ``report`` reads (bytes).
 MAX_BYTES = 512 * 1024 * 1024
 
@@ -41,7 +45,7 @@ def json_kind(payload: Any) -> str | None:
     if not isinstance(payload, dict):
         return None
     declared = payload.get("kind", payload.get("experiment"))
-    if isinstance(declared, str) and declared in KINDS:
+    if isinstance(declared, str) and declared in JSON_KINDS:
         return str(declared)
     if isinstance(payload.get("records"), list) and payload["records"] and all(
             isinstance(r, dict) and "indicators" in r for r in payload["records"]):
@@ -107,9 +111,14 @@ def _load_csv(path: Path) -> tuple[str, Any]:
         return "rig", {"experiment": "rig", "rows": rows}
     if {"variant", "mae"} <= cols:
         return "rig", {"experiment": "rig", "rows": rows}
+    if {"sensor", "indicator", "auc_overall"} <= cols:
+        return "ranking", {"rows": rows}
+    if {"true", "predicted"} <= cols:
+        return "sizes", {"rows": rows}
     raise GearshotError(f"{str(path)!r} is not a CSV gearshot writes (predict's table: "
-                        f"recording, predicted, low, high ...; or ablations.csv: variant, "
-                        f"mae_percent ...); its columns are {sorted(map(str, cols))[:8]}")
+                        f"recording, predicted, low, high ...; the demo's ablations.csv or "
+                        f"predictions.csv; indicators' ranking.csv); its columns are "
+                        f"{sorted(map(str, cols))[:8]}")
 
 
 def read_output(path) -> tuple[str, Any]:
@@ -351,4 +360,6 @@ KINDS: dict[str, tuple[Check, Render]] = {
     "rig": (_check_experiment, _experiment_report),
     "rig-family": (_check_family, _family_report),
     "indicators": (_check_indicators, _indicators_report),
+    "ranking": (report_tables.check_ranking, report_tables.ranking_report),
+    "sizes": (report_tables.check_sizes, report_tables.sizes_report),
 }
