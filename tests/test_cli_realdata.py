@@ -127,6 +127,6 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--recordings", str(small["spur1"]), "--speed", "30", "--load", "10",
               "--cycles-per-segment", "10", "--out", str(out_json), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    records = json.loads(out_json.read_text())
+    records = json.loads(out_json.read_text())["rows"]
     assert [r["comparable"] for r in records] == frame["comparable"].tolist()
     assert all(isinstance(r["comparable"], bool) for r in records)
