@@ -125,6 +125,13 @@ def test_malformed_tables_are_refused_in_one_line(content, tmp_path):
     assert "\n" not in str(info.value) and "t.csv" in str(info.value)
 
 
+def test_a_demo_json_without_load_still_reports(tmp_path):
+    (tmp_path / "d.json").write_text(json.dumps({"speed": 15, "mae": 10,
+                                                 "ablations": {"full": 10.0}}))
+    text = report_from_any_json(tmp_path / "d.json", tmp_path / "rep").read_text()
+    assert "Condition: 15 rps; seed None." in text
+
+
 def _row(**change):
     row = {"recording": "/d/a.zip", "role": "test", "segment": 0, "predicted": 0.3,
            "low": 0.1, "high": 0.5}
@@ -180,6 +187,14 @@ MALFORMED = {
                          ["ablations.full", "-5"]),
     "demo ablation named a path": (json.dumps({"mae": 10, "ablations": {"../x": 5}}),
                                    ["ablations key", "../x"]),
+    "nested 900 deep inside a valid demo": (
+        '{"mae": 10, "ablations": {"full": 5}, "feature_errors": {"x": 1}, "params": '
+        + "[" * 900 + "]" * 900 + "}", ["nested deeper than 16"]),
+    "demo feature_errors nested": (json.dumps({"mae": 10, "ablations": {"full": 5},
+                                               "feature_errors": {"x": [[1]]}}),
+                                   ["feature_errors.x"]),
+    "demo note a list": (json.dumps({"mae": 10, "ablations": {"full": 5},
+                                     "grade_note": ["edge"]}), ["grade_note"]),
     "demo speed null": (json.dumps({"speed": None, "mae": 10, "ablations": {"full": 5}}),
                         ["speed"]),
     "family cell a string": (json.dumps({"experiment": "rig-family", "tables": {

@@ -22,8 +22,9 @@ def write_report(folder, summary: dict, figures: dict) -> Path:
     folder = Path(folder)
     lines = ["# gearshot report", ""]
     if "speed" in summary:
-        lines += [f"Condition: {summary['speed']:g} rps, {summary['load']:g} Nm; "
-                  f"seed {summary.get('seed')}.", ""]
+        load = f", {summary['load']:g} Nm" if summary.get("load") is not None else ""
+        lines += [f"Condition: {summary['speed']:g} rps{load}; seed {summary.get('seed')}.",
+                  ""]
     spread = summary.get("ablations_std")
     over = f" (mean ± std over {summary['draws']} example draws)" if spread else ""
     if "mae" in summary:

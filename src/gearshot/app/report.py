@@ -28,6 +28,8 @@ KINDS_TEXT = ("predict --out X.csv or X.json, demo results.json, ablations.csv o
               "--json, indicators --json or its ranking.csv")
 #: The kinds a JSON declares (``kind`` or ``experiment``); the others are CSV tables.
 JSON_KINDS = ("predict", "demo", "simulated", "rig", "rig-family", "indicators")
+#: The deepest nesting of lists and objects an output may have (gearshot writes at most 5).
+MAX_DEPTH = 16
 #: The largest output file ``report`` reads (bytes).
 MAX_BYTES = 512 * 1024 * 1024
 
@@ -79,7 +81,7 @@ def _load_json(path: Path) -> Any:
 
     try:
         text = path.read_text(encoding="utf-8")
-        return json.loads(text, parse_float=finite, parse_constant=constant)
+        payload = json.loads(text, parse_float=finite, parse_constant=constant)
     except RecursionError:
         raise GearshotError(f"{str(path)!r}: its JSON is nested too deep to be an output "
                             f"of gearshot") from None
@@ -88,6 +90,22 @@ def _load_json(path: Path) -> Any:
             raise
         raise GearshotError(f"{str(path)!r} is not a JSON file ({type(exc).__name__}: "
                             f"{str(exc).splitlines()[0][:80]})") from None
+    if _depth(payload) > MAX_DEPTH:
+        raise GearshotError(f"{str(path)!r}: its JSON is nested deeper than {MAX_DEPTH} "
+                            f"levels; no output of gearshot is")
+    return payload
+
+
+def _depth(value: Any) -> int:
+    """How deeply lists and objects nest in a parsed JSON value (iteratively)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        item, level = stack.pop()
+        if isinstance(item, (list, dict)):
+            deepest = max(deepest, level)
+            stack.extend((v, level + 1) for v in (item.values() if isinstance(item, dict)
+                                                  else item))
+    return deepest
 
 
 def _load_csv(path: Path) -> tuple[str, Any]:

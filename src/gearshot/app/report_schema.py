@@ -186,6 +186,9 @@ DEMO = {
     "grade": Field("int", required=False, low=1, high=12),
     "rig_grade": Field("int", required=False, low=1, high=12),
     "selected_features": Field("strings", required=False),
+    "feature_errors": Field("numbers", required=False),
+    "grade_note": Field("str", required=False, nullable=True),
+    "ablation_note": Field("str", required=False, nullable=True),
     "n_neighbors": Field("int", required=False, low=1),
 }
 
