@@ -26,7 +26,7 @@ def per_sa_ms(pair, *, batch, speed, repeats=2, seed=0):
     Every call and repeat draws its own sizes and profile errors (seeded by the batch size,
     speed and repeat): the simulator caches fault tables per fault, so reusing the same
     sizes would time cache hits (≈ 3 ms instead of ≈ 5.7 ms per SA at 15 rps, measured
-    in session 5), which a database never gets (sizes are continuous draws).
+    with the earlier simulator), which a database never gets (sizes are continuous draws).
     """
     best = np.inf
     for rep in range(repeats):

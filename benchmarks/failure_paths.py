@@ -7,7 +7,9 @@ and exceptions other than GearshotError (or RuntimeWarnings) from the public API
     PYTHONPATH=src python benchmarks/failure_paths.py
 
 It ends with the cases of issue #22 (``benchmarks/integrity_paths.py``: concurrent builds,
-manifest tampering, zeroed recordings and crafted model files, a full disk, exit 3).
+manifest tampering, zeroed recordings and crafted model files, a full disk, exit 3) and
+those of issue #32 (``benchmarks/report_paths.py``: ``gearshot report`` on malformed
+outputs, ``gearshot simulate --repair`` after every kind of store damage).
 
 The command-line contract of issue #32 (options never silently ignored, empty paths, stores
 into folders of other files, checks before the long work, the same bounds everywhere, a
@@ -387,6 +389,14 @@ def main() -> None:
     integrity = importlib.util.module_from_spec(spec22)
     spec22.loader.exec_module(integrity)
     integrity.main(trials=10)
+
+    # issue #32: report on malformed outputs, repairs
+    print()
+    spec32 = importlib.util.spec_from_file_location("report_paths",
+                                                    ROOT / "benchmarks" / "report_paths.py")
+    report_paths = importlib.util.module_from_spec(spec32)
+    spec32.loader.exec_module(report_paths)
+    report_paths.main()
 
 
 if __name__ == "__main__":

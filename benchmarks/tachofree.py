@@ -227,7 +227,7 @@ def runup_row(label, acc, tacho, fs, *, orders, speed_range, revs_per_cycle, tru
     return row
 
 
-RIG_SEEDS = {"development": [0], "held-out": [1, 2]}  # session 7: seed 0 looked at, 1-2 not
+RIG_SEEDS = {"development": [0], "held-out": [1, 2]}  # seed 0 looked at while developing, 1-2 not
 
 
 def part_c(quick: bool) -> pd.DataFrame:

@@ -97,7 +97,8 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--grade", "6", "--grade", "7", "--n-healthy", "6", "--n-faulty", "24",
               "--store", str(store), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    assert "pair 96 -> 32 teeth" in res.stdout and "input (tacho) shaft 30 Hz" in res.stdout
+    assert ("monitored gear 32 teeth on the input shaft (the fault's gear) meshing with 96 "
+            "teeth on the idler shaft") in res.stdout and "input (tacho) shaft 30 Hz" in res.stdout
     assert "rev/s" not in res.stdout     # no internal (idler) speeds
     # a machine's database is paired by default (each signal's healthy twin stored)
     assert json.loads((store / "manifest.json").read_text()).get("paired") is True
@@ -129,6 +130,6 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
               "--recordings", str(small["spur1"]), "--speed", "30", "--load", "10",
               "--cycles-per-segment", "10", "--out", str(out_json), env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    records = json.loads(out_json.read_text())
+    records = json.loads(out_json.read_text())["rows"]
     assert [r["comparable"] for r in records] == frame["comparable"].tolist()
     assert all(isinstance(r["comparable"], bool) for r in records)

@@ -333,8 +333,10 @@ def test_predict_without_machine_writes_the_columns(tmp_path):
                           "--load", "10", "--out", str(out)], capture_output=True,
                          text=True, env=env, timeout=600)
     assert res.returncode == 0, res.stderr
-    records = json.loads(out.read_text())
-    assert len(records) == 1
+    payload = json.loads(out.read_text())
+    records = payload["rows"]
+    assert len(records) == 1 and payload["summary"]["comparable"] == int(
+        records[0]["comparable"])
     assert isinstance(records[0]["comparable"], bool)
     # two healthy SAs cannot calibrate the test: no p-value, not comparable
     assert records[0]["comparability"] is None and records[0]["comparable"] is False

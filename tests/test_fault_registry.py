@@ -19,10 +19,10 @@ from gearshot.fault_registry import (
 )
 
 SRC = Path(__file__).resolve().parents[1] / "src"
-#: a store built by session 6's code (before the registry), where a type's code was its
+#: a store built before the fault-type registry, where a type's code was its
 #: position in the dict ``FAULT_TYPES``: seed 11, 15 rev/s, 10 N m, grade 7, 1 + 1 signals
 #: of 16 points per type, paired
-OLD_STORE = Path(__file__).resolve().parent / "data" / "store_session6_fault_types.zip"
+OLD_STORE = Path(__file__).resolve().parent / "data" / "store_before_fault_registry.zip"
 #: the codes and model versions every store built so far carries
 OLD_CODES = {"ftff": 0, "partial_face": 1, "breakage": 2, "destruction": 3}
 OLD_VERSIONS = {"ftff": 1, "partial_face": 1, "breakage": 2, "destruction": 1}

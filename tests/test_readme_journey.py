@@ -91,7 +91,14 @@ def test_readme_journey_estimates_are_self_describing(journey):
     # --speed and --load were left out: read from the tacho, the database's only load
     assert "database condition: tacho shaft 30 Hz, load 10 N m" in res.stdout
     assert "mean estimated size" in res.stdout          # the summary's value column is headed
-    frame = pd.DataFrame(json.loads((journey["work"] / "estimates.json").read_text()))
+    payload = json.loads((journey["work"] / "estimates.json").read_text())
+    # the JSON carries its inputs and fit beside its rows (issue #32)
+    assert payload["kind"] == "predict" and payload["inputs"]["faulty_size"] == 0.5
+    assert payload["inputs"]["machine"] == "examples/machines/phm09_spur.toml"
+    assert len(payload["inputs"]["healthy"]) == 2 and payload["inputs"]["speed"] == 30.0
+    assert payload["fit"]["grade"] in (6, 7) and payload["fit"]["simulated_reference"] == "twin"
+    assert payload["summary"]["segments"] == len(payload["rows"])
+    frame = pd.DataFrame(payload["rows"])
     assert set(frame["role"]) == {"healthy_holdout", "faulty_rest", "test"}
     names = {Path(r).name for r in frame.loc[frame["role"] == "test", "recording"]}
     assert names == {f"spur{k}_30hz_Low_1.zip" for k in (1, 2, 3)}  # the glob, expanded

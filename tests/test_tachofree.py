@@ -377,7 +377,7 @@ def test_phm09_predict_segments_say_where_the_speed_came_from():
         assert speed == pytest.approx(29.92, rel=0.002)
 
 
-# ------------------------------------------------- session 8: ratio locks, cheap search
+# ------------------------------------------------- ratio locks, cheap search
 def test_the_comb_search_finds_the_same_maximum_as_scoring_every_speed():
     """Branch and bound over cells of candidate speeds: the same best score and the same
     (first) speed as the exact comb of every candidate."""

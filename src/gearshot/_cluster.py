@@ -22,14 +22,14 @@ __all__ = ["dask_client", "WORKER_MALLOC", "IN_PROCESS_BLOCKS"]
 #: Database builds of at most this many blocks run in-process (one block per core on
 #: threads, :mod:`gearshot.sim._block_threads`): a LocalCluster's start-up and its workers'
 #: separate writes cost more than they save there (one paper condition, 12 blocks: 10.8 s
-#: in-process against 20 s on a 2-worker LocalCluster, benchmarks/RESULTS.md, session 8).
+#: in-process against 20 s on a 2-worker LocalCluster, measured with issue #23).
 IN_PROCESS_BLOCKS = 16
 
 #: glibc allocator settings of the LocalCluster's workers (set before they start). Dask's
 #: own ``MALLOC_TRIM_THRESHOLD_=65536`` also pins the mmap threshold at 128 KiB: every
 #: array above it (an SA batch, a spectrum) is then mapped afresh and page-faulted in on
 #: each use, which cost a Sec. 4.1 dataset 1.18 s of CPU instead of 0.52 s with these
-#: (benchmarks/RESULTS.md, issue #23 session 8). Arrays up to 32 MiB come from the heap,
+#: (measured with issue #23). Arrays up to 32 MiB come from the heap,
 #: and up to 128 MiB of freed heap is kept for reuse.
 WORKER_MALLOC = {"MALLOC_TRIM_THRESHOLD_": 128 << 20, "MALLOC_MMAP_THRESHOLD_": 32 << 20}
 

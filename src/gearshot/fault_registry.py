@@ -20,7 +20,7 @@ options    the simulator: which of ``simulate_sa``'s shared fault options (``cen
 The codes are written out, never derived from an order: they are the values every store
 and seed built so far carry (0 ... 3 in the order the types were added), and a new type
 takes the next free code. Bump ``version`` when a type's geometry or physics changes
-(breakage 2: the growth path over the face share, session 5).
+(breakage 2: the growth path over the face share).
 
 This module imports nothing of the simulator (nor numba), so the estimator and the command
 line may import it::

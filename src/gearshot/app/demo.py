@@ -8,6 +8,7 @@ averages over draws), and writes figures plus a Markdown report into a folder.
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -45,7 +46,8 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
     from .._validation import check_int
 
     draws = check_int(draws, "draws", minimum=1, maximum=100)
-    console = console or Console()
+    # off a terminal (a pipe, a file) rich would cut the tables at 80 columns
+    console = console or Console(width=None if sys.stdout.isatty() else 200)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
@@ -60,21 +62,31 @@ def run_demo(out="gearshot-demo", *, seed=0, n_healthy=50, n_faulty=350, duratio
     est = full["estimator"]
     full_pred = predictions[(predictions["variant"] == "full") & (predictions["repeat"] == 0)]
     _print_tables(console, stats, first, full_pred, draws)
+    grades = [int(g) for g in np.unique(database["grade"].values)]
+    grade_note = edge_grade_note(int(est.grade_), grades)
     console.print(f"example: size {full['example_size']:.2f}; chosen grade {est.grade_} "
-                  f"(hidden rig grade {rig.reveal().grade})")
+                  f"(hidden rig grade {rig.reveal().grade}){grade_note}")
+    ablation_note = ablation_spread_note(stats)
+    if ablation_note:
+        console.print(ablation_note)
 
     console.rule("4. figures and report")
     figures = _figures(out, est, stats, full_pred, campaign, rig)
     summary = {
         "speed": SPEED, "load": LOAD, "seed": seed, "draws": draws,
-        "mae": float(stats.loc["full", "mean"]),
-        "mae_std": float(stats.loc["full", "std"]),
-        "ablations": {v: float(r["mean"]) for v, r in stats.iterrows()},
-        "ablations_std": {v: float(r["std"]) for v, r in stats.iterrows()},
+        "mae_unit": "%",
+        "mae": _round(stats.loc["full", "mean"]),
+        "mae_std": _round(stats.loc["full", "std"]),
+        "ablations": {v: _round(r["mean"]) for v, r in stats.iterrows()},
+        "ablations_std": {v: _round(r["std"]) for v, r in stats.iterrows()},
         "grade": int(est.grade_), "rig_grade": int(rig.reveal().grade),
+        "grade_note": grade_note.strip("; ") or None,
+        "ablation_note": ablation_note or None,
         "selected_features": list(est.selected_features_),
-        "feature_errors": est.feature_errors_, "n_neighbors": int(est.n_neighbors_),
-        "seconds": time.perf_counter() - t_start,
+        "feature_errors": {k: _round(v, 4) for k, v in est.feature_errors_.items()}
+        if isinstance(est.feature_errors_, dict) else est.feature_errors_,
+        "n_neighbors": int(est.n_neighbors_),
+        "seconds": round(time.perf_counter() - t_start, 1),
     }
     report = _write_outputs(out, summary, figures, results, full_pred)
     console.print(f"report: {report.resolve()}")
@@ -149,11 +161,55 @@ def _write_outputs(out, summary, figures, results, full_pred):
     from .markdown import write_report
 
     write_json_atomic(summary, out / "results.json", indent=2, sort_keys=False)
-    with atomic_path(out / "ablations.csv") as tmp:
-        results.drop(columns=["estimator"]).to_csv(tmp, index=False)
+    table = results.drop(columns=["estimator"])
+    table.insert(list(table.columns).index("mae"), "mae_percent", 100 * table["mae"])
+    with atomic_path(out / "ablations.csv") as tmp:   # MAE in %, as in the report
+        table.drop(columns=["mae"]).to_csv(tmp, index=False, float_format="%.4g")
     with atomic_path(out / "predictions.csv") as tmp:
-        full_pred.to_csv(tmp, index=False)
+        full_pred.to_csv(tmp, index=False, float_format="%.4g")
     return write_report(out, summary, figures)
+
+
+def _round(value, digits: int = 2):
+    """A float rounded for the outputs (None stays None)."""
+    return None if value is None else round(float(value), digits)
+
+
+def edge_grade_note(grade: int, grades) -> str:
+    """A note when the chosen grade is the first or last of the database's grades: the
+    search stopped at a bound of its range, so the rig's best match may lie beyond it."""
+    lo, hi = min(grades), max(grades)
+    if grade not in (lo, hi) or lo == hi:
+        return ""
+    side = "smoothest" if grade == lo else "roughest"
+    return (f"; grade {grade} is the {side} grade of the database's range {lo}-{hi}, at the "
+            f"edge of the search: the example fits best at a bound, so the closest "
+            f"simulated build may lie outside the range (or no grade fits it well); read "
+            f"the estimates as extrapolated from the edge")
+
+
+def ablation_spread_note(stats) -> str:
+    """A comment for every ablation whose mean MAE is below the full algorithm's, with
+    the spread over the draws: whether the difference is larger than that spread."""
+    if "full" not in stats.index:
+        return ""
+    full_mean, full_std = float(stats.loc["full", "mean"]), float(stats.loc["full", "std"])
+    draws = int(stats.attrs.get("draws", 1))
+    notes = []
+    for variant, row in stats.iterrows():
+        if variant == "full" or float(row["mean"]) >= full_mean:
+            continue
+        diff = full_mean - float(row["mean"])
+        spread = max(full_std, float(row["std"]))
+        verdict = ("within the spread over the draws: no evidence that it is better"
+                   if diff <= spread else
+                   "larger than the spread over the draws: on this rig and condition the "
+                   "ablated step costs accuracy; one rig is one draw of a machine, see the "
+                   "rig family in benchmarks/RESULTS.md for the average over rigs")
+        notes.append(f"note: {variant} ({float(row['mean']):.1f} ± {float(row['std']):.1f} "
+                     f"%) is below the full algorithm ({full_mean:.1f} ± {full_std:.1f} %) "
+                     f"by {diff:.1f} points over {draws} draw(s), {verdict}")
+    return "\n".join(notes)
 
 
 def _mae_stats(results):

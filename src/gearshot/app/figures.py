@@ -11,7 +11,7 @@ import pandas as pd
 from .._errors import GearshotError
 
 __all__ = ["simulated_figures", "rig_figures", "estimator_figures", "report_from_json",
-           "ablation_figure"]
+           "report_from_rows", "ablation_figure"]
 
 
 def _plt():
@@ -148,9 +148,14 @@ def report_from_json(path, out) -> Path:
     rows = pd.DataFrame(rows)
     if not np.issubdtype(rows["mae"].dtype, np.number):
         raise GearshotError(f"{str(path)!r}: its rows' 'mae' values are not numbers")
+    return report_from_rows(rows, out, simulated=payload.get("experiment") == "simulated")
+
+
+def report_from_rows(rows: pd.DataFrame, out, *, simulated: bool) -> Path:
+    """Figures and ``report.md`` (and ``report.html``) from an experiment's rows."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    if payload.get("experiment") == "simulated":
+    if simulated:
         simulated_figures(rows, out)
     else:
         from .markdown import write_report

@@ -305,14 +305,17 @@ _META = ("file", "case", "condition", "sensor", "tacho_speed_hz", "shaft_speed_h
 
 
 def indicator_figures(payload: dict[str, Any], folder: str | Path, *,
-                      title: str = "") -> list[Path]:
+                      title: str = "", labels: dict[str, str] | None = None) -> list[Path]:
     """One figure per indicator (``<name>.png``): value against the tacho-shaft speed, one
-    panel per sensor, one colour per case (the file-name prefix before the first ``_``),
-    one marker per remaining condition; the unit on the axis. Written atomically."""
+    panel per sensor, one colour per label (``labels``: {file name: label}, as
+    ``--labels`` gives them) or, without labels, per case (the file-name prefix before the
+    first ``_``), one marker per remaining condition; the unit on the axis. Written
+    atomically."""
     from matplotlib.figure import Figure
 
-
     table = indicator_table(payload)
+    if labels:
+        table["case"] = [f"label {labels.get(Path(f).name, '?')}" for f in table["file"]]
     units = payload.get("units", {}).get("indicators", {})
     folder = Path(folder)
     cols = [c for c in table.columns if c not in _META]

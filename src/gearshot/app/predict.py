@@ -12,9 +12,11 @@ from .._errors import GearshotError
 from .._validation import check_in_range
 from ..io.input_health import input_check_column, mark_rows, require_ok
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
+from .fit_summary import fit_attrs
 from .trust import add_trust_columns, fit_check_line, trust_summary
 
 __all__ = ["predict_from_files", "predict_recordings", "write_predictions",
+           "predictions_payload", "FIT_KEYS",
            "format_predictions", "comparable_summary", "input_check_summary",
            "trust_summary", "fit_check_line", "add_trust_columns", "summary_table", "ROLES"]
 
@@ -125,6 +127,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = speed, load
     add_trust_columns(frame, est.fit_check_)
+    frame.attrs.update(fit_attrs(est))
     return frame
 
 
@@ -247,6 +250,10 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
                                      cycles_per_segment=cycles_per_segment, sensor=sensor,
                                      holdout=holdout, coverage=coverage, seed=seed,
                                      speed_tolerance=speed_tolerance)
+        frame.attrs["inputs"] = _inputs(database, healthy, faulty, faulty_size, frame,
+                                        machine=machine, speed=frame.attrs.get("speed_hz"),
+                                        seed=seed, coverage=coverage,
+                                        speed_unit="Hz (tacho shaft)")
         return frame, (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, "
                        f"load {frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}")
     if speed is None:
@@ -258,19 +265,75 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
                                speed=speed, load=load, coverage=coverage,
                                gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed,
                                holdout=holdout)
+    frame.attrs["inputs"] = _inputs(database, healthy, faulty, faulty_size, frame,
+                                    machine=None, speed=frame.attrs.get("speed"), seed=seed,
+                                    coverage=coverage, speed_unit="rps (pinion)")
     return frame, (f"database condition: {frame.attrs['speed']:g} rps, load "
                    f"{frame.attrs['load']:g} N m")
 
 
+def _inputs(database, healthy, faulty, faulty_size, frame, *, machine, speed, seed,
+            coverage, speed_unit) -> dict:
+    """The ``inputs`` of a predict JSON (kept in the frame's ``attrs``)."""
+    load = frame.attrs.get("load")
+    return {"database": str(database), "healthy": [str(p) for p in healthy],
+            "faulty": str(faulty), "faulty_size": float(faulty_size),
+            "speed": None if speed is None else float(speed), "speed_unit": speed_unit,
+            "load": None if load is None else float(load),
+            "machine": None if machine is None else str(machine), "seed": int(seed),
+            "coverage": float(coverage)}
+
+
+#: The keys of the fit a predict JSON carries, when the frame's ``attrs`` hold them
+#: (``fit_check``: the frame's fit verdict, when a fit check ran).
+FIT_KEYS = ("grade", "calibration", "simulated_reference", "fit_check", "load_source",
+            "load_choice")
+
+
+def _summary(frame: pd.DataFrame) -> dict:
+    """Counts of a predict table: rows, recordings, rows per role, and per flag column."""
+    summary: dict = {"segments": int(len(frame)),
+                     "recordings": int(frame["recording"].nunique()) if len(frame) else 0}
+    if "role" in frame:
+        summary["segments_by_role"] = {str(k): int(v) for k, v in
+                                       frame["role"].value_counts(sort=False).items()}
+    for flag in ("comparable", "trusted", "below_detection_limit"):
+        if flag in frame:
+            summary[flag] = int(frame[flag].fillna(False).astype(bool).sum())
+    return summary
+
+
+def predictions_payload(frame: pd.DataFrame) -> dict:
+    """The predict JSON: ``kind``, ``gearshot_version``, ``inputs`` (database, healthy
+    files, faulty file, declared size, speed, load, machine, seed, coverage: from
+    ``frame.attrs["inputs"]``), ``fit`` (grade or calibration, simulated reference, fit
+    check: the frame's ``attrs``), ``summary`` (counts) and ``rows`` (one per segment,
+    every column; NaN as null)."""
+    import json
+
+    from .. import __version__
+
+    attrs = frame.attrs
+    fit = {key: attrs[key] for key in FIT_KEYS if key in attrs}
+    return {"kind": "predict", "gearshot_version": __version__,
+            "inputs": dict(attrs.get("inputs") or {}),
+            "fit": json.loads(json.dumps(fit, default=str)),
+            "summary": _summary(frame),
+            "rows": json.loads(frame.to_json(orient="records"))}
+
+
 def write_predictions(frame: pd.DataFrame, out: str | Path) -> Path:
-    """Write a predict table to ``out``: JSON records when it ends in ``.json``, else CSV
-    (through :func:`gearshot._atomic.atomic_path`)."""
+    """Write a predict table to ``out``: by suffix ``.json``, :func:`predictions_payload`
+    (inputs and fit beside the rows); else CSV, one row per segment (through
+    :func:`gearshot._atomic.atomic_path`)."""
+    import json
+
     from .._atomic import atomic_path
 
     out = Path(out)
     with atomic_path(out, make_parents=True) as tmp:
         if out.suffix.lower() == ".json":
-            tmp.write_text(frame.to_json(orient="records", indent=2))
+            tmp.write_text(json.dumps(predictions_payload(frame), indent=2))
         else:
             frame.to_csv(tmp, index=False)
     return out

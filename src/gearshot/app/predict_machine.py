@@ -193,8 +193,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
             example_record=seg.holdout_sas("faulty_rest"))
     frame = _estimates(est, seg, cond, coverage)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs["grade"] = getattr(est, "grade_", None)
-    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
+    from .fit_summary import fit_attrs
+
+    frame.attrs.update(fit_attrs(est))
     return frame
 
 

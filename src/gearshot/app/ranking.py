@@ -23,7 +23,17 @@ import pandas as pd
 from .._errors import GearshotError
 
 __all__ = ["read_labels", "indicator_ranking", "format_ranking", "ranking_figure",
-           "HEALTHY_LABELS"]
+           "HEALTHY_LABELS", "RANKING_NOTE"]
+
+#: What the ranking's columns mean and how far its AUCs can be trusted (printed with it
+#: and written in its report).
+RANKING_NOTE = (
+    "separation = |2 AUC - 1|: the overall AUC folded onto [0, 1] (0: the indicator does no "
+    "better than chance; 1: one threshold separates healthy from faulty records, whichever "
+    "way the indicator moves). An AUC from few records is weak evidence: with n_healthy "
+    "and n_faulty records in a cell there are only n_healthy x n_faulty comparisons, and "
+    "with one faulty record per cell an AUC of 1.00 means only that this one record lies "
+    "beyond every healthy one; the columns n_healthy and n_faulty give the counts.")
 
 #: Labels of the healthy class (compared without case)
 HEALTHY_LABELS = ("0", "healthy", "good")
@@ -118,15 +128,26 @@ def indicator_ranking(payload: dict[str, Any], labels: pd.DataFrame) -> pd.DataF
             row["n_healthy"], row["n_faulty"] = int((~y).sum()), int(y.sum())
             rows.append(row)
     out = pd.DataFrame(rows)
-    return out.sort_values(["separation", "indicator"], ascending=[False, True],
-                           kind="stable", ignore_index=True)
+    out = out.sort_values(["separation", "indicator"], ascending=[False, True],
+                          kind="stable", ignore_index=True)
+    first = merged[merged["sensor"] == merged["sensor"].iloc[0]]
+    out.attrs["cells"] = {cell: (int((~part["faulty"]).sum()), int(part["faulty"].sum()))
+                          for cell, part in first.groupby("cell", sort=True)}
+    return out
 
 
 def format_ranking(ranking: pd.DataFrame) -> str:
     """The ranking as printed by ``gearshot indicators --labels``."""
     head = ("indicator ranking: AUC of healthy vs faulty records (1 or 0: a threshold "
             "separates them; 0.5: chance), per cell and overall")
-    return head + "\n" + ranking.to_string(index=False, float_format=lambda v: f"{v:.2f}")
+    lines = [head, ranking.to_string(index=False, float_format=lambda v: f"{v:.2f}",
+                                     line_width=None)]
+    cells = ranking.attrs.get("cells")
+    if cells:
+        lines.append("records per cell (healthy/faulty): " + ", ".join(
+            f"{cell} {h}/{f}" for cell, (h, f) in cells.items()))
+    lines.append(RANKING_NOTE)
+    return "\n".join(lines)
 
 
 def ranking_figure(ranking: pd.DataFrame, path: str | Path, *, title: str = "") -> Path:

@@ -1,19 +1,44 @@
-"""Markdown report gathering an experiment's tables and figures."""
+"""``gearshot report``: figures, ``report.md`` and a self-contained ``report.html`` from
+any output gearshot writes.
+
+One kind of output = one entry of :data:`KINDS`: a check against its declared schema
+(:mod:`gearshot.app.report_schema`) and one small function that writes its report. A new
+kind adds a detection line in :func:`json_kind` and one entry.
+"""
 
 from __future__ import annotations
 
+import json
+import math
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
-from .._atomic import write_text_atomic
+from .._errors import GearshotError
+from . import report_schema as schema
+from . import report_tables
 from .markdown import md_table as _md_table
-from .markdown import write_report
+from .markdown import write_markdown, write_report
 
-__all__ = ["write_report", "json_kind", "report_from_any_json"]
+__all__ = ["write_report", "json_kind", "report_from_any_json", "read_output", "KINDS",
+           "predict_rows"]
+
+KINDS_TEXT = ("predict --out X.csv or X.json, demo results.json, ablations.csv or "
+              "predictions.csv, experiment simulated/rig --json, experiment rig-family "
+              "--json, indicators --json or its ranking.csv")
+#: The kinds a JSON declares (``kind`` or ``experiment``); the others are CSV tables.
+JSON_KINDS = ("predict", "demo", "simulated", "rig", "rig-family", "indicators")
+#: The deepest nesting of lists and objects an output may have (gearshot writes at most 5).
+MAX_DEPTH = 16
+#: The largest output file ``report`` reads (bytes).
+MAX_BYTES = 512 * 1024 * 1024
 
 
-def json_kind(payload) -> str | None:
-    """Which gearshot JSON ``payload`` is: ``"demo"``, ``"simulated"``, ``"rig"``,
-    ``"rig-family"``, ``"predict"``, ``"indicators"``, or None."""
+def json_kind(payload: Any) -> str | None:
+    """Which gearshot output ``payload`` is: ``"demo"``, ``"simulated"``, ``"rig"``,
+    ``"rig-family"``, ``"predict"``, ``"indicators"``, or None. A declared ``kind`` (or
+    ``experiment``) wins; the older predict JSON (a bare list of rows) is recognised by
+    its rows' keys."""
     if isinstance(payload, list):
         if payload and all(isinstance(r, dict) and {"recording", "predicted"} <= set(r)
                            for r in payload):
@@ -21,61 +46,189 @@ def json_kind(payload) -> str | None:
         return None
     if not isinstance(payload, dict):
         return None
-    if payload.get("experiment") in ("simulated", "rig") and isinstance(payload.get("rows"),
-                                                                       list):
-        return str(payload["experiment"])
-    if payload.get("experiment") == "rig-family" and isinstance(payload.get("tables"), dict):
-        return "rig-family"
-    if payload.get("kind") == "indicators" or (
-            isinstance(payload.get("records"), list) and payload["records"]
-            and all(isinstance(r, dict) and "indicators" in r for r in payload["records"])):
+    declared = payload.get("kind", payload.get("experiment"))
+    if isinstance(declared, str) and declared in JSON_KINDS:
+        return str(declared)
+    if isinstance(payload.get("records"), list) and payload["records"] and all(
+            isinstance(r, dict) and "indicators" in r for r in payload["records"]):
         return "indicators"
     if "ablations" in payload and "mae" in payload:
         return "demo"
     return None
 
 
-KINDS_TEXT = ("demo results.json, experiment simulated/rig --json, experiment rig-family "
-              "--json, predict --out X.json, indicators --json")
+def predict_rows(payload: Any) -> list:
+    """The rows of a predict output: the bare list (older JSON) or its ``rows``."""
+    return payload if isinstance(payload, list) else payload.get("rows")
 
 
-def report_from_any_json(path, out) -> Path:
-    """``gearshot report``: figures and ``report.md`` from any JSON gearshot writes.
+def _load_json(path: Path) -> Any:
+    """The JSON of ``path``; a non-finite number (``Infinity``, ``1e400``) or a nesting
+    too deep for Python is refused in one line. ``NaN`` (as gearshot writes a missing
+    value) reads as NaN and is refused later where the schema wants a number."""
+
+    def finite(text: str) -> float:
+        value = float(text)
+        if not math.isfinite(value):
+            raise GearshotError(f"{str(path)!r}: the number {text[:30]} is out of float "
+                                f"range (gearshot writes only finite numbers)")
+        return value
+
+    def constant(name: str) -> float:
+        if name == "NaN":
+            return math.nan
+        raise GearshotError(f"{str(path)!r}: {name} is not a number gearshot writes")
+
+    try:
+        text = path.read_text(encoding="utf-8")
+        payload = json.loads(text, parse_float=finite, parse_constant=constant)
+    except RecursionError:
+        raise GearshotError(f"{str(path)!r}: its JSON is nested too deep to be an output "
+                            f"of gearshot") from None
+    except (UnicodeDecodeError, ValueError) as exc:
+        if isinstance(exc, GearshotError):
+            raise
+        raise GearshotError(f"{str(path)!r} is not a JSON file ({type(exc).__name__}: "
+                            f"{str(exc).splitlines()[0][:80]})") from None
+    if _depth(payload) > MAX_DEPTH:
+        raise GearshotError(f"{str(path)!r}: its JSON is nested deeper than {MAX_DEPTH} "
+                            f"levels; no output of gearshot is")
+    return payload
+
+
+def _depth(value: Any) -> int:
+    """How deeply lists and objects nest in a parsed JSON value (iteratively)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        item, level = stack.pop()
+        if isinstance(item, (list, dict)):
+            deepest = max(deepest, level)
+            stack.extend((v, level + 1) for v in (item.values() if isinstance(item, dict)
+                                                  else item))
+    return deepest
+
+
+def _load_csv(path: Path) -> tuple[str, Any]:
+    """A CSV gearshot writes: predict's table (one row per segment) or the demo's
+    ``ablations.csv`` (one row per variant and draw)."""
+    import pandas as pd
+
+    try:
+        frame = pd.read_csv(path)
+    except (UnicodeDecodeError, ValueError) as exc:   # pandas' parser errors included
+        raise GearshotError(f"{str(path)!r} is not a CSV table ({type(exc).__name__}: "
+                            f"{str(exc).splitlines()[0][:80] if str(exc) else ''})") from None
+    rows = frame.to_dict(orient="records")
+    cols = set(frame.columns)
+    if {"recording", "predicted"} <= cols:
+        return "predict", rows
+    if {"variant", "mae_percent"} <= cols and "mae" not in cols:   # the demo's, in %
+        rows = [{**r, "mae": r["mae_percent"] / 100
+                 if isinstance(r["mae_percent"], (int, float)) else r["mae_percent"]}
+                for r in rows]
+        return "rig", {"experiment": "rig", "rows": rows}
+    if {"variant", "mae"} <= cols:
+        return "rig", {"experiment": "rig", "rows": rows}
+    if {"sensor", "indicator", "auc_overall"} <= cols:
+        return "ranking", {"rows": rows}
+    if {"true", "predicted"} <= cols:
+        return "sizes", {"rows": rows}
+    raise GearshotError(f"{str(path)!r} is not a CSV gearshot writes (predict's table: "
+                        f"recording, predicted, low, high ...; the demo's ablations.csv or "
+                        f"predictions.csv; indicators' ranking.csv); its columns are "
+                        f"{sorted(map(str, cols))[:8]}")
+
+
+def read_output(path) -> tuple[str, Any]:
+    """Read and check one gearshot output: ``(kind, payload)``.
 
     Raises
     ------
     GearshotError
-        One line naming the file when it is not such a JSON.
+        One line naming the file: not readable, not an output gearshot writes, or a field
+        outside its declared schema (:mod:`gearshot.app.report_schema`).
     """
-    import json
+    path = Path(path)
+    if not path.is_file():
+        raise GearshotError(f"results file {str(path)!r} does not exist")
+    if path.stat().st_size > MAX_BYTES:
+        raise GearshotError(f"{str(path)!r} is {path.stat().st_size} bytes; gearshot's "
+                            f"outputs are below {MAX_BYTES}")
+    if path.suffix.lower() == ".csv":
+        kind, payload = _load_csv(path)
+    else:
+        payload = _load_json(path)
+        kind = json_kind(payload)  # type: ignore[assignment]
+        if kind is None:
+            raise GearshotError(f"{str(path)!r} is not an output that gearshot writes (one "
+                                f"of: {KINDS_TEXT})")
+    KINDS[kind][0](payload, repr(str(path)))
+    return kind, payload
 
-    from .._errors import GearshotError
 
+def report_from_any_json(path, out) -> Path:
+    """``gearshot report``: figures, ``report.md`` and ``report.html`` from any output
+    gearshot writes (JSON or CSV); returns the Markdown's path.
+
+    Raises
+    ------
+    GearshotError
+        One line naming the file when it is not such an output or breaks its schema.
+    """
     path, out = Path(path), Path(out)
-    try:
-        payload = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise GearshotError(f"{str(path)!r} is not a JSON file ({type(exc).__name__}: "
-                            f"{str(exc).splitlines()[0][:80]})") from None
-    kind = json_kind(payload)
-    if kind is None:
-        raise GearshotError(f"{str(path)!r} is not a JSON that gearshot writes (one of: "
-                            f"{KINDS_TEXT})")
+    kind, payload = read_output(path)
     out.mkdir(parents=True, exist_ok=True)
-    if kind in ("simulated", "rig"):
-        from .figures import report_from_json
-
-        return report_from_json(path, out)
-    if kind == "demo":
-        return _demo_report(payload, out)
-    if kind == "rig-family":
-        return _family_report(payload, out)
-    if kind == "predict":
-        return _predict_report(payload, out, source=path)
-    return _indicators_report(payload, out, source=path)
+    return KINDS[kind][1](payload, out, path)
 
 
-def _demo_report(payload, out: Path) -> Path:
+# --- checks, one per kind ------------------------------------------------------------
+
+def _check_predict(payload: Any, where: str) -> None:
+    schema.check_predict_rows(predict_rows(payload), where)
+    if isinstance(payload, dict):
+        for key in ("inputs", "fit", "summary"):
+            if not isinstance(payload.get(key, {}), dict):
+                raise GearshotError(f"{where}: {key} must be an object; got "
+                                    f"{type(payload[key]).__name__}")
+
+
+def _check_experiment(payload: Any, where: str) -> None:
+    row = schema.SIMULATED_ROW if payload.get("experiment") == "simulated" else \
+        schema.EXPERIMENT_ROW
+    schema.check_rows(payload.get("rows"), row, where)
+
+
+def _check_demo(payload: Any, where: str) -> None:
+    schema.check_fields(payload, schema.DEMO, where, "")
+    for key in ("ablations", "ablations_std"):
+        for name, value in (payload.get(key) or {}).items():
+            if value is None or not 0 <= value <= 100:
+                raise GearshotError(f"{where}: {key}.{name} must be an MAE in % in "
+                                    f"[0, 100]; got {value!r}")
+            schema.check_name(name, where, f"{key} key")
+
+
+def _check_family(payload: Any, where: str) -> None:
+    schema.check_fields(payload, schema.FAMILY, where, "")
+    schema.check_family_tables(payload.get("tables"), where)
+
+
+def _check_indicators(payload: Any, where: str) -> None:
+    schema.check_indicators(payload, where)
+
+
+# --- reports, one per kind -------------------------------------------------------------
+
+def _experiment_report(payload, out: Path, source: Path) -> Path:
+    import pandas as pd
+
+    from .figures import report_from_rows
+
+    return report_from_rows(pd.DataFrame(payload["rows"]), out,
+                            simulated=payload.get("experiment") == "simulated")
+
+
+def _demo_report(payload, out: Path, source: Path) -> Path:
     from .figures import ablation_figure
 
     figs = {"Mean MAE of the ablations over the example draws (bars: ± 1 std), Fig. 14b":
@@ -86,39 +239,35 @@ def _demo_report(payload, out: Path) -> Path:
     return write_report(out, payload, figs)
 
 
-def _family_report(payload, out: Path) -> Path:
+def _family_report(payload, out: Path, source: Path) -> Path:
     import pandas as pd
 
     lines = ["# gearshot report: rig family", "",
-             f"Range {payload.get('range')}, {len(payload.get('seeds', []))} rigs x "
+             f"Range {payload.get('range')}, {len(payload.get('seeds') or [])} rigs x "
              f"{payload.get('draws')} draws; parameters {payload.get('params') or 'defaults'}.",
              "MAE and coverage in %.", ""]
-    tables = {name: pd.DataFrame(split.get("data", []), columns=split.get("columns"),
-                                 index=split.get("index"))
+    tables = {name: pd.DataFrame(split["data"], columns=split["columns"],
+                                 index=split["index"]).astype(float)
               for name, split in payload["tables"].items()}
     for name, frame in tables.items():
         lines += [f"## {name}", ""] + _md_table(frame.reset_index(names=""), "{:.1f}")
     cond = tables.get("condition")
-    if cond is not None and len(cond.columns):
+    if cond is not None and len(cond.columns) and len(cond):
         from .figures import ablation_figure
 
         col = "mean" if "mean" in cond else cond.columns[0]
         fig = ablation_figure({str(k): float(v) / 100 for k, v in cond[col].items()}, out,
                               name="family_mae")
         lines += ["## MAE by variant over the rigs", "", f"![MAE by variant]({fig.name})", ""]
-    target = out / "report.md"
-    write_text_atomic(target, "\n".join(lines), make_parents=True)
-    return target
+    return write_markdown(out, lines)
 
 
-def _predict_report(rows, out: Path, *, source: Path) -> Path:
+def _predict_report(payload, out: Path, source: Path) -> Path:
     import pandas as pd
 
     from .predict import summary_table
 
-    frame = pd.DataFrame(rows)
-    if "low" not in frame:
-        frame["low"] = frame["high"] = frame["predicted"]
+    frame = pd.DataFrame(predict_rows(payload))
     table = summary_table(frame)
     figs = {"Estimated size per segment and its interval, by recording":
             _predict_figure(frame, out / "estimates.png")}
@@ -126,6 +275,8 @@ def _predict_report(rows, out: Path, *, source: Path) -> Path:
              f"{len(frame)} SA segments of {frame['recording'].nunique()} recording(s). "
              "Role: what a segment was to the fit (healthy_fitted and example were fitted "
              "on; healthy_holdout, faulty_rest and test were not).", ""]
+    if isinstance(payload, dict):
+        lines += _predict_header(payload)
     if "fit_check" in frame and len(frame):
         lines += [f"Fit check: {frame['fit_check'].iloc[0]}.", ""]
     if "comparable" in frame:
@@ -138,9 +289,33 @@ def _predict_report(rows, out: Path, *, source: Path) -> Path:
     lines += _md_table(table)
     for caption, fig in figs.items():
         lines += [f"## {caption}", "", f"![{caption}]({fig.name})", ""]
-    target = out / "report.md"
-    write_text_atomic(target, "\n".join(lines), make_parents=True)
-    return target
+    return write_markdown(out, lines)
+
+
+def _predict_header(payload: dict) -> list[str]:
+    """The inputs and the fit of a predict JSON, as bullet lists."""
+    lines = []
+    if payload.get("gearshot_version"):
+        lines += [f"Written by gearshot {payload['gearshot_version']}.", ""]
+    for key, title in (("inputs", "Inputs"), ("fit", "Fit")):
+        part = payload.get(key) or {}
+        if part:
+            lines += [f"## {title}", ""]
+            lines += [f"* {name.replace('_', ' ')}: {_short(value)}"
+                      for name, value in part.items()]
+            lines.append("")
+    return lines
+
+
+def _short(value: Any) -> str:
+    if isinstance(value, list) and len(value) > 4:
+        return f"{', '.join(map(str, value[:4]))} and {len(value) - 4} more"
+    if isinstance(value, list):
+        return ", ".join(map(str, value)) or "none"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    text = str(value)
+    return text if len(text) <= 200 else text[:197] + "..."
 
 
 def _predict_figure(frame, path: Path) -> Path:
@@ -152,7 +327,7 @@ def _predict_figure(frame, path: Path) -> Path:
     from .._atomic import atomic_path
 
     names = list(dict.fromkeys(frame["recording"]))
-    fig = Figure(figsize=(7, 1.4 + 0.35 * len(names)), layout="constrained")
+    fig = Figure(figsize=(7, 1.4 + 0.35 * min(len(names), 60)), layout="constrained")
     ax = fig.subplots()
     roles = list(dict.fromkeys(frame["role"])) if "role" in frame else [None]
     trusted = frame["trusted"].astype(bool) if "trusted" in frame else None
@@ -162,7 +337,7 @@ def _predict_figure(frame, path: Path) -> Path:
         y = np.array([names.index(r) + 0.12 * (k - (len(roles) - 1) / 2)
                       for r in part["recording"]])
         ok = np.ones(len(part), bool) if trusted is None else trusted[part.index].to_numpy()
-        for keep, style in ((ok, dict(fmt="o", color=f"C{k}", label=role)),
+        for keep, style in ((ok, dict(fmt="o", color=f"C{k % 10}", label=role)),
                             (~ok, dict(fmt="o", color="0.6", mfc="none",
                                        label=untrusted_label))):
             if not keep.any():
@@ -173,7 +348,8 @@ def _predict_figure(frame, path: Path) -> Path:
                         ms=3, lw=0.6, **style)
             if style["label"] == untrusted_label:
                 untrusted_label = "_nolegend_"  # one legend entry for every untrusted role
-    ax.set_yticks(range(len(names)), [Path(n).name for n in names], fontsize=7)
+    if len(names) <= 60:
+        ax.set_yticks(range(len(names)), [Path(n).name for n in names], fontsize=7)
     ax.set_xlim(-0.02, 1.02)
     ax.set_xlabel("estimated fault size y (0 healthy ... 1), bars: prediction interval")
     if roles != [None] or trusted is not None:
@@ -183,7 +359,7 @@ def _predict_figure(frame, path: Path) -> Path:
     return path
 
 
-def _indicators_report(payload, out: Path, *, source: Path) -> Path:
+def _indicators_report(payload, out: Path, source: Path) -> Path:
     from .indicators import indicator_figures, indicator_table
 
     table = indicator_table(payload).drop(columns=["case", "condition"])
@@ -197,10 +373,32 @@ def _indicators_report(payload, out: Path, *, source: Path) -> Path:
     if payload.get("ranking"):
         import pandas as pd
 
-        lines += ["## Indicator ranking (AUC, healthy vs faulty)", ""]
+        from .ranking import RANKING_NOTE
+
+        lines += ["## Indicator ranking (AUC, healthy vs faulty)", "", RANKING_NOTE, ""]
+        cells = payload.get("ranking_cells")
+        if isinstance(cells, dict) and cells:
+            lines += ["Records per cell (healthy/faulty): " + ", ".join(
+                f"{cell} {_short(c.get('healthy') if isinstance(c, dict) else c)}/"
+                f"{_short(c.get('faulty') if isinstance(c, dict) else c)}"
+                for cell, c in cells.items()) + ".", ""]
         lines += _md_table(pd.DataFrame(payload["ranking"]), "{:.2f}")
     for p in paths:
         lines += [f"## {p.stem}", "", f"![{p.stem}]({p.name})", ""]
-    target = out / "report.md"
-    write_text_atomic(target, "\n".join(lines), make_parents=True)
-    return target
+    return write_markdown(out, lines)
+
+
+Check = Callable[[Any, str], None]
+Render = Callable[[Any, Path, Path], Path]
+
+#: Every kind ``report`` reads: its schema check and its report writer.
+KINDS: dict[str, tuple[Check, Render]] = {
+    "predict": (_check_predict, _predict_report),
+    "demo": (_check_demo, _demo_report),
+    "simulated": (_check_experiment, _experiment_report),
+    "rig": (_check_experiment, _experiment_report),
+    "rig-family": (_check_family, _family_report),
+    "indicators": (_check_indicators, _indicators_report),
+    "ranking": (report_tables.check_ranking, report_tables.ranking_report),
+    "sizes": (report_tables.check_sizes, report_tables.sizes_report),
+}

@@ -12,7 +12,8 @@ from pathlib import Path
 
 from .._cluster import IN_PROCESS_BLOCKS, dask_client
 
-__all__ = ["default_store", "simulate_database", "simulate_machine_database"]
+__all__ = ["default_store", "simulate_database", "simulate_machine_database",
+           "repair_store"]
 
 
 def default_store() -> Path:
@@ -37,6 +38,27 @@ def simulate_database(store: Path, *, speeds: Sequence[float], loads: Sequence[f
         build_database(store, GearPair.paper(), speeds=speeds, loads=loads, grades=grades,
                        n_healthy=n_healthy, n_faulty=n_faulty, seed=seed, client=client,
                        fault_types=list(fault_types), paired=paired)
+    return store
+
+
+def repair_store(store: Path | None, others: Sequence[str], *, scheduler: str | None = None,
+                 workers: int = 2, echo=print) -> Path:
+    """``gearshot simulate --repair --store S``: :func:`gearshot.sim.repair_database` on
+    ``S`` (the store's own build arguments, read from its blocks); ``others``: the other
+    build options given, refused (the repair takes its arguments from the store)."""
+    from .._errors import GearshotError
+    from ..sim import repair_database
+
+    if store is None:
+        raise GearshotError("--repair needs --store: the store to repair")
+    if others:
+        raise GearshotError(f"--repair takes the build's arguments from the store; do not "
+                            f"give {', '.join(others)} with it")
+    with dask_client(scheduler, workers, needed=False) as client:
+        done = repair_database(store, client=client)
+    echo(f"repaired: {'; '.join(done)}" if done else "nothing to repair: manifest and "
+         "blocks whole")
+    echo(f"database ready: {store}")
     return store
 
 
@@ -75,8 +97,10 @@ def simulate_machine_database(machine_file: Path, store: Path | None, *,
                        fault_types=list(fault_types), paired=paired)
     mate_shaft, _ = mach.mate()
     ref_kind = "tacho" if mach.tacho is not None else "reference"
-    line = (f"pair {pair.z_pinion} -> {pair.z_gear} teeth (fault on the {pair.z_gear}-tooth "
-            f"gear, its mate on the {mate_shaft} shaft); conditions: {mach.reference_shaft} "
+    shaft = mach.monitored.shaft if mach.monitored is not None else "monitored"
+    line = (f"monitored gear {pair.z_gear} teeth on the {shaft} shaft (the "
+            f"fault's gear) meshing with {pair.z_pinion} teeth on the {mate_shaft} shaft; "
+            f"conditions: {mach.reference_shaft} "
             f"({ref_kind}) shaft {', '.join(f'{s:g}' for s in speeds)} Hz x load "
             f"{', '.join(f'{x:g}' for x in loads)} N m")
     return store, line

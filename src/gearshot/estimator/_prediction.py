@@ -132,8 +132,9 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         pandas.DataFrame
             One row per SA: ``predicted, low, high`` (:meth:`predict`,
             :meth:`predict_interval`), ``comparability, comparable``
-            (:meth:`comparability`: its p-value and verdict), ``input_check``, ``fit_check`` (the fit's verdict,
-            ``fit_check_.verdict``: "passed" or the reason) and ``trusted``: the input
+            (:meth:`comparability`: its p-value and verdict), ``input_check``,
+            ``fit_check`` (the fit's verdict, ``fit_check_.verdict``: "passed" or the
+            reason) and ``trusted``: the input
             check is "ok", the segment is comparable and the fit check passed.
         """
         import pandas as pd

@@ -35,9 +35,9 @@ __all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEED
 PAPER_CONDITIONS = RIG_CONDITIONS
 DEV_SEEDS = range(100, 124)
 #: The held-out range of issue #19 (fresh: never run before the decision of
-#: ``benchmarks/results/family_decision_session6.md`` was committed).
+#: ``benchmarks/results/family_configuration_grade_calibration.md`` was committed).
 HELDOUT_SEEDS = range(9500, 9524)
-#: Issue #12's held-out range, evaluated twice in session 5: spent, kept for reproduction.
+#: Issue #12's held-out range, evaluated twice: spent, kept for reproduction.
 SPENT_HELDOUT_SEEDS = range(9000, 9024)
 #: the seed ranges by name (``--range`` of the benchmark and of the CLI)
 RANGES = {"dev": DEV_SEEDS, "heldout": HELDOUT_SEEDS, "spent": SPENT_HELDOUT_SEEDS}

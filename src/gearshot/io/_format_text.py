@@ -21,7 +21,6 @@ import numpy as np
 
 from .._errors import GearshotError
 from ._fileio import TIME_NAMES, RawFile, read_sidecar, time_column_fs
-from ._fixed_width import read_fixed_width
 
 __all__ = ["read_text", "TEXT_SUFFIXES", "read_text_bytes"]
 
@@ -142,12 +141,6 @@ def read_text(path: Path, *, delimiter: str | None | EllipsisType = ..., header:
     """
     path = Path(path)
     data = read_text_bytes(path)
-    table = None
-    if skip_rows == 0 and header is not True and delimiter in (..., None):
-        table = read_fixed_width(data)  # the PHM09 layout: no tokenizing, exact
-    if table is not None:
-        return _raw_file(path, [str(i) for i in range(table.shape[1])],
-                         [table[:, i] for i in range(table.shape[1])], columns, header=False)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:

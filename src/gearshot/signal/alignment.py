@@ -5,12 +5,12 @@ from __future__ import annotations
 from typing import Literal, cast, overload
 
 import numpy as np
+import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
 from .._typing import ComplexArray, FloatArray, IntArray
 from .._validation import as_signal_array, check_int, describe, finite_result
-from . import _fft
 from ._lag_search import _LagSearch, contenders, roots
 
 __all__ = ["fractional_shift", "subtract_with_lags", "subtract_healthy"]
@@ -77,8 +77,8 @@ def fractional_shift(x: ArrayLike, delay: ArrayLike) -> FloatArray:
         raise GearshotError(f"delay of shape {tau.shape} does not broadcast to the batch "
                             f"shape {x.shape[:-1]} of x (shape {x.shape})")
     n = x.shape[-1]
-    spectrum = _fft.fft(x, axis=-1) * _shift_factors(n, -tau)
-    return _fft.ifft(spectrum, axis=-1).real
+    spectrum = scipy.fft.fft(x, axis=-1) * _shift_factors(n, -tau)
+    return cast(FloatArray, scipy.fft.ifft(spectrum, axis=-1).real)
 
 
 def _grid_shift_factors(n: int, steps: IntArray, upsample: int) -> ComplexArray:
@@ -192,8 +192,8 @@ def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
     (:func:`~gearshot.signal._lag_search.contenders`) are not searched: their lag is −1
     (the residual, reference and delay are the same)."""
     n = flat.shape[-1]
-    spec_x = _fft.fft(flat, axis=-1)
-    spec_r = _fft.fft(refs, axis=-1)
+    spec_x = scipy.fft.fft(flat, axis=-1)
+    spec_r = scipy.fft.fft(refs, axis=-1)
     search = _LagSearch(n, upsample) if lags is None else None
 
     residual = np.empty_like(flat)
@@ -297,4 +297,4 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch |
     rows = np.arange(len(sx))
     pair = np.cumsum(keep.ravel()).reshape(keep.shape)[rows, best] - 1
     back = res_spec[pair] * np.conj(advance[pair])
-    return _fft.ifft(back, axis=-1).real, best, steps[rows, best] / upsample, steps
+    return scipy.fft.ifft(back, axis=-1).real, best, steps[rows, best] / upsample, steps

@@ -7,6 +7,8 @@ from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.interpolate import CubicSpline, PchipInterpolator
+from scipy.ndimage import map_coordinates, spline_filter1d
 
 from .._errors import GearshotError
 from .._typing import FloatArray
@@ -20,7 +22,6 @@ from .._validation import (
     describe,
     finite_result,
 )
-from ._splines import NotAKnotSpline, bspline_read
 from .antialias import bandlimited_resynthesis, min_shaft_rate
 
 __all__ = ["pulse_times", "angular_resample", "angle_to_time"]
@@ -110,7 +111,7 @@ def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
 
     The time-of-angle curve through the pulses (pulse ``k`` at ``k / pulses_per_rev``
     revolutions from the first) is a cubic spline (not-a-knot ends, as
-    :class:`scipy.interpolate.CubicSpline`, computed in NumPy), so speed varies smoothly
+    :class:`scipy.interpolate.CubicSpline`), so speed varies smoothly
     rather than piecewise-constantly; where a spline would not be monotone (extreme speed
     jumps) or with fewer than 4 pulses a monotone PCHIP is used instead.
 
@@ -149,14 +150,12 @@ def angle_to_time(pulse_times: ArrayLike, angles: ArrayLike, *,
             f"({pulses.size} pulses at pulses_per_rev={ppr}); got {first!r} "
             f"({int(outside.sum())} value(s) outside)")
     curve: Callable[[FloatArray], FloatArray] | None = None
-    if pulses.size >= 4:  # not-a-knot cubic spline, as scipy.interpolate.CubicSpline
-        spline = NotAKnotSpline(revs, pulses)
+    if pulses.size >= 4:  # not-a-knot cubic spline
+        spline = CubicSpline(revs, pulses)
         if not (np.any(spline(revs[:-1] + 0.5 / ppr, 1) <= 0)
                 or np.any(spline(revs, 1) <= 0)):
             curve = spline
     if curve is None:  # too few pulses, or the spline turns back: monotone PCHIP
-        from scipy.interpolate import PchipInterpolator
-
         curve = PchipInterpolator(revs, pulses)
     return cast(FloatArray, curve(np.clip(revs_at, 0.0, span)))
 
@@ -234,7 +233,7 @@ def angular_resample(x: ArrayLike, fs: float, pulse_times: ArrayLike, *, samples
         x_fine, position = _bandlimited_fine(x, fs, pulses, times, spr=spr, ppr=ppr,
                                              upsample=upsample, passband=passband)
     else:
-        import scipy.signal  # imported here: a 0.5-1 s import the default path never needs
+        import scipy.signal
 
         x_fine = scipy.signal.resample_poly(x, upsample, 1, axis=-1) if upsample > 1 else x
         position = times * fs * upsample  # fractional sample index in x_fine
@@ -278,10 +277,13 @@ def _bandlimited_fine(x: FloatArray, fs: float, pulses: FloatArray, times: Float
 
 
 def _spline_read(x_fine: FloatArray, position: FloatArray) -> FloatArray:
-    """Cubic-spline values of each signal (last axis) at fractional sample ``position``;
-    shape (n_signals, position.size)."""
+    """Cubic B-spline values of each signal (last axis, mirror boundaries) at fractional
+    sample ``position`` (:func:`scipy.ndimage.map_coordinates` on the coefficients of
+    :func:`scipy.ndimage.spline_filter1d`); shape (n_signals, position.size)."""
     flat = x_fine.reshape(-1, x_fine.shape[-1])
+    coeffs = spline_filter1d(flat, order=3, axis=-1, mode="mirror")
     out = np.empty((flat.shape[0], position.size))
-    for i, row in enumerate(flat):
-        out[i] = bspline_read(row, position)
+    where = position[None]
+    for i, row in enumerate(coeffs):
+        out[i] = map_coordinates(row, where, order=3, mode="mirror", prefilter=False)
     return out

@@ -14,6 +14,7 @@ import math
 from typing import cast
 
 import numpy as np
+import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
@@ -27,7 +28,6 @@ from .._validation import (
     check_positive,
     finite_result,
 )
-from . import _fft
 
 __all__ = ["antialias_filter", "bandlimited_resynthesis", "min_shaft_rate"]
 
@@ -63,7 +63,7 @@ def _lowpass_spectrum(x: FloatArray, fs: float, cutoff: float,
     pad = min(n - 1, int(math.ceil(6.0 * fs / width)))
     widths = [(0, 0)] * (x.ndim - 1) + [(pad, pad)]
     xp = np.pad(x, widths, mode="reflect", reflect_type="odd")
-    n_fft = _fft.next_fast_len(xp.shape[-1])
+    n_fft = scipy.fft.next_fast_len(xp.shape[-1], real=True)
     spec: ComplexArray = np.fft.rfft(xp, n=n_fft, axis=-1)
     f = np.arange(spec.shape[-1]) * (fs / n_fft)
     gain = np.ones(f.size)
@@ -117,7 +117,7 @@ def bandlimited_resynthesis(x: ArrayLike, fs: float, *, cutoff: float, passband:
     passband = check_in_range(passband, "passband", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
     spec, n_fft, pad = _lowpass_spectrum(x, fs, min(cutoff, fs / 2), passband)
-    n_out = _fft.next_fast_len(int(math.ceil(n_fft * rate / fs)))
+    n_out = scipy.fft.next_fast_len(int(math.ceil(n_fft * rate / fs)), real=True)
     n_out += n_out % 2
     half = n_out // 2 + 1
     if half <= spec.shape[-1]:

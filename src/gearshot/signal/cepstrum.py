@@ -5,12 +5,12 @@ from __future__ import annotations
 from typing import cast
 
 import numpy as np
+import scipy.fft
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
 from .._typing import ComplexArray, FloatArray
 from .._validation import as_signal_array, finite_result
-from . import _fft
 
 __all__ = ["real_cepstrum", "minimum_phase"]
 
@@ -32,7 +32,7 @@ def real_cepstrum(magnitude: ArrayLike) -> FloatArray:
     [ 0.      0.25   -0.0625  0.0208]
     """
     checked = _checked_magnitude(magnitude)
-    return _fft.ifft(np.log(checked), axis=-1).real
+    return cast(FloatArray, scipy.fft.ifft(np.log(checked), axis=-1).real)
 
 
 def _checked_magnitude(magnitude: ArrayLike) -> FloatArray:
@@ -78,8 +78,8 @@ def minimum_phase(magnitude: ArrayLike) -> ComplexArray:
     """
     checked = _checked_magnitude(magnitude)
     length = checked.shape[-1]
-    cep = _fft.ifft(np.log(checked), axis=-1)
+    cep = scipy.fft.ifft(np.log(checked), axis=-1)
     fold = np.zeros(length)
     fold[0] = 1.0
     fold[1:int(np.ceil((length - 1) / 2))] = 2.0
-    return cast(ComplexArray, np.exp(_fft.fft(cep * fold, axis=-1)))
+    return cast(ComplexArray, np.exp(scipy.fft.fft(cep * fold, axis=-1)))

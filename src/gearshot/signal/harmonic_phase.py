@@ -11,7 +11,7 @@ line in its band, would); over the first and last 5 % of the record the first ha
 alone (the zero-phase filters' edge errors grow with the order), with a half-cosine
 over the next 2.5 %. On the PHM09 records the transmission error of each harmonic
 differs, so their average follows the shaft better than any one of them
-(``benchmarks/RESULTS.md``, issue #24, session 8).
+(``benchmarks/RESULTS.md``, "Machines without a tachometer").
 """
 
 from __future__ import annotations

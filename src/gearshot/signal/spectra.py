@@ -5,13 +5,13 @@ from __future__ import annotations
 from typing import cast
 
 import numpy as np
+import scipy.fft
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
 
 from .._errors import GearshotError
 from .._typing import FloatArray
 from .._validation import MAX_POINTS, as_signal_array, check_in_range, check_int, finite_result
-from . import _fft
 
 __all__ = ["amplitude_spectrum", "acs_background"]
 
@@ -54,7 +54,7 @@ def amplitude_spectrum(x: ArrayLike, *, nfft: int = 2**15) -> FloatArray:
             f"x has {x.shape[-1]} samples, fewer than one segment of nfft={nfft}")
     segs = x[..., : n_seg * nfft].reshape(*x.shape[:-1], n_seg, nfft)
     if np.iscomplexobj(segs):
-        power = (np.abs(_fft.fft(segs, axis=-1)) ** 2).sum(axis=-2)
+        power = (np.abs(scipy.fft.fft(segs, axis=-1)) ** 2).sum(axis=-2)
     else:  # |X_{n-k}| = |conj X_k| = |X_k|: the one-sided half, mirrored
         half = (np.abs(np.fft.rfft(segs, axis=-1)) ** 2).sum(axis=-2)
         power = np.empty(half.shape[:-1] + (nfft,))

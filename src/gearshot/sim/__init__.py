@@ -12,7 +12,9 @@ Pieces (SI units; angles in rad; accelerations in g):
 * :func:`draw_profile_errors` — DIN 3962 profile errors per tooth.
 * :func:`simulate` — time signals with constant or time-varying speed and load;
   :func:`simulate_sa` — batched steady-state synchronous averages.
-* :func:`build_database` / :func:`load_database` — resumable Zarr databases.
+* :func:`build_database` / :func:`load_database` — resumable Zarr databases;
+  :func:`repair_database` (``gearshot simulate --repair --store S``) restores a store's
+  manifest from its blocks and rebuilds exactly its damaged or missing blocks.
 
 Example
 -------
@@ -23,6 +25,7 @@ Example
 (2, 2048)
 """
 
+from ._db_repair import repair_database
 from .database import build_database, default_database_path, load_database, pair_attrs
 from .dynamics import DEFAULT_MIN_FS, SimulationResult, simulate, simulate_sa, system_matrices
 from .fault_types import (
@@ -60,6 +63,7 @@ __all__ = [
     "system_matrices",
     "build_database",
     "load_database",
+    "repair_database",
     "pair_attrs",
     "default_database_path",
 ]

@@ -3,7 +3,8 @@
 :func:`read_block` reads every file of a block once, checks its size and CRC-32 (the
 block's checksum list, :mod:`gearshot.sim._db_checksums`) on the bytes read and decodes the
 block from those bytes; :func:`resume_problem` decides from file sizes and times alone
-whether a block can be kept when a build resumes.
+whether a block can be kept when a build resumes (and from the digest of its checksum
+list, whether that list was edited).
 """
 
 from __future__ import annotations
@@ -12,7 +13,14 @@ import json
 import zlib
 from pathlib import Path
 
-from ._db_checksums import ATTR, ROOT, block_problem, block_record
+from ._db_checksums import (
+    ATTR,
+    ROOT,
+    block_problem,
+    block_record,
+    files_digest,
+    record_problem,
+)
 
 __all__ = ["read_block", "resume_problem"]
 
@@ -41,6 +49,8 @@ def read_block(path: Path):
     files = record.get("files")
     if not isinstance(files, dict) or not files:
         return None, f"its checksum list (attribute {ATTR!r}) is damaged"
+    if record_problem(record) is not None:
+        return None, record_problem(record)
     buf = default_buffer_prototype().buffer
     content = {ROOT: buf.from_bytes(root)}
     for rel, want in sorted(files.items()):
@@ -77,8 +87,14 @@ def resume_problem(path: Path) -> str | None:
     except (OSError, ValueError):
         return block_problem(path)
     files = record.get("files") if record else None
-    if not isinstance(files, dict) or not files:
-        return block_problem(path)
+    if not isinstance(files, dict) or not files or "files_sha256" not in record:
+        # a list from before its digest: checked in full once, then given the digest
+        problem = block_problem(path)
+        if problem is None and isinstance(files, dict) and files:
+            _add_files_digest(path)
+        return problem
+    if record_problem(record) is not None:
+        return record_problem(record)
     for rel, want in files.items():
         try:
             st = (path / rel).stat()
@@ -87,3 +103,13 @@ def resume_problem(path: Path) -> str | None:
         if [st.st_size] != list(want)[:1] or st.st_mtime_ns > stamp:
             return block_problem(path)
     return None
+
+
+def _add_files_digest(path: Path) -> None:
+    """Record the digest of a (fully checked) block's checksum list in its metadata."""
+    from .._atomic import write_json_atomic
+
+    meta = json.loads((path / ROOT).read_text())
+    record = meta["attributes"][ATTR]
+    record["files_sha256"] = files_digest(record["files"])
+    write_json_atomic(meta, path / ROOT, indent=2, sort_keys=False)

@@ -11,6 +11,7 @@ record into a finished block; :func:`block_problem` checks every file against it
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import zlib
@@ -21,7 +22,7 @@ from ..fault_registry import fault_type_record
 from ._integrity import block_content_problem, manifest_diff, manifest_digest
 
 __all__ = ["ROOT", "ATTR", "write_checksums", "block_record", "block_problem",
-           "block_manifest", "ownership_problem"]
+           "block_manifest", "ownership_problem", "files_digest", "record_problem"]
 
 ROOT = "zarr.json"           # the block group's metadata; holds the record
 ATTR = "gearshot_block"
@@ -48,9 +49,28 @@ def write_checksums(folder: Path, manifest: dict) -> None:
             if rel != ROOT and not name.startswith("."):
                 files[rel] = list(_file_digest(full))
     meta = json.loads((folder / ROOT).read_text())
-    meta.setdefault("attributes", {})[ATTR] = {"files": files, "manifest": manifest,
+    meta.setdefault("attributes", {})[ATTR] = {"files": files, "files_sha256":
+                                               files_digest(files), "manifest": manifest,
                                                "manifest_sha256": manifest_digest(manifest)}
     write_json_atomic(meta, folder / ROOT, indent=2, sort_keys=False)
+
+
+def files_digest(files: dict) -> str:
+    """SHA-256 of a checksum list (canonical JSON): an edited size or CRC in the list
+    shows without reading a chunk."""
+    text = json.dumps(files, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def record_problem(record: dict) -> str | None:
+    """Whether a block's checksum list was changed after it was written (its recorded
+    digest no longer matches it); ``None`` also for a list from before digests."""
+    digest = record.get("files_sha256")
+    files = record.get("files")
+    if digest is not None and (not isinstance(files, dict) or files_digest(files) != digest):
+        return (f"its checksum list (attribute {ATTR!r}) was changed after the build (its "
+                f"digest no longer matches)")
+    return None
 
 
 def block_record(path: Path) -> dict:
@@ -75,6 +95,9 @@ def block_problem(path: Path) -> str | None:
     files = record.get("files")
     if not isinstance(files, dict) or not files:
         return f"its checksum list (attribute {ATTR!r}) is damaged"
+    edited = record_problem(record)
+    if edited is not None:
+        return edited
     for rel, want in sorted(files.items()):
         full = path / rel
         if not full.is_file():

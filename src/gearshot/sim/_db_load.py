@@ -19,11 +19,13 @@ from ._block_read import read_block
 from ._db_checksums import ATTR, block_manifest, block_record
 from ._db_manifest import (
     block_name,
+    blocks_manifest,
     check_fault_models,
     pair_attrs,
     pair_from_manifest,
     read_manifest,
     rebuild_hint,
+    repair_command,
 )
 from ._integrity import block_content_problem, manifest_diff, manifest_digest
 
@@ -64,13 +66,21 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
 
     store = Path(store).expanduser()
     if not (store / "manifest.json").exists():
+        if any((store / "blocks").glob("*.zarr")) if (store / "blocks").is_dir() else False:
+            raise GearshotError(f"store {str(store)!r} has lost its manifest.json; run "
+                                f"`gearshot simulate --repair --store {str(store)}`: it "
+                                f"restores it from the blocks' copies")
         raise GearshotError(f"store {str(store)!r} holds no gearshot database "
                             f"(no manifest.json)")
     man = read_manifest(store)
-    i = _index(man["speeds"], speed, "speed")
-    j = _index(man["loads"], load, "load")
-    ks = (range(len(man["grades"])) if grade is None
-          else [_index(man["grades"], grade, "grade")])
+    try:
+        i = _index(man["speeds"], speed, "speed")
+        j = _index(man["loads"], load, "load")
+        ks = (range(len(man["grades"])) if grade is None
+              else [_index(man["grades"], grade, "grade")])
+    except GearshotError:
+        _refuse_edited_manifest(store, man)
+        raise
     types = _types_to_load(store, man, fault_type)
     parts = [_load_block(store, man, i, j, k, ft, speed, load) for k in ks for ft in types]
     parts = [p.drop_vars(["speed", "load"]) for p in parts]
@@ -80,6 +90,17 @@ def load_database(store, *, speed: float, load: float, grade: int | None = None,
     if pair is not None:
         ds.attrs.update(pair_attrs(pair))
     return ds.assign_coords(speed=float(man["speeds"][i]), load=float(man["loads"][j]))
+
+
+def _refuse_edited_manifest(store: Path, man: dict) -> None:
+    """Raise when every block vouches for another build than ``manifest.json``: a condition
+    missing from an edited manifest is tampering, not the caller's wrong argument."""
+    theirs, _, _ = blocks_manifest(store)
+    if theirs is not None and theirs != man:
+        raise GearshotError(f"store {str(store)!r}: manifest.json was changed after the "
+                            f"build (differs from what its blocks record in "
+                            f"{manifest_diff(man, theirs)}); run `{repair_command(store)}` "
+                            f"to restore it from the blocks' copies")
 
 
 def _index(values, want, name) -> int:

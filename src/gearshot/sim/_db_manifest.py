@@ -25,7 +25,7 @@ from .geometry import GearPair
 
 __all__ = ["FORMAT", "PAIR_ATTRS", "block_name", "make_manifest", "pair_attrs",
            "pair_from_manifest", "check_fault_models", "read_manifest", "rebuild_hint",
-           "prepare_store"]
+           "prepare_store", "repair_command", "blocks_manifest"]
 
 FORMAT = 1
 
@@ -116,10 +116,12 @@ def read_manifest(store: Path) -> dict:
         if not isinstance(man, dict) or not {"speeds", "loads", "grades"} <= set(man):
             raise ValueError("not a gearshot manifest")
     except (OSError, ValueError) as exc:
+        text = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
         raise GearshotError(
-            f"store {str(store)!r}: manifest.json is damaged ({exc}); run build_database / "
-            f"`gearshot simulate` on this store with its original arguments: the manifest "
-            f"is restored from the blocks' copies (no block is rebuilt)") from None
+            f"store {str(store)!r}: manifest.json is damaged ({text}); run `gearshot "
+            f"simulate --repair --store {str(store)}`: it restores the manifest from the "
+            f"blocks' copies (or build_database / `gearshot simulate` on this store with "
+            f"its original arguments)") from None
     return man
 
 
@@ -138,7 +140,9 @@ def rebuild_hint(store: Path, man: dict, blocks=()) -> str:
            + ("" if man.get("paired") else " --no-paired"))   # paired is the default
     what = (f"it (re)builds {', '.join(blocks)} and reuses the other blocks" if blocks else
             "it restores manifest.json from the blocks' copies and rebuilds no block")
-    return f"run `{cmd}` (or build_database with the same arguments): {what}"
+    return (f"run `gearshot simulate --repair --store {str(store)}` (it checks every block "
+            f"in full and rebuilds exactly the damaged and missing ones), or `{cmd}` (or "
+            f"build_database with the same arguments): {what}")
 
 
 def prepare_store(store: Path, manifest: dict, progress: bool = True) -> None:
@@ -186,3 +190,18 @@ def _restore_or_refuse(store: Path, old: dict | None, manifest: dict, progress: 
     raise GearshotError(f"store {str(store)!r} holds a different build "
                         f"(differs in {', '.join(diff)}){hint}; use a new store "
                         f"(--store / store=)")
+
+
+def repair_command(store) -> str:
+    """The command that repairs ``store``: ``gearshot simulate --repair --store STORE``."""
+    return f"gearshot simulate --repair --store {str(store)}"
+
+
+def blocks_manifest(store: Path) -> tuple[dict | None, int, int]:
+    """The manifest the store's blocks vouch for: ``(manifest or None, blocks vouching,
+    blocks)``; None when no block vouches for one or they vouch for different builds."""
+    blocks = sorted((store / "blocks").glob("*.zarr")) if (store / "blocks").is_dir() else []
+    copies = [c for c in (block_manifest(b) for b in blocks) if c is not None]
+    if not copies or any(c != copies[0] for c in copies[1:]):
+        return None, len(copies), len(blocks)
+    return copies[0], len(copies), len(blocks)

@@ -194,7 +194,7 @@ def _stack_errors(errs: list[ToothProfileErrors]):
 
 
 LANES = 32     # signals integrated side by side by one thread (_kernel._modal_step); 8 -> 32
-#                halves the kernel time per SA (benchmarks/RESULTS.md, session 7)
+#                halves the kernel time per SA (measured with issue #23)
 
 
 def _lanes(n: int) -> tuple[int, int]:

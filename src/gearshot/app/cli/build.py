@@ -84,10 +84,26 @@ def simulate(
                                          f"{', '.join(FAULT_TYPE_NAMES)}."),
     machine: Path | None = typer.Option(None, "--machine", help=HELP_MACHINE),
     paired: bool = typer.Option(True, "--paired/--no-paired", help=HELP_PAIRED),
+    repair: bool = typer.Option(False, "--repair", help="Repair the store named by --store "
+                                "from what its blocks record: restore a lost, empty, "
+                                "invalid or edited manifest.json, check every block in "
+                                "full and rebuild exactly the damaged and missing ones "
+                                "(no other option)."),
 ) -> None:
-    """Build (or finish) a simulated database; resumable."""
+    """Build (or finish) a simulated database; resumable. --repair: repair a store."""
     from ...paper import PAPER_LOADS, PAPER_SPEEDS
-    from ..simulate import default_store, simulate_database, simulate_machine_database
+    from ..simulate import (
+        default_store,
+        repair_store,
+        simulate_database,
+        simulate_machine_database,
+    )
+
+    if repair:
+        repair_store(store, _given_options(ctx, {"repair", "store", "scheduler",
+                                                 "workers"}),
+                     scheduler=scheduler, workers=workers, echo=typer.echo)
+        return
 
     for other in ("--machine", "--speed", "--load"):
         refuse_together(ctx, "--paper", other, "--paper builds the paper pair at all the "
@@ -119,6 +135,18 @@ def simulate(
         speeds, loads = (PAPER_SPEEDS, PAPER_LOADS) if paper else (speed, load)
         simulate_database(store, speeds=speeds, loads=loads, **common)
     typer.echo(f"database ready: {store}")
+
+
+def _given_options(ctx: typer.Context, allowed: set[str]) -> list[str]:
+    """The options given on the command line other than ``allowed`` (as --names)."""
+    given = []
+    for param in ctx.command.params:
+        name = param.name or ""
+        source = ctx.get_parameter_source(name)
+        if name not in allowed and source is not None and source.name not in (
+                "DEFAULT", "DEFAULT_MAP"):
+            given.append(max(getattr(param, "opts", [name]), key=len))
+    return given
 
 
 @app.command()

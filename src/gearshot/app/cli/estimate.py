@@ -237,6 +237,8 @@ def _write_indicator_outputs(payload: dict, label_table, json_out: Path | None,
     if json_out is not None:
         typer.echo(f"indicators written to {json_out}")
     if out is not None:
+        indicator_figures(payload, out, title=title, labels=None if label_table is None
+                          else dict(zip(label_table["file"], label_table["label"])))
         typer.echo(f"figures written to {out}")
 
 
@@ -248,6 +250,8 @@ def _ranking(payload: dict, label_table, out: Path | None, title: str) -> None:
 
     ranking = indicator_ranking(payload, label_table)
     payload["ranking"] = json.loads(ranking.to_json(orient="records"))
+    payload["ranking_cells"] = {cell: {"healthy": h, "faulty": f}
+                                for cell, (h, f) in ranking.attrs.get("cells", {}).items()}
     typer.echo(format_ranking(ranking))
     if out is not None:
         with atomic_path(out / "ranking.csv", make_parents=True) as tmp:
@@ -257,13 +261,14 @@ def _ranking(payload: dict, label_table, out: Path | None, title: str) -> None:
 
 @app.command()
 def report(
-    results: Path = typer.Argument(..., help="A JSON written by gearshot: demo's "
-                                   "results.json, experiment/rig-family/indicators --json, "
-                                   "predict --out X.json."),
+    results: Path = typer.Argument(..., help="An output of gearshot: predict --out X.csv "
+                                   "or X.json, demo's results.json or ablations.csv, "
+                                   "experiment/rig-family/indicators --json."),
     out: Path = typer.Option(Path("gearshot-report"), "--out", help="Folder for the "
-                             "figures and report.md."),
+                             "figures, report.md and report.html."),
 ) -> None:
-    """Figures and a Markdown report from any JSON gearshot writes."""
+    """Figures, report.md and a self-contained report.html from any output gearshot
+    writes (JSON or CSV)."""
     if not results.is_file():
         raise GearshotError(f"results file {str(results)!r} does not exist")
     early(out, "--out", folder=True)

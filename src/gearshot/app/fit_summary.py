@@ -1,0 +1,19 @@
+"""What a fitted estimator chose, as plain values for a predict table's ``attrs`` (and so
+the ``fit`` of its JSON)."""
+
+from __future__ import annotations
+
+__all__ = ["fit_attrs"]
+
+
+def fit_attrs(est) -> dict:
+    """What a fitted estimator chose, for a predict table's ``attrs`` (and so its JSON's
+    ``fit``): ``grade``, ``calibration`` (strategy and the weighted settings' grades) and
+    ``simulated_reference``."""
+    calibration = getattr(est, "calibration_", None) or {}
+    settings = [{"grade": int(s["grade"]), "weight": float(s.get("weight", 1.0))}
+                for s in calibration.get("settings", []) if "grade" in s]
+    grade = getattr(est, "grade_", None)
+    return {"grade": None if grade is None else int(grade),
+            "calibration": {"strategy": calibration.get("strategy"), "settings": settings},
+            "simulated_reference": getattr(est, "simulated_reference_", None)}
