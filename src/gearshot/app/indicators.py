@@ -150,15 +150,23 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
         the gear train).
     """
+    from ..io import Recording
+    from ..machine.signal_check import verify_machine
+
     machine.check_shaft(shaft, "--shaft")
     if isinstance(sensors, str):
         sensors = [sensors]
     names = [machine.sensor(s).name for s in
              (sensors or ([sensor] if sensor else [s.name for s in machine.sensors]))]
     ratio = float(machine.speed_ratio(shaft))
+    recs = [Recording.read(p, machine=machine) for p in paths]
+    # the machine file must put its mesh orders where the recordings have them (the
+    # healthy baseline recordings where given)
+    verify_machine(machine, [Recording.read(p, machine=machine) for p in baseline_paths]
+                   if baseline_paths else recs)
     baselines = _baselines(baseline_paths, machine, shaft, names)
-    records = [row for path in paths
-               for row in _record_rows(path, machine, shaft, names, baselines, ratio)]
+    records = [row for path, rec in zip(paths, recs)
+               for row in _record_rows(path, machine, shaft, names, baselines, ratio, rec)]
     units = {n: indicator_units(machine, n) for n in names}
     return {"kind": "indicators", "machine": machine.name,
             "machine_file": None if machine_file is None else str(machine_file),
@@ -179,11 +187,14 @@ def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
 
 
 def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
-                 baselines: dict[str, float | None], ratio: float) -> list[dict[str, Any]]:
-    """The payload records of one file: one per sensor."""
+                 baselines: dict[str, float | None], ratio: float,
+                 rec: Any = None) -> list[dict[str, Any]]:
+    """The payload records of one file (``rec``: the file read with ``machine``): one per
+    sensor."""
     from ..io import Recording
 
-    rec = Recording.read(path, machine=machine)
+    if rec is None:
+        rec = Recording.read(path, machine=machine)
     tacho = float(rec.shaft_speed())
     rows = []
     for name in names:

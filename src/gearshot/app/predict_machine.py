@@ -12,10 +12,12 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
+from ..machine.signal_check import verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 
-__all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
+__all__ = ["machine_segments", "predict_from_machine", "machine_database_path",
+           "check_database_pair"]
 
 
 def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty: int,
@@ -148,6 +150,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     cps = _check_options(machine, healthy, [faulty, *recordings], cycles_per_segment,
                          holdout)
     database_conditions(database, machine)   # a bad --database fails now
+    check_database_pair(database, machine)
+    # the machine file must put its mesh orders where the healthy recordings have them
+    verify_machine(machine, healthy)
     seg = _segment_recordings(machine, healthy, faulty, recordings, cps=cps, sensor=sensor,
                               holdout=holdout, example_segment=example_segment)
     cond = _condition(database, machine, seg, speed=speed, load=load,
@@ -165,6 +170,35 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     frame.attrs["grade"] = getattr(est, "grade_", None)
     frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
     return frame
+
+
+def check_database_pair(database: str | Path, machine) -> None:
+    """Refuse a database simulated for another pair than the machine's monitored pair.
+
+    Teeth, module, face width, pressure angle and helix angle of the store's pair
+    (its manifest) must be those of :meth:`gearshot.Machine.gear_pair` (which itself
+    refuses a helical stage without its helix angle). A store whose manifest holds no
+    readable pair is left to the estimator's tooth check.
+    """
+    from ..sim._db_manifest import pair_from_manifest, read_manifest
+
+    want = machine.gear_pair()
+    have = pair_from_manifest(read_manifest(Path(database)))
+    if have is None:
+        return
+    diffs = []
+    for name, unit, scale in (("z_pinion", "", 1.0), ("z_gear", "", 1.0),
+                              ("module", " mm", 1e3), ("face_width", " mm", 1e3),
+                              ("pressure_angle", " deg", 180 / np.pi),
+                              ("helix_angle", " deg", 180 / np.pi)):
+        a, b = float(getattr(have, name)), float(getattr(want, name))
+        if not np.isclose(a, b, rtol=1e-9, atol=1e-12):
+            diffs.append(f"{name} {a * scale:g}{unit} in the database, {b * scale:g}{unit} "
+                         f"in the machine")
+    if diffs:
+        raise GearshotError(f"--database {str(database)!r} was simulated for another pair than "
+                            f"the monitored pair of machine {machine.name!r}: "
+                            f"{'; '.join(diffs)}; build it with gearshot simulate --machine")
 
 
 def _check_options(machine, healthy, others, cycles_per_segment, holdout) -> int:
