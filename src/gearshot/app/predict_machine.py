@@ -12,7 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..machine.signal_check import verify_machine
+from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 
@@ -35,8 +35,9 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     """SA segments of the monitored gear's shaft for one recording file.
 
     ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
-    machine without ``[tacho]``) and ``speed_uncertainty_hz`` (rev/s of the reference
-    shaft, ``None`` with a tacho).
+    machine without ``[tacho]``), ``speed_uncertainty_hz`` (rev/s of the reference
+    shaft, ``None`` with a tacho) and ``speed_check`` (``"ok"`` or why the tracked speed
+    is not to be trusted, :func:`gearshot.machine.signal_check.speed_check`).
 
     Returns
     -------
@@ -63,7 +64,8 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
                             f"{cycles_per_segment} is too many")
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
     if info is not None:
-        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
+        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty,
+                    speed_check=speed_check(machine, rec))
     return blocks.mean(axis=1), x, rec.shaft_speed()
 
 
@@ -132,16 +134,17 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
         load_source, load_clarity, predicted, low, high, comparability, comparable,
-        speed_source, speed_uncertainty_hz`` (``database_load``: the load estimated at,
-        N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
+        speed_source, speed_uncertainty_hz, speed_check`` (``database_load``: the load
+        estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
         (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
         ``comparability``/``comparable``: the score of
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` and whether the
         segment looks like the fitted machine; ``speed_source``: ``tacho`` or
-        ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
-        ``vibration``); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
+        ``vibration``, with the standard uncertainty of the speed, rev/s, for
+        ``vibration``; ``speed_check``: ``ok`` or why a tracked speed is not to be trusted
+        -- such a row is not to be trusted); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
         ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
         reference.
     """
@@ -327,4 +330,5 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
+    frame["speed_check"] = [seg.sources[r]["speed_check"] for r in frame["recording"]]
     return frame

@@ -46,7 +46,7 @@ import numpy as np
 from .._errors import GearshotError
 
 __all__ = ["MeshLine", "MachineCheck", "verify_machine", "check_recording",
-           "MIN_COMB_DB", "MIN_ODD_DB", "MIN_GAIN_DB", "MIN_PROMINENCE_DB", "SPEED_RANGE_MARGIN"]
+           "MIN_COMB_DB", "MIN_ODD_DB", "MIN_GAIN_DB", "MAX_WHOLE_GAIN_DB", "MIN_PROMINENCE_DB", "speed_check", "SPEED_RANGE_MARGIN"]
 
 #: The declared comb (every stage's mesh, harmonics 1-3, clipped to -10...20 dB, mean over
 #: lines and sensors) must stand this many dB above the neighbouring whole orders.
@@ -58,6 +58,10 @@ MIN_ODD_DB = 2.0
 #: A nameable mistake's scale of the orders must put the comb's lines this many dB higher
 #: over the floor than the declared scale before it is named.
 MIN_GAIN_DB = 3.0
+#: Along a tracked angle, the record's whole orders 1-100 (median level over the half
+#: orders between them) must not stand this many dB better at another speed within 15 %:
+#: otherwise the mesh comb locked on a sideband or a ratio of the speed.
+MAX_WHOLE_GAIN_DB = 1.0
 #: A declared mesh whose harmonics 1-3 stand this many dB out counts as found.
 MIN_PROMINENCE_DB = 3.0
 #: Relative margin around ``[speed] range_hz`` (and around a nominal speed) within which
@@ -68,6 +72,8 @@ _NEIGHBOURS = 4
 _SAMPLES_PER_REV = 1024
 _CLIP = (-10.0, 20.0)
 _ODD_TOP = 125.0
+_WHOLE_TOP = 100.0
+_WHOLE_SEARCH = 0.15
 
 
 @dataclass(frozen=True)
@@ -117,6 +123,10 @@ class MachineCheck:
         Mean clipped prominence of every declared line at scale 1 and at ``scale``.
     odd_db : float
         Mean prominence of the odd harmonics of the lowest declared mesh.
+    whole_db : float
+        Median level of the whole orders 1-100 over the half orders, dB.
+    speed_ratio : float
+        True / used speed at which the whole orders stand best (within 15 %).
     """
 
     recording: str
@@ -129,6 +139,8 @@ class MachineCheck:
     score_db: float = 0.0
     best_score_db: float = 0.0
     odd_db: float = 0.0
+    whole_db: float = 0.0
+    speed_ratio: float = 1.0
 
     def describe(self) -> str:
         """One line: the file, the verdict, the mistake."""
@@ -198,6 +210,31 @@ def _order_spectrum(x: np.ndarray, spc: int) -> _Spectrum:
 
 
 # ---------------------------------------------------------------- the check
+def _whole_order_db(spec: _Spectrum, r: np.ndarray, top: float = _WHOLE_TOP) -> np.ndarray:
+    """Median level at the orders ``j * r`` (``j`` = 1 ... ``top``) minus the median level
+    half-way between them, dB, for every ratio ``r``: every whole order of the true shaft
+    carries a line (its harmonics, the meshes and their sidebands: every shaft of a train
+    turns a whole number of times per revolution of the train's common period), so this
+    peaks at the ratio of the true speed to the speed of the angle used."""
+    r = np.atleast_1d(np.asarray(r, dtype=float))
+    j = np.arange(1, int(min(top, (spec.max_order - 1) / r.max())) + 1, dtype=float)
+    on = spec.at(np.multiply.outer(r, j)).mean(axis=0)
+    off = spec.at(np.multiply.outer(r, j + 0.5)).mean(axis=0)
+    return np.asarray(np.median(on, axis=-1) - np.median(off, axis=-1))
+
+
+def _speed_ratio_found(spec: _Spectrum) -> tuple[float, float, float]:
+    """(level at ratio 1, best level, its ratio) of the whole-order comb over true/used
+    speed ratios within :data:`_WHOLE_SEARCH`."""
+    top = min(_WHOLE_TOP, spec.max_order / (1 + _WHOLE_SEARCH) - 1)
+    step = 0.5 / (top * spec.n_revs)
+    r = np.arange(1 - _WHOLE_SEARCH, 1 + _WHOLE_SEARCH + step, step)
+    w = _whole_order_db(spec, r, top)
+    w1 = float(_whole_order_db(spec, np.array([1.0]), top)[0])
+    i = int(np.argmax(w))
+    return w1, float(w[i]), float(r[i])
+
+
 def _stage_lines(machine: Any) -> list[tuple[str, Fraction]]:
     ref = machine.reference_shaft
     return [(f"{st.driver} {st.driver_teeth}T -> {st.driven} {st.driven_teeth}T",
@@ -319,7 +356,7 @@ def _tooth_mistake(lines: list[MeshLine]) -> str:
 
 
 def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = None,
-                    odd_test: bool = True) -> MachineCheck:
+                    odd_test: bool = True, comb_test: bool = True) -> MachineCheck:
     """Verify ``machine`` against one recording read with it (no exception).
 
     Parameters
@@ -332,6 +369,9 @@ def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = N
     odd_test : bool, default True
         Test the odd harmonics of the lowest mesh here (:data:`MIN_ODD_DB`);
         :func:`verify_machine` tests their mean over the recordings instead.
+    comb_test : bool, default True
+        Test the declared comb, its odd harmonics and the speed range; ``False``: only
+        the tracked speed (the whole orders, :func:`speed_check`).
 
     Returns
     -------
@@ -354,9 +394,20 @@ def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = N
     s1 = float(np.mean(np.clip(prom, *_CLIP)))
     low = float(declared.min())
     odd = float(np.mean(spec.prominence(low * np.arange(1, max(2, int(_ODD_TOP / low) + 1), 2))))
-    plausible = _plausible_speeds(machine, rec)
+    whole, whole_best, ratio = _speed_ratio_found(spec)
     k, best = 1.0, s1
-    if s1 < MIN_COMB_DB:
+    plausible = _plausible_speeds(machine, rec)
+    if source == "vibration" and whole_best - whole > MAX_WHOLE_GAIN_DB and \
+            abs(ratio - 1.0) * _WHOLE_TOP * spec.n_revs > 1.0:
+        mistake = (f"the speed tracked in the vibration ({speed:.4g} Hz) looks "
+                   f"{100 * (1 / ratio - 1):+.2f} % off: the record's whole orders stand "
+                   f"best at {speed * ratio:.4g} Hz ({whole_best:+.1f} against {whole:+.1f} dB "
+                   f"over the half orders at the tracked speed): the mesh comb locked on a "
+                   f"sideband or a ratio of the speed (check [speed] range_hz or the nominal "
+                   f"speed)")
+    elif not comb_test:
+        mistake = ""
+    elif s1 < MIN_COMB_DB:
         k, best, mistake = _name_mistake(machine, spec, speed, source, plausible, lines,
                                          declared, s1)
     elif odd_test and odd < MIN_ODD_DB:
@@ -366,7 +417,37 @@ def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = N
     else:
         mistake = ""
     return MachineCheck(label, not mistake, mistake, k, speed, source, tuple(lines), s1,
-                        best, odd)
+                        best, odd, whole, ratio)
+
+
+def speed_check(machine: Any, rec: Any) -> str:
+    """``"ok"``, or why a speed tracked in the vibration is not to be trusted.
+
+    With a tacho: ``"ok"`` (the pulses are the speed). Without: the whole orders of the
+    shaft in the record's order spectrum along the tracked angle must stand best at the
+    tracked speed, not at another within 15 % (:data:`MAX_WHOLE_GAIN_DB`): a comb locked
+    on a sideband of a mesh (e.g. 2 idler orders beside the PHM09 spur input mesh: 2.08 %
+    off) or a run-up locked on another line fails here. The tracker's own refusal (no
+    line stands out, an ambiguous ratio 1/2 ... 2) is returned as the reason too. The
+    machine file itself is :func:`verify_machine`'s.
+
+    Parameters
+    ----------
+    machine : gearshot.Machine
+    rec : gearshot.io.Recording
+        Read with ``machine``.
+
+    Returns
+    -------
+    str
+    """
+    if rec.speed_source != "vibration":
+        return "ok"
+    try:
+        check = check_recording(machine, rec, odd_test=False, comb_test=False)
+    except GearshotError as exc:
+        return str(exc)
+    return "ok" if check.passed else check.mistake
 
 
 def _half_mistake(machine: Any, declared: np.ndarray, low: float, odd: float) -> str:
