@@ -344,9 +344,16 @@ def _name_mistake(machine: Any, spec: _Spectrum, speed: float, source: str,
                      f"machine file), wrong tooth counts, or a wrong tacho")
 
 
-def _tooth_mistake(lines: list[MeshLine]) -> str:
+def _tooth_mistake(lines: list[MeshLine], half: bool = False) -> str:
+    """One mesh missing while the others stand: a tooth count (``half``: not where the
+    missing mesh is half of a declared one -- that is another train at twice the
+    orders)."""
     standing = [ln for ln in lines if ln.stands]
     absent = [ln for ln in lines if ln.prominence_db < 0.0]
+    if half:
+        orders = [ln.order for ln in lines]
+        absent = [ln for ln in absent
+                  if not any(abs(2 * ln.order - o) < 1e-6 for o in orders)]
     if standing and absent:
         missing = ", ".join(f"{ln.stage} at order {ln.order:.4g} ({ln.prominence_db:+.1f} dB)"
                             for ln in absent)
@@ -411,9 +418,14 @@ def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = N
         k, best, mistake = _name_mistake(machine, spec, speed, source, plausible, lines,
                                          declared, s1)
     elif odd_test and odd < MIN_ODD_DB:
-        mistake = _tooth_mistake(lines) or _half_mistake(machine, declared, low, odd)
+        mistake = (_tooth_mistake(lines, half=True)
+                   or _half_mistake(machine, declared, low, odd))
     elif plausible is not None and not plausible[0] <= speed <= plausible[1]:
-        mistake = _fs_mistake(rec, speed, plausible)
+        # a wrong pulse count or tacho shaft moves the orders too; fs does not
+        k, best, mistake = _name_mistake(machine, spec, speed, source, plausible, lines,
+                                         declared, s1)
+        if k == 1.0:
+            k, best, mistake = 1.0, s1, _fs_mistake(rec, speed, plausible)
     else:
         mistake = ""
     return MachineCheck(label, not mistake, mistake, k, speed, source, tuple(lines), s1,
@@ -528,7 +540,7 @@ def verify_machine(machine: Any, recordings: Any, *, sensors: Sequence[str] | No
     odd = float(np.mean([c.odd_db for c in out])) if out else MIN_ODD_DB
     if out and odd < MIN_ODD_DB:
         declared = np.array([ln.order for ln in out[0].lines])
-        mistake = (_tooth_mistake(list(out[0].lines))
+        mistake = (_tooth_mistake(list(out[0].lines), half=True)
                    or _half_mistake(machine, declared, float(declared.min()), odd))
         out = [dataclasses.replace(c, passed=False, mistake=c.mistake or mistake)
                for c in out]
