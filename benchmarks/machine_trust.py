@@ -74,7 +74,7 @@ def _verdict(machine_file: Path, record: Path) -> str:
         text = str(exc)
         import re
         for key in (r"pulses_per_rev looks like \d+, not \d+", "fs off by factor",
-                    r"tacho.shaft looks like '\w+'", "tooth count", "another gear train",
+                    r"tacho.shaft looks like '\w+'", "another gear train", "tooth count",
                     "tracked in the vibration", "no mesh harmonic", "do not stand"):
             hit = re.search(key, text)
             if hit:

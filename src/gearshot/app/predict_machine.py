@@ -135,8 +135,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
         load_source, load_clarity, predicted, low, high, comparability, comparable,
         speed_source, speed_uncertainty_hz, speed_check`` (``database_load``: the load
-        estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or ``chosen``
-        (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
+        estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or
+        ``chosen`` (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
         estimated at, both in Hz of the tacho (reference) shaft;
         ``comparability``/``comparable``: the score of
@@ -144,9 +144,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         segment looks like the fitted machine; ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the speed, rev/s, for
         ``vibration``; ``speed_check``: ``ok`` or why a tracked speed is not to be trusted
-        -- such a row is not to be trusted); ``attrs`` hold the condition (``speed_hz``, ``load``, ``load_source``,
-        ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
-        reference.
+        -- such a row is not to be trusted); ``attrs`` hold the condition (``speed_hz``,
+        ``load``, ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None),
+        the grade and the simulated reference.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
 
