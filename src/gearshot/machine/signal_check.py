@@ -126,7 +126,8 @@ class MachineCheck:
     odd_db : float
         Mean prominence of the odd harmonics of the lowest declared mesh.
     whole_db : float
-        Median level of the whole orders 1-100 over the half orders, dB.
+        Median level of the whole orders 1-100 over the half orders, dB (tracked speed
+        only; 0 with a tacho).
     speed_ratio : float
         True / used speed at which the whole orders stand best (within 15 %).
     """
@@ -420,7 +421,9 @@ def check_recording(machine: Any, rec: Any, *, sensors: Sequence[str] | None = N
     s1 = float(np.mean(np.clip(prom, *_CLIP)))
     low = float(declared.min())
     odd = float(np.mean(spec.prominence(low * np.arange(1, max(2, int(_ODD_TOP / low) + 1), 2))))
-    whole, whole_best, ratio = _speed_ratio_found(spec)
+    # the whole-order scan only where the speed was tracked (a tacho's speed is exact)
+    whole, whole_best, ratio = (_speed_ratio_found(spec) if source == "vibration"
+                                else (0.0, 0.0, 1.0))
     k, best = 1.0, s1
     plausible = _plausible_speeds(machine, rec)
     moved = ""
