@@ -6,24 +6,26 @@ revolution and the sampling rate make the reference shaft's speed, the tooth cou
 other shaft's. A mistake in any of them moves every gear mesh away from the order the file
 declares for it, and the estimates built on that angle are wrong without looking wrong.
 Each stage's mesh is a line at order ``driver_teeth * speed_ratio(driver)`` of the reference
-shaft (with harmonics); :func:`verify_machine` measures how far each declared mesh line
-stands out of the whole-record order spectrum of that shaft (along the tacho's angle, or
-the angle tracked from the vibration), and where they do not stand out, the scale ``k`` of
-the orders at which the declared comb stands best: the found orders are ``k`` times the
-declared ones. The likely mistake is named from ``k`` and the speed:
+shaft (with harmonics). :func:`check_recording` reads the whole-record order spectrum of
+that shaft (along the tacho's angle, or the angle tracked from the vibration) and tests,
+in this order:
 
-* ``k`` a ratio of whole numbers ``p / P`` with the speed off the machine's declared range
-  by ``1 / k``: ``pulses_per_rev`` looks like ``P``, not ``p``;
-* ``k`` the speed ratio of two shafts: the tacho (or ``[speed]``) watches the other shaft;
-* ``k`` = 1 but the speed off the declared range (``[speed] range_hz``) or the recording's
-  nominal speed by a constant factor ``q``: ``fs`` is off by ``q`` (the orders do not move
-  with the sampling rate: the tacho and the vibration are stretched alike);
-* some declared meshes standing and others not: a tooth count;
-* otherwise the orders found are another gear train's (another gearbox's machine file).
-
-Without a tacho the reference speed is tracked in the vibration: a tracking error (the
-comb locked on a sideband or a ratio of the true speed) moves the meshes the same way and
-is named as such (:func:`gearshot.signal.tracking.estimate_shaft_angle`).
+1. without a tacho, the tracked speed (:func:`speed_check`): the record's whole orders
+   must stand best at the tracked speed, not at another within 15 % (a comb locked on a
+   mesh sideband or on a ratio of the speed is named with its size and the speed found);
+2. the declared comb must stand out (:data:`MIN_COMB_DB`); where it does not, the scale
+   ``k`` of the orders that a nameable mistake makes is tried (:data:`MIN_GAIN_DB`):
+   ``k = p / P`` with the speed off the declared range: ``pulses_per_rev`` looks like
+   ``P``, not ``p``; ``k`` the speed ratio of two shafts: the tacho (or ``[speed]``)
+   watches the other shaft; none: a tooth count (one mesh missing, the others standing)
+   or another gear train;
+3. the odd harmonics of the lowest declared mesh must stand out (:data:`MIN_ODD_DB`;
+   tested by :func:`verify_machine` on the mean over its recordings): otherwise that mesh
+   is not there and the train found has twice the declared orders (the PHM09 helical
+   file on spur records: 16, 8 declared, 32, 16 found);
+4. the speed must lie in the declared ``[speed] range_hz`` (or within 10 % of the
+   recording's nominal ``speed``): otherwise, with the orders where declared, ``fs`` is
+   off (the tacho and the vibration are stretched alike, so the orders cannot show it).
 
 Level of a line: its peak in the Hann-windowed order spectrum of the whole record, in dB
 above the median of the spectrum over the surrounding whole order. *Prominence* of a line:
