@@ -513,3 +513,87 @@ def test_phm09_fused_harmonics_bring_the_helical_sa_near_the_tacho_sa():
     c = np.fft.irfft(np.fft.rfft(a) * np.conj(np.fft.rfft(b)), n=16 * a.size)
     e = fractional_shift(b, np.argmax(c) / 16.0) - a
     assert np.sqrt(np.mean(e ** 2) / np.mean(a ** 2)) < 0.08
+
+
+# ------------------------------------------------------------ the tracked speed checked
+def _notacho_with_range(tmp_path, kind: str, lo: float, hi: float) -> Path:
+    text = (MACHINES / f"phm09_{kind}_notacho.toml").read_text()
+    assert "range_hz = [26, 52]" in text
+    out = tmp_path / f"{kind}_range.toml"
+    out.write_text(text.replace("range_hz = [26, 52]", f"range_hz = [{lo}, {hi}]"))
+    return out
+
+
+@needs_phm09
+def test_a_comb_locked_on_a_mesh_sideband_fails_the_speed_check(tmp_path):
+    """Issue 29's failure mode on a shared record: a range that leaves the true speed out
+    makes the comb lock 2.08 % high (the input mesh's sideband at 2 idler orders, 32 + 2/3);
+    the stated uncertainty cannot cover that, the speed check names it."""
+    from gearshot.machine.signal_check import speed_check
+
+    path = PHM09 / "spur2_30hz_Low_1.zip"
+    true = Recording.read(path, machine=MACHINES / "phm09_spur.toml").shaft_speed()
+    rec = Recording.read(path, machine=_notacho_with_range(tmp_path, "spur", 30.2, 33))
+    tracked = rec.shaft_speed()
+    assert tracked / true - 1 == pytest.approx(2 / 96, abs=0.001)   # the wrong lock
+    assert abs(tracked - true) > 10 * rec.speed_uncertainty
+    verdict = speed_check(rec.machine, rec)
+    assert "looks +2.09 % off" in verdict and f"best at {true:.4g} Hz" in verdict
+    with pytest.raises(GearshotError, match=r"tracked in the vibration .* looks \+2\.09 % off"):
+        verify_machine_on(rec)
+    good = Recording.read(path, machine=MACHINES / "phm09_spur_notacho.toml")
+    assert speed_check(good.machine, good) == "ok"
+
+
+def verify_machine_on(rec):
+    from gearshot.machine.signal_check import verify_machine
+    return verify_machine(rec.machine, rec)
+
+
+@needs_phm09
+def test_the_stated_speed_uncertainty_covers_the_tacho_and_reaches_predict_rows():
+    from gearshot.app.predict_machine import machine_segments
+    from gearshot.signal.tracking import SPEED_MODEL_REL
+
+    path = PHM09 / "spur3_30hz_Low_1.zip"
+    rt = Recording.read(path, machine=MACHINES / "phm09_spur.toml")
+    rv = Recording.read(path, machine=MACHINES / "phm09_spur_notacho.toml")
+    angle = rv.vibration_angle()
+    u = rv.speed_uncertainty
+    assert u == pytest.approx(math.hypot(angle.speed_std, SPEED_MODEL_REL * angle.mean_speed))
+    assert u > angle.speed_std   # the phase noise alone was 3.4 x too small here
+    assert abs(rv.shaft_speed() - rt.shaft_speed()) < 2 * u
+    # the tacho's speed over 0.25 s windows, against the tracked angle's
+    pulses = rt.pulse_times()
+    edges = np.arange(pulses[0] + 0.1, pulses[-1] - 0.1, 0.25)
+    tacho = np.diff(np.interp(edges, pulses, np.arange(pulses.size) / 10)) / 0.25
+    tracked = np.diff(np.interp(edges, angle.times, angle.angle)) / 0.25
+    assert np.mean(np.abs(tracked - tacho) <= 2 * u) >= 0.9
+    assert np.mean(np.abs(tracked - tacho) <= 2 * angle.speed_std) < 0.9
+    info: dict = {}
+    machine_segments(path, rv.machine, cycles_per_segment=10, info=info)
+    assert info["speed_source"] == "vibration" and info["speed_check"] == "ok"
+    assert info["speed_uncertainty_hz"] == pytest.approx(u)
+
+
+def test_a_virtual_rig_run_up_locked_on_another_line_fails_the_speed_check():
+    """Rig seed 3's run-up 14 -> 17 rev/s, searched over 12.6-18.7 rev/s, tracks 15 % high
+    with a stated uncertainty of 0.04 rev/s; the check names the rig's true mean speed."""
+    from gearshot.machine.signal_check import speed_check
+    from gearshot.rig import VirtualRig
+    from gearshot.signal import pulse_times
+
+    machine = Machine.from_dict({
+        "name": "virtual rig", "shafts": ["input", "output"],
+        "stage": [{"driver": "input", "driver_teeth": 17, "driven": "output",
+                   "driven_teeth": 38}],
+        "speed": {"shaft": "input", "range_hz": [12.6, 18.7]},
+        "sensor": [{"name": "acceleration", "channel": "acceleration", "sensitivity": 1.0,
+                    "unit": "g"}]})
+    rec = VirtualRig(seed=3).record(speed=14.0, load=10, duration=4.0, end_speed=17.0)
+    pulses = pulse_times(rec.tacho, rec.fs)
+    true = (pulses.size - 1) / (pulses[-1] - pulses[0]) / (rec.tacho_pulses_per_rev or 1)
+    blind = dataclasses.replace(rec, tacho=None, machine=machine)
+    assert blind.shaft_speed() / true > 1.1
+    verdict = speed_check(machine, blind)
+    assert "looks +15" in verdict and "best at 15.4" in verdict

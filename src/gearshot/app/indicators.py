@@ -165,6 +165,9 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
         speed, rev/s; ``null`` with a tacho); ``shaft_speed_hz`` that of ``shaft`` (through
         the gear train). With ``errors="collect"``, also ``"failures"``.
     """
+    from ..io import Recording
+    from ..machine.signal_check import verify_machine
+
     machine.check_shaft(shaft, "--shaft")
     if errors not in ("raise", "collect"):
         raise GearshotError(f"errors must be 'raise' or 'collect'; got {errors!r}")
@@ -174,17 +177,33 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
     names = [machine.sensor(s).name for s in
              (sensors or ([sensor] if sensor else [s.name for s in machine.sensors]))]
     ratio = float(machine.speed_ratio(shaft))
-    baselines = _baselines(baseline_paths, machine, shaft, names)
-    records: list[dict[str, Any]] = []
     failures: list[dict[str, str]] = []
-    for path in paths:
+
+    def attempt(path, work):
+        """``work()``, or None with the failure collected (``errors="collect"``)."""
         try:
-            records += _record_rows(path, machine, shaft, names, baselines, ratio,
-                                    hints.get(str(path)))
+            return work()
         except GearshotError as exc:
             if errors == "raise":
                 raise
             failures.append({"file": str(path), "error": " ".join(str(exc).split())})
+            return None
+
+    reads = {str(p): attempt(p, lambda p=p: _read(p, machine, names, hints.get(str(p))))
+             for p in paths}
+    good = [r for r in reads.values() if r is not None]
+    # the machine file must put its mesh orders where the recordings have them (the
+    # healthy baseline recordings where given)
+    if baseline_paths or good:
+        verify_machine(machine, [Recording.read(p, machine=machine) for p in baseline_paths]
+                       if baseline_paths else [rec for rec, _ in good])
+    baselines = _baselines(baseline_paths, machine, shaft, names)
+    records: list[dict[str, Any]] = []
+    for path in paths:
+        read = reads[str(path)]
+        if read is not None:
+            records += attempt(path, lambda: _record_rows(path, machine, shaft, names,
+                                                          baselines, ratio, *read)) or []
     units = {n: indicator_units(machine, n) for n in names}
     payload = {"kind": "indicators", "machine": machine.name,
                "machine_file": None if machine_file is None else str(machine_file),
@@ -220,11 +239,11 @@ def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
     return {n: baseline_variance(recs, machine, shaft=shaft, sensor=n) for n in names}
 
 
-def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
-                 baselines: dict[str, float | None], ratio: float,
-                 hint: float | None = None) -> list[dict[str, Any]]:
-    """The payload records of one file: one per sensor."""
-    from ..features import available_features
+def _read(path: str | Path, machine, names: Sequence[str],
+          hint: float | None = None) -> tuple[Any, dict]:
+    """One file read with ``machine`` (``hint``: its speed hint, no tacho), the input
+    checks of its sensors ``names`` and its speed (read or tracked now: a record whose
+    speed cannot be found fails here, naming a failed sensor where that is why)."""
     from ..io import Recording
     from ..io._vibration import SPEED_HINT_KEY
     from ..io.input_health import check_input
@@ -234,13 +253,24 @@ def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
     checks = {n: check_input(rec.channel(n).acceleration, units=machine.sensor(n).unit)
               for n in names}
     try:
-        tacho = float(rec.shaft_speed())
+        rec.shaft_speed()
     except GearshotError as exc:   # no tacho: the speed comes from a failed sensor?
         bad = [f"{n}: {c.failed} ({c.reason})" for n, c in checks.items() if not c.ok]
         if bad:
             raise GearshotError(f"{str(path)!r} fails the input check of "
                                 f"{'; '.join(bad)}; {exc}") from None
         raise
+    return rec, checks
+
+
+def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
+                 baselines: dict[str, float | None], ratio: float,
+                 rec: Any, checks: dict) -> list[dict[str, Any]]:
+    """The payload records of one file (``rec``, ``checks``: :func:`_read`'s): one per
+    sensor."""
+    from ..features import available_features
+
+    tacho = float(rec.shaft_speed())
     rows = []
     for name in names:
         if checks[name].ok:

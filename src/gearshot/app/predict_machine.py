@@ -12,12 +12,15 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
+from ..io.input_health import (check_input, check_segments, input_check_column, mark_rows,
+                               require_ok)
+from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 from .trust import add_trust_columns
 
-__all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
+__all__ = ["machine_segments", "predict_from_machine", "machine_database_path",
+           "check_database_pair"]
 
 
 def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty: int,
@@ -36,8 +39,10 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
 
     ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
     machine without ``[tacho]``), ``speed_uncertainty_hz`` (rev/s of the reference
-    shaft, ``None`` with a tacho) and the sensor's input checks
-    (:mod:`gearshot.io.input_health`): ``recording`` and ``segments``.
+    shaft, ``None`` with a tacho), ``speed_check`` (``"ok"`` or why the tracked speed
+    is not to be trusted, :func:`gearshot.machine.signal_check.speed_check`) and the
+    sensor's input checks (:mod:`gearshot.io.input_health`): ``recording`` and
+    ``segments``.
 
     Returns
     -------
@@ -64,7 +69,8 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
                             f"{cycles_per_segment} is too many")
     blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
     if info is not None:
-        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty)
+        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty,
+                    speed_check=speed_check(machine, rec))
         info.update(_input_health(rec.channel(name).acceleration, blocks.mean(axis=1),
                                  machine.sensor(name).unit))
     return blocks.mean(axis=1), x, rec.shaft_speed()
@@ -150,7 +156,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
         load_source, load_clarity, predicted, low, high, comparability, comparable,
-        input_check, speed_source, speed_uncertainty_hz`` (``database_load``: the load
+        input_check, speed_source, speed_uncertainty_hz, speed_check, fit_check, trusted``
+        (``database_load``: the load
         estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or
         ``chosen`` (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
         recording's reference-shaft speed; ``database_speed_hz``: the condition it is
@@ -160,13 +167,14 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         fitted machine's healthy segments that look at least as far from it) and whether
         it is at least the stated false-alarm rate (0.01); ``speed_source``: ``tacho`` or
         ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
-        ``vibration``; ``input_check``: ``"ok"`` or the failed check of
+        ``vibration``; ``speed_check``: ``ok`` or why a tracked speed is not to be trusted
+        (such a row is not trusted); ``input_check``: ``"ok"`` or the failed check of
         :mod:`gearshot.io.input_health`, per recording and segment, with the row's
         ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
         recording that fails is refused), ``fit_check`` (the fit's verdict on its own
         hold-outs, the same in every row: "passed" or the reason,
         :attr:`OneFaultShotEstimator.fit_check_`) and ``trusted``
-        (:func:`gearshot.estimator.trusted_column`); ``attrs`` hold the ``fit_check``
+        (:func:`gearshot.estimator.trusted_column`: every check passes); ``attrs`` hold the ``fit_check``
         (:meth:`FitCheck.as_dict`), the condition (``speed_hz``, ``load``,
         ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade
         and the simulated reference.
@@ -176,6 +184,9 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     cps = _check_options(machine, healthy, [faulty, *recordings], cycles_per_segment,
                          holdout)
     database_conditions(database, machine)   # a bad --database fails now
+    check_database_pair(database, machine)
+    # the machine file must put its mesh orders where the healthy recordings have them
+    verify_machine(machine, healthy)
     seg = _segment_recordings(machine, healthy, faulty, recordings, cps=cps, sensor=sensor,
                               holdout=holdout, example_segment=example_segment)
     cond = _condition(database, machine, seg, speed=speed, load=load,
@@ -197,6 +208,35 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
 
     frame.attrs.update(fit_attrs(est))
     return frame
+
+
+def check_database_pair(database: str | Path, machine) -> None:
+    """Refuse a database simulated for another pair than the machine's monitored pair.
+
+    Teeth, module, face width, pressure angle and helix angle of the store's pair
+    (its manifest) must be those of :meth:`gearshot.Machine.gear_pair` (which itself
+    refuses a helical stage without its helix angle). A store whose manifest holds no
+    readable pair is left to the estimator's tooth check.
+    """
+    from ..sim._db_manifest import pair_from_manifest, read_manifest
+
+    want = machine.gear_pair()
+    have = pair_from_manifest(read_manifest(Path(database)))
+    if have is None:
+        return
+    diffs = []
+    for name, unit, scale in (("z_pinion", "", 1.0), ("z_gear", "", 1.0),
+                              ("module", " mm", 1e3), ("face_width", " mm", 1e3),
+                              ("pressure_angle", " deg", 180 / np.pi),
+                              ("helix_angle", " deg", 180 / np.pi)):
+        a, b = float(getattr(have, name)), float(getattr(want, name))
+        if not np.isclose(a, b, rtol=1e-9, atol=1e-12):
+            diffs.append(f"{name} {a * scale:g}{unit} in the database, {b * scale:g}{unit} "
+                         f"in the machine")
+    if diffs:
+        raise GearshotError(f"--database {str(database)!r} was simulated for another pair than "
+                            f"the monitored pair of machine {machine.name!r}: "
+                            f"{'; '.join(diffs)}; build it with gearshot simulate --machine")
 
 
 def _check_options(machine, healthy, others, cycles_per_segment, holdout) -> int:
@@ -336,4 +376,5 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
+    frame["speed_check"] = [seg.sources[r]["speed_check"] for r in frame["recording"]]
     return frame

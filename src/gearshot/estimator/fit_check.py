@@ -306,14 +306,16 @@ TRUST_COLUMNS = ("predicted", "low", "high", "comparability", "comparable", "inp
 
 
 def trusted_column(frame: Any) -> Any:
-    """The ``trusted`` column of a predict table: ``input_check == "ok"`` (a table
-    without ``input_check`` counts as "ok"), ``comparable`` and ``fit_check ==
-    "passed"`` (a table without ``fit_check`` is not trusted)."""
+    """The ``trusted`` column of a predict table: ``input_check == "ok"`` and
+    ``speed_check == "ok"`` (a table without either column counts as "ok"),
+    ``comparable`` and ``fit_check == "passed"`` (a table without ``fit_check`` is not
+    trusted)."""
     import pandas as pd
 
     ok = pd.Series(True, index=frame.index)
-    if "input_check" in frame:
-        ok &= frame["input_check"].astype(str) == "ok"
+    for check in ("input_check", "speed_check"):
+        if check in frame:
+            ok &= frame[check].astype(str) == "ok"
     ok &= frame["comparable"].astype(bool) if "comparable" in frame else False
     ok &= (frame["fit_check"].astype(str) == "passed") if "fit_check" in frame else False
     return ok.astype(bool)

@@ -32,11 +32,13 @@ class VibrationRecording(TachoRecording):
 
     @property
     def speed_uncertainty(self) -> float | None:
-        """Standard uncertainty (rev/s) of the instantaneous speed of the tracked shaft
-        estimated from the vibration (phase noise only); ``None`` with a tacho."""
+        """Standard uncertainty (rev/s) of the speed of the tracked shaft estimated from the
+        vibration (phase noise and a model term validated against a tacho,
+        :attr:`gearshot.signal.tracking.ShaftAngle.speed_uncertainty`); ``None`` with a
+        tacho."""
         if self.tacho is not None:
             return None
-        return float(self.vibration_angle().speed_std)
+        return float(self.vibration_angle().speed_uncertainty)
 
     def vibration_angle(self, *, orders: Any = None, speed_range: Any = None,
                         bandwidth: float | None = None):

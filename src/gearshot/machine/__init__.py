@@ -18,6 +18,7 @@ shafts is an exact fraction). It is read from a TOML file (:meth:`Machine.from_t
     face_width_mm = 15.0
     pressure_angle_deg = 20.0
     helix_angle_deg = 0.0
+    # helical = true               # helical teeth of unstated angle: not simulated
 
     [tacho]
     channel = "tacho"              # a name from [file].columns
@@ -59,6 +60,8 @@ Every error is a :class:`gearshot.GearshotError` naming the key and the bad valu
 
 The package: :mod:`.parts` (the dataclasses of a machine's parts), :mod:`.gearbox`
 (:class:`Machine`: the parts checked together, the gear train's exact speed ratios),
+:mod:`.signal_check` (the machine file verified against recordings: its mesh orders where
+it says, the tracked speed checked),
 :mod:`._tables` (one parser per table of the file), :mod:`._consistency` (the checks across
 parts, the speed-ratio solver), :mod:`._values` (single values and tables of a file).
 """

@@ -27,7 +27,7 @@ __all__ = ["machine_fields"]
 
 _TOP = {"name", "shafts", "stage", "tacho", "sensor", "file", "monitored", "analysis", "speed"}
 _STAGE = {"driver", "driver_teeth", "driven", "driven_teeth", "module_mm", "face_width_mm",
-          "pressure_angle_deg", "helix_angle_deg"}
+          "pressure_angle_deg", "helix_angle_deg", "helical"}
 #: optional stage geometry: file key, factor to SI, GearStage field
 _GEOMETRY = (("module_mm", 1e-3, "module"), ("face_width_mm", 1e-3, "face_width"),
              ("pressure_angle_deg", math.pi / 180, "pressure_angle"))
@@ -75,12 +75,18 @@ def _stage(st: Mapping[str, Any], i: int) -> GearStage:
             opt[field_name] = float_key(st[key], f"stage[{i}].{key}") * scale
     helix = math.radians(float_key(st.get("helix_angle_deg", 0.0),
                                    f"stage[{i}].helix_angle_deg", allow_zero=True))
+    helical = st.get("helical", helix > 0.0)
+    if not isinstance(helical, bool):
+        raise GearshotError(f"stage[{i}].helical must be true or false; got {helical!r}")
+    if helix > 0.0 and not helical:
+        raise GearshotError(f"stage[{i}]: helical = false contradicts helix_angle_deg = "
+                            f"{math.degrees(helix):g}")
     try:
         return GearStage(name_key(st["driver"], f"stage[{i}].driver"),
                          int_key(st["driver_teeth"], f"stage[{i}].driver_teeth"),
                          name_key(st["driven"], f"stage[{i}].driven"),
                          int_key(st["driven_teeth"], f"stage[{i}].driven_teeth"),
-                         helix_angle=helix, **opt)
+                         helix_angle=helix, helical=helical, **opt)
     except GearshotError as exc:
         raise GearshotError(f"stage[{i}]: {exc}") from None
 

@@ -192,14 +192,24 @@ class Machine:
         The simulator puts the fault on its driven gear (``z_gear``), so ``z_gear`` is the
         monitored gear and ``z_pinion`` its mate, whichever drives in the machine. Geometry
         missing from the description takes the paper's values (module 3 mm, face width
-        15 mm, 20 deg). ``helix_angle`` is passed only if ``GearPair`` accepts it.
-        """
-        import dataclasses
+        15 mm, 20 deg); the helix angle is the stage's (0: a spur pair).
 
+        Raises
+        ------
+        GearshotError
+            The monitored stage is helical (``helical = true``) but states no
+            ``helix_angle_deg``: simulated as a spur pair it would not be this machine's.
+        """
         from ..sim import GearPair
 
         st = self.monitored_stage()
         _, mate_teeth = self.mate()
+        if st.helical and st.helix_angle == 0.0:
+            raise GearshotError(
+                f"machine {self.name!r}: the monitored stage {st.driver} {st.driver_teeth}T "
+                f"-> {st.driven} {st.driven_teeth}T is helical but states no "
+                f"helix_angle_deg; the simulator would build a spur pair, not this "
+                f"machine's: state the helix angle in its [[stage]]")
         base = GearPair.paper()
         teeth = self._monitored().teeth
         kwargs: dict[str, Any] = dict(z_pinion=mate_teeth, z_gear=teeth)
@@ -211,15 +221,7 @@ class Machine:
             kwargs["face_width"] = st.face_width
         if st.pressure_angle is not None:
             kwargs["pressure_angle"] = st.pressure_angle
-        fields = {f.name for f in dataclasses.fields(GearPair)}
-        if "helix_angle" in fields:
-            kwargs["helix_angle"] = st.helix_angle
-        elif st.helix_angle:
-            import warnings
-
-            warnings.warn(f"GearPair has no helix_angle yet; the monitored pair is simulated "
-                          f"as a spur pair (helix angle {math.degrees(st.helix_angle):g} deg "
-                          f"ignored)", stacklevel=2)
+        kwargs["helix_angle"] = st.helix_angle
         kwargs.update(overrides)
         return GearPair.paper(**kwargs)
 

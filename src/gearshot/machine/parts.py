@@ -28,7 +28,11 @@ class GearStage:
     pressure_angle : float or None
         Normal pressure angle, rad.
     helix_angle : float
-        rad (0 for spur gears).
+        rad (0 for spur gears, or for helical gears whose angle is not stated).
+    helical : bool or None
+        Helical teeth (``helical = true`` in the file, with or without
+        ``helix_angle_deg``); default: ``helix_angle > 0``. A helical stage without its
+        angle cannot be simulated (:meth:`gearshot.Machine.gear_pair` refuses it).
     """
 
     driver: str
@@ -39,8 +43,11 @@ class GearStage:
     face_width: float | None = None
     pressure_angle: float | None = None
     helix_angle: float = 0.0
+    helical: bool | None = None
 
     def __post_init__(self) -> None:
+        if self.helical is None:
+            object.__setattr__(self, "helical", self.helix_angle > 0.0)
         name_key(self.driver, "stage.driver")
         name_key(self.driven, "stage.driven")
         int_key(self.driver_teeth, "stage.driver_teeth")
