@@ -202,8 +202,8 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
     for path in paths:
         read = reads[str(path)]
         if read is not None:
-            records += attempt(path, lambda: _record_rows(path, machine, shaft, names,
-                                                          baselines, ratio, *read)) or []
+            records += attempt(path, lambda p=path, r=read: _record_rows(
+                p, machine, shaft, names, baselines, ratio, *r)) or []
     units = {n: indicator_units(machine, n) for n in names}
     payload = {"kind": "indicators", "machine": machine.name,
                "machine_file": None if machine_file is None else str(machine_file),
