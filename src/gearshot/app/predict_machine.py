@@ -12,8 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..io.input_health import (check_input, check_segments, input_check_column, mark_rows,
-                               require_ok)
+from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
