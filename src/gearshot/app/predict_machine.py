@@ -173,8 +173,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         recording that fails is refused), ``fit_check`` (the fit's verdict on its own
         hold-outs, the same in every row: "passed" or the reason,
         :attr:`OneFaultShotEstimator.fit_check_`) and ``trusted``
-        (:func:`gearshot.estimator.trusted_column`: every check passes); ``attrs`` hold the ``fit_check``
-        (:meth:`FitCheck.as_dict`), the condition (``speed_hz``, ``load``,
+        (:func:`gearshot.estimator.trusted_column`: every check passes); ``attrs`` hold
+        the ``fit_check`` (:meth:`FitCheck.as_dict`), the condition (``speed_hz``, ``load``,
         ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade
         and the simulated reference.
     """
