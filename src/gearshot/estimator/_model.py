@@ -61,7 +61,9 @@ from .calibration import (
     resolve_calibration,
 )
 from .comparability import fit_comparability
+from .detection import detection_limit
 from .options import EstimatorOptions, resolve_options
+from .regressors import ESTIMATORS
 
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
@@ -145,6 +147,11 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         88.9 % at the worst condition). With an unpaired database (the paper's first
         healthy reference) the same range picks 0.14. 0 gives pure split-conformal
         intervals. There is no upper bound (intervals are clipped to [0, 1]).
+    estimator : {"paper", "isotonic", "boosting"}, default "paper"
+        Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): the
+        paper's KNN, an isotonic map of a learned linear score, or gradient-boosted trees.
+        Screened on the rig family's development range (issue #30, benchmarks/RESULTS.md
+        "Estimator: information limit and new default").
     random_state : int >= 0, numpy RandomState or Generator, or None
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
         step 1, the validation split of step 8 and the matched noise) gets its own child
@@ -205,6 +212,13 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         (:mod:`gearshot.estimator.comparability`).
     mesh_orders_ : tuple of int
         The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
+    detection_limit_ : float
+        The smallest size this fit tells apart from healthy at 95 % confidence, given
+        this machine's noise and the chosen grades
+        (:func:`~gearshot.estimator.detection.detection_limit`): estimates below it are
+        "below the detection limit" (:func:`~gearshot.estimator.below_detection_limit`).
+    detection_threshold_ : float
+        The 95 % quantile of the healthy validation rows' estimates it starts from.
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -221,6 +235,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
         "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
         "model_discrepancy": [Interval(float, 0, None)],
+        "estimator": [Options(ESTIMATORS)],
         "random_state": [RandomStateValue()],
         "options": [NoneValue(), Resolvable(
             resolve_options, "an EstimatorOptions or a mapping of its fields")],
@@ -234,7 +249,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                  rms_normalization: bool = True,
                  mesh_order: int | Sequence[int] | None = None,
                  fault_type: str | None = None, model_discrepancy: float = 0.12,
-                 random_state: Any = None,
+                 estimator: str = "paper", random_state: Any = None,
                  options: EstimatorOptions | Mapping[str, Any] | None = None) -> None:
         self.features = features
         self.feature_selection = feature_selection
@@ -246,6 +261,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         self.mesh_order = mesh_order
         self.fault_type = fault_type
         self.model_discrepancy = model_discrepancy
+        self.estimator = estimator
         self.random_state = random_state
         self.options = options
 
@@ -339,6 +355,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"], twins, seeds["match_noise"])
         grade_choice = self._choose_grades(ctx, grades, twins is not None)
+        detection = detection_limit(grade_choice["setting_models_"],
+                                    [st["weight"] for st in
+                                     grade_choice["calibration_"]["settings"]])
         comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
                                           faulty_example=inputs.faulty_example,
                                           faulty_size=inputs.faulty_size)
@@ -353,7 +372,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             selection_features_=selection.features, selected_columns_=cols,
             faulty_size_=inputs.faulty_size, step_seeds_=seeds,
             simulated_reference_=reference, comparability_reference_=comparability,
-            mesh_orders_=orders, **grade_choice)
+            mesh_orders_=orders, detection_limit_=detection.limit,
+            detection_threshold_=detection.threshold, **grade_choice)
         for name, value in learned.items():
             setattr(self, name, value)
         return self
