@@ -111,7 +111,7 @@ def grade_rows(db, grade, noise_scale, seed, candidates, *, tf=None, power=None,
         out["isotonic_rms"] = iso.predict(X4[test, 0])
         for name, X in (("gbm_paper4", X4), ("gbm_12", X12),
                         ("gbm_12_bands", np.hstack([X12, E]))):
-            gbm = HistGradientBoostingRegressor(loss="absolute_error", max_iter=200,
+            gbm = HistGradientBoostingRegressor(loss="absolute_error", max_iter=100,
                                                 learning_rate=0.05, random_state=seed)
             out[name] = np.clip(gbm.fit(X[train], y[train]).predict(X[test]), 0, 1)
     return out

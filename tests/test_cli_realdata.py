@@ -120,6 +120,12 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     assert not frame.loc[frame["role"] == "test", "comparable"].any()
     assert frame.loc[frame["role"] != "test", "comparable"].all()
     assert "comparable: 4 segment(s), not comparable: 4" in res.stdout
+    # issue #30 item 3: every estimate says whether it lies below the fit's detection
+    # limit; the flagged estimates are the smallest ones
+    flagged = frame["below_detection_limit"]
+    assert flagged.dtype == bool
+    if flagged.any() and not flagged.all():
+        assert frame.loc[flagged, "predicted"].max() < frame.loc[~flagged, "predicted"].min()
     out_json = tmp_path / "pred.json"
     res = run("predict", "--machine", str(SPUR), "--database", str(store), "--healthy",
               str(small["spur3"]), "--faulty", str(small["spur2"]), "--faulty-size", "0.5",
@@ -129,3 +135,4 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     records = json.loads(out_json.read_text())
     assert [r["comparable"] for r in records] == frame["comparable"].tolist()
     assert all(isinstance(r["comparable"], bool) for r in records)
+    assert [r["below_detection_limit"] for r in records] == flagged.tolist()

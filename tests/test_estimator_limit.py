@@ -78,3 +78,52 @@ def test_oracle_bad_inputs_name_the_argument(kwargs, word):
     args.update(kwargs)
     with pytest.raises(GearshotError, match=word):
         fit_template_oracle(**args)
+
+
+# ------------------------------------------------------------------ detection limit
+def _fit_with_noise(noise):
+    from estimator_data import paired_synthetic_database, synthetic_target, tf_pair
+
+    from gearshot.estimator import OneFaultShotEstimator
+
+    tfs = tf_pair()
+    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
+    healthy, long, faulty, y = synthetic_target(6, tfs[0], n_healthy=15, n_each=5,
+                                                noise=noise)
+    est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0)
+    return est.fit(db, healthy, faulty[7], y[7], long, selection_tf=tfs[1]), faulty, y
+
+
+def test_detection_limit_exists_and_grows_with_noise():
+    from gearshot.estimator import below_detection_limit
+
+    limits = []
+    for noise in (0.2, 2.0, 8.0):
+        est, faulty, y = _fit_with_noise(noise)
+        assert 0 <= est.detection_limit_ <= 1
+        assert est.detection_limit_ >= est.detection_threshold_
+        limits.append(est.detection_limit_)
+        pred = est.predict(faulty)
+        flags = below_detection_limit(est, pred)
+        assert flags.dtype == bool and flags.shape == pred.shape
+        np.testing.assert_array_equal(flags, pred < est.detection_limit_)
+    assert limits[0] < limits[1] < limits[2]
+
+
+def test_detection_limit_from_validation_rows():
+    from types import SimpleNamespace
+
+    from gearshot.estimator.detection import detection_limit
+
+    rng = np.random.default_rng(0)
+    y = np.r_[np.zeros(200), rng.uniform(0, 1, 800)]
+    pred = np.where(y == 0, np.abs(rng.normal(0, 0.05, y.size)), y + rng.normal(0, 0.02, y.size))
+    model = SimpleNamespace(validation_y=y, validation_prediction=pred)
+    found = detection_limit([model], [1.0])
+    # healthy estimates |N(0, 0.05)|: 95 % quantile 1.96 * 0.05; unbiased faulty estimates
+    assert found.threshold == pytest.approx(0.098, abs=0.015)
+    assert found.limit == pytest.approx(found.threshold, abs=0.02)
+    with pytest.raises(GearshotError, match="weights"):
+        detection_limit([model], [-1.0])
+    with pytest.raises(GearshotError, match="confidence"):
+        detection_limit([model], [1.0], confidence=1.5)

@@ -5,7 +5,8 @@ The reference file ``tests/data/paper_estimator_predictions.npz`` was written by
 commit 97efe7c (before issue #30); regenerate it only from such a tree::
 
     git archive 97efe7c src tests | tar -x -C /tmp/before
-    cd /tmp/before && PYTHONPATH=src:tests python <this tree>/tests/test_estimator_paper_identity.py \
+    cd /tmp/before && PYTHONPATH=src:tests python \
+        <this tree>/tests/test_estimator_paper_identity.py \
         <this tree>/tests/data/paper_estimator_predictions.npz
 """
 

@@ -58,7 +58,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         (roles: :data:`ROLES`; the last two from
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
     """
-    from ..estimator import OneFaultShotEstimator, default_selection_tf
+    from ..estimator import OneFaultShotEstimator, below_detection_limit, default_selection_tf
     from ..sim import load_database
     from .conditions import choose_condition
     from .files import expand_recordings
@@ -89,10 +89,13 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     for path, sa in targets:
         low, high = est.predict_interval(sa, coverage=coverage)
         comp = est.comparability(sa)
+        predicted = est.predict(sa)
         frames.append(pd.DataFrame(dict(recording=str(path),
                                         role=_roles(path, len(sa), fitted, faulty),
                                         segment=np.arange(len(sa)),
-                                        predicted=est.predict(sa), low=low, high=high,
+                                        predicted=predicted, low=low, high=high,
+                                        below_detection_limit=below_detection_limit(
+                                            est, predicted),
                                         comparability=comp.score,
                                         comparable=comp.comparable)))
     frame = pd.concat(frames, ignore_index=True)
