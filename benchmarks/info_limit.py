@@ -23,6 +23,8 @@ bin's signal-to-noise ratio as it is, so the identity path stands for all paths.
 * **oracle** (:mod:`gearshot.estimator.oracle`): templates of Δ on a size grid from the
   noise-free training components, Gaussian likelihood of the test's noisy difference
   spectrum outside the mesh bands, posterior median: the lowest MAE reachable there.
+* **oracle_magnitude**: the same with the spectra's magnitudes only (Rice likelihood per
+  bin): the limit when the fault's place in the cycle and the path's phase are unknown.
 * **paper**: step 7's four features of the noisy differences, centred on the healthy
   training rows, KNN with K chosen on a 70/30 split of the training rows (step 8): the
   paper's estimator with no domain gap (its simulated floor).
@@ -94,6 +96,9 @@ def grade_rows(db, grade, noise_scale, seed, candidates, *, tf=None, power=None,
 
     oracle = fit_template_oracle(delta[train], y[train], power, mesh_order=38, n_points=n)
     out["oracle"] = oracle.predict(noisy[test])
+    blind = fit_template_oracle(delta[train], y[train], power, mesh_order=38, n_points=n,
+                                phase=False)
+    out["oracle_magnitude"] = blind.predict(noisy[test])
 
     def centred(names):
         X = spectrum_features(noisy, n, 38, names=names)

@@ -47,6 +47,12 @@ def test_oracle_recovers_size_from_templates_and_known_noise():
     assert np.all(pred[:10] <= 0.02)           # healthy read as healthy
     post = oracle.posterior(noisy)
     assert np.allclose(post.sum(axis=1), 1)
+    # magnitudes only (the fault's place in the cycle unknown): still close, not better
+    blind = fit_template_oracle(_components(y_train, rng), y_train, power, mesh_order=MESH,
+                                n_points=N, bandwidth=0.01, phase=False)
+    err_blind = np.abs(blind.predict(noisy) - y_test)
+    assert np.mean(err_blind) < 0.05
+    assert np.mean(err_blind) >= np.mean(err) - 0.005
 
 
 def test_oracle_error_grows_with_noise():

@@ -14,6 +14,10 @@ the Bayes posterior of the size given the target's difference spectrum:
 * **prior**: the training sizes' histogram on the grid (healthy signals at ``y = 0``);
 * **estimate**: the posterior median (the minimiser of the expected absolute error).
 
+With ``phase=False`` only the magnitudes ``|X|`` count (a Rice likelihood per bin around
+``|T(y_j)|``): the limit of an estimator that does not know where in the revolution the
+fault sits or how the path turns its phase.
+
 The bins are those the difference signal keeps (the paper's step 7 removes the mesh
 harmonics and their ±2 sidebands, and DC): what no estimator of the difference signal sees
 is not counted. Used by ``benchmarks/info_limit.py`` to measure the lowest error reachable in
@@ -88,6 +92,8 @@ class TemplateOracle:
         Variance per bin of the fault components around ``T(y)`` plus the noise power.
     log_prior : ndarray (n_grid,)
         Log prior weight of each grid size.
+    phase : bool
+        Whether the likelihood uses the spectra's phases (else magnitudes only).
     """
 
     grid: FloatArray
@@ -95,6 +101,7 @@ class TemplateOracle:
     templates: ComplexArray
     variance: FloatArray
     log_prior: FloatArray
+    phase: bool = True
 
     def log_posterior(self, spectra: ArrayLike) -> FloatArray:
         """Unnormalised log posterior of every grid size for every spectrum.
@@ -118,10 +125,27 @@ class TemplateOracle:
         out = np.empty((x.shape[0], self.grid.size))
         rows = max(1, _BLOCK // (self.grid.size * self.bins.size))
         inv = 1.0 / self.variance
+        if not self.phase:
+            return np.asarray(self._log_rice(np.abs(x), inv, rows) + self.log_prior,
+                              dtype=np.float64)
         for i in range(0, x.shape[0], rows):
             d = x[i:i + rows, None, :] - self.templates[None, :, :]
             out[i:i + rows] = -np.einsum("rgb,gb->rg", d.real ** 2 + d.imag ** 2, inv)
         return np.asarray(out - log_norm + self.log_prior, dtype=np.float64)
+
+    def _log_rice(self, r: FloatArray, inv: FloatArray, rows: int) -> FloatArray:
+        """Sum over bins of the Rice log-density of magnitudes ``r`` (n, n_bins) around
+        ``|T|`` with ``E|noise|² = variance`` (terms free of the grid dropped)."""
+        from scipy.special import i0e
+
+        amp = np.abs(self.templates)
+        out = np.empty((r.shape[0], self.grid.size))
+        base = -np.sum(np.log(self.variance), axis=1) - np.sum(amp ** 2 * inv, axis=1)
+        for i in range(0, r.shape[0], rows):
+            z = 2.0 * r[i:i + rows, None, :] * amp[None, :, :] * inv[None, :, :]
+            out[i:i + rows] = (np.sum(np.log(i0e(z)) + z, axis=2)
+                               - np.einsum("rb,gb->rg", r[i:i + rows] ** 2, inv) + base)
+        return out
 
     def posterior(self, spectra: ArrayLike) -> FloatArray:
         """Posterior probabilities of the grid sizes (rows sum to 1), (n_signals, n_grid)."""
@@ -140,7 +164,7 @@ class TemplateOracle:
 def fit_template_oracle(differences: ArrayLike, fault_size: ArrayLike,
                         noise_power: ArrayLike, *, mesh_order: int | Sequence[int],
                         n_points: int, n_grid: int = 101,
-                        bandwidth: float = 0.02) -> TemplateOracle:
+                        bandwidth: float = 0.02, phase: bool = True) -> TemplateOracle:
     """Templates of the fault component from noise-free difference spectra.
 
     Parameters
@@ -161,6 +185,8 @@ def fit_template_oracle(differences: ArrayLike, fault_size: ArrayLike,
     bandwidth : float > 0, default 0.02
         Standard deviation in size units of the Gaussian kernel that smooths the
         templates over ``y``.
+    phase : bool, default True
+        Use the complex spectra (False: their magnitudes only, a Rice likelihood).
 
     Returns
     -------
@@ -213,4 +239,4 @@ def fit_template_oracle(differences: ArrayLike, fault_size: ArrayLike,
     prior = (counts + 0.5) / (counts.sum() + 0.5 * n_grid)
     return TemplateOracle(grid, bins, np.asarray(templates, np.complex128),
                           np.asarray(scatter + power[bins][None, :], np.float64),
-                          np.log(prior))
+                          np.log(prior), bool(phase))
