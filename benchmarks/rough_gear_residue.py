@@ -21,8 +21,12 @@ import numpy as np
 def main():
     from gearshot.estimator import OneFaultShotEstimator, steps
     from gearshot.estimator.oracle import fault_bins
-    from gearshot.experiments.family import (SA_PIPELINE_VERSION, draw_family,
-                                             family_database, family_paths)
+    from gearshot.experiments.family import (
+        SA_PIPELINE_VERSION,
+        draw_family,
+        family_database,
+        family_paths,
+    )
     from gearshot.experiments.family_rigs import rig_segments
     from gearshot.experiments.rig import rig_dataset
     from gearshot.paper import RIG_HEALTHY_RECORDINGS, TABLE1_SIZES
