@@ -124,6 +124,12 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     assert not frame["comparable"].any()
     assert "comparable: 0 segment(s), not comparable: 8" in res.stdout
     assert "comparability is not calibrated" in res.stdout
+    # issue #30 item 3: every estimate says whether it lies below the fit's detection
+    # limit; the flagged estimates are the smallest ones
+    flagged = frame["below_detection_limit"]
+    assert flagged.dtype == bool
+    if flagged.any() and not flagged.all():
+        assert frame.loc[flagged, "predicted"].max() < frame.loc[~flagged, "predicted"].min()
     out_json = tmp_path / "pred.json"
     res = run("predict", "--machine", str(SPUR), "--database", str(store), "--healthy",
               str(small["spur3"]), "--faulty", str(small["spur2"]), "--faulty-size", "0.5",
@@ -133,3 +139,4 @@ def test_simulate_and_predict_with_a_machine_end_to_end(small, tmp_path):
     records = json.loads(out_json.read_text())["rows"]
     assert [r["comparable"] for r in records] == frame["comparable"].tolist()
     assert all(isinstance(r["comparable"], bool) for r in records)
+    assert [r["below_detection_limit"] for r in records] == flagged.tolist()

@@ -27,7 +27,7 @@ def test_default_is_the_papers_four():
     assert out.shape == (5, 4)
     everything = features.extract_features(gear_sa(rng=rng, n=3), MESH,
                                            names=features.available_features())
-    assert everything.shape == (3, 10)
+    assert everything.shape == (3, 18)   # 10 indicators + 8 band RMS (issue #30)
     assert set(features.available_features()) >= {"fm0", "fm4", "m6a", "m8a", "na4", "er"}
 
 
@@ -88,3 +88,21 @@ def test_unknown_name_lists_valid_ones():
         features.extract_features(np.zeros((1, N)), MESH, names=["nope"])
     with pytest.raises(GearshotError, match="baseline_variance"):
         features.extract_features(np.zeros((1, N)), MESH, names="na4", baseline_variance=-1.0)
+
+
+def test_band_rms_splits_the_difference_signal_by_order():
+    """Issue #30's band features: a tone at order k lands in band 1 + 8 (k - 1) // 1024
+    with its RMS a / sqrt(2); with the mean, the bands' squares sum to rms_diff²."""
+    n = 2048
+    theta = np.arange(n) / n
+    names = [f"band_rms_{k}" for k in range(1, 9)]
+    for order, band in ((5, 1), (300, 3), (1000, 8)):
+        tone = 2.0 * np.cos(2 * np.pi * order * theta)
+        f = features.extract_features(tone, 38, names=names)
+        expected = np.zeros(8)
+        expected[band - 1] = 2.0 / np.sqrt(2)
+        np.testing.assert_allclose(f, expected, atol=1e-12)
+    x = np.random.default_rng(0).normal(size=(4, n))
+    f = features.extract_features(x, 38, names=["rms_diff", *names])
+    np.testing.assert_allclose(np.sum(f[:, 1:] ** 2, axis=1) + x.mean(axis=1) ** 2,
+                               f[:, 0] ** 2, rtol=1e-10)

@@ -141,3 +141,4 @@ def test_cli_predict_refuses_recordings_of_another_tooth_count(db40, tmp_path):
     assert ok.returncode == 0, ok.stderr
     frame = pd.read_csv(tmp_path / "p.csv")
     assert len(frame) >= 1 and frame["predicted"].between(0, 1).all()
+    assert frame["below_detection_limit"].dtype == bool    # issue #30: every row says

@@ -20,6 +20,11 @@ The classical indicators follow Zakrajsek (1993) and Decker (2002):
 ``er``   energy ratio: RMS of the Zakrajsek difference signal ÷ RMS of the regular meshing
          signal (mesh harmonics and first-order sidebands)
 
+Spectral shape of the difference signal (issue #30):
+
+``band_rms_1`` … ``band_rms_8``  RMS of the difference signal in 8 equal-width order bands
+         of ``1 … n_points // 2`` (with the mean, their squares sum to ``rms_diff²``)
+
 Moment ratios of signals whose RMS is below ``1e-10`` are 0 (the reference's convention).
 """
 
@@ -124,6 +129,27 @@ def _er(p: _Parts) -> FloatArray:
         return cast(FloatArray, np.where(den < _TINY_RMS, 0.0, _rms(p.zakrajsek_diff) / den))
 
 
+#: Equal-width order bands of the difference spectrum (``band_rms_1`` … ``band_rms_8``).
+N_BANDS = 8
+
+
+def _band_rms(k: int) -> _Feature:
+    """RMS of the difference signal's content in the ``k``-th of :data:`N_BANDS` equal
+    order bands of ``1 … n // 2`` (Parseval on the one-sided difference spectrum)."""
+    def band(p: _Parts) -> FloatArray:
+        edges = np.linspace(1, p.n // 2 + 1, N_BANDS + 1).astype(int)
+        part = p.diff_spectrum[..., edges[k - 1]:edges[k]]
+        power = 2.0 * np.sum(part.real ** 2 + part.imag ** 2, axis=-1)
+        if edges[k] == p.n // 2 + 1 and p.n % 2 == 0:     # Nyquist counted once
+            nyq = p.diff_spectrum[..., p.n // 2]
+            power -= nyq.real ** 2 + nyq.imag ** 2
+        return cast(FloatArray, np.sqrt(np.maximum(power, 0.0)) / p.n)
+    return band
+
+
+for _k in range(1, N_BANDS + 1):
+    _register(f"band_rms_{_k}")(_band_rms(_k))
+
 FEATURES = MappingProxyType(_REGISTRY)
 """Read-only mapping of feature name → function of the shared decomposition."""
 
@@ -137,7 +163,7 @@ def available_features() -> tuple[str, ...]:
     >>> available_features()[:4]    # the paper's four come first
     ('rms_diff', 'kurtosis_diff', 'rms_env_diff', 'skewness_env_diff')
     >>> len(available_features())
-    10
+    18
     """
     return tuple(_REGISTRY)
 

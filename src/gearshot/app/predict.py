@@ -78,7 +78,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         :meth:`~gearshot.estimator.fit_check.FitCheck.as_dict`. A healthy or faulty
         recording that fails an input check is refused.
     """
-    from ..estimator import OneFaultShotEstimator, default_selection_tf
+    from ..estimator import OneFaultShotEstimator, below_detection_limit, default_selection_tf
     from ..sim import load_database
     from .conditions import choose_condition
     from .files import expand_recordings
@@ -134,12 +134,16 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
 def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFrame:
     """One row per SA segment of one recording: estimate, interval, comparability and the
     input checks of its segments (``health``: resolved path -> checks)."""
+    from ..estimator import below_detection_limit
+
     low, high = est.predict_interval(sa, coverage=coverage)
     comp = est.comparability(sa)
+    predicted = est.predict(sa)
     rows = pd.DataFrame(dict(recording=str(path), role=roles,
-                             segment=start + np.arange(len(sa)), predicted=est.predict(sa),
-                             low=low, high=high, comparability=comp.p_value,
-                             comparable=comp.comparable))
+                             segment=start + np.arange(len(sa)), predicted=predicted,
+                             low=low, high=high,
+                             below_detection_limit=below_detection_limit(est, predicted),
+                             comparability=comp.p_value, comparable=comp.comparable))
     return mark_rows(rows, input_check_column(**health[_key(path)], rows=rows["segment"]))
 
 

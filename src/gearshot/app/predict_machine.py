@@ -360,10 +360,13 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["load_source"] = cond.load_source
     frame["load_clarity"] = None if cond.choice is None else cond.choice.clarity
     if seg.rows:
+        from ..estimator import below_detection_limit
+
         sas = np.stack([r[4] for r in seg.rows])
         low, high = est.predict_interval(sas, coverage=coverage)
         frame["predicted"] = est.predict(sas)
         frame["low"], frame["high"] = low, high
+        frame["below_detection_limit"] = below_detection_limit(est, frame["predicted"])
         frame["comparability"], frame["comparable"] = _comparability_columns(est, sas)
     frame.attrs["speed_hz"], frame.attrs["load"] = cond.speed, cond.load
     frame.attrs["load_source"] = cond.load_source

@@ -19,6 +19,7 @@ from ._model import STEP_SEEDS, OneFaultShotEstimator, default_selection_tf
 from ._params import check_estimator_params
 from .calibration import CalibrationOptions
 from .comparability import Comparability, ComparabilityReference, harmonic_profile
+from .detection import DETECTION_CONFIDENCE, below_detection_limit
 from .fit_check import FitCheck, check_fit, trusted_column
 from .options import EstimatorOptions
 from .persistence import load_estimator, save_estimator
@@ -81,4 +82,6 @@ __all__ = [
     "save_estimator",
     "load_estimator",
     "check_estimator_params",
+    "below_detection_limit",
+    "DETECTION_CONFIDENCE",
 ]

@@ -18,7 +18,7 @@ from ._inputs import _FitInputs
 from ._simulated import residue_noise_spectrum
 from ._target import _TargetSide, target_features
 from .calibration import resolve_calibration
-from .knn import KnnModel
+from .regressors import StepModel, fit_regressor
 from .uncertainty import grade_weights
 from .zero_shot import healthy_signature, match_grade, signature_weights
 
@@ -46,7 +46,7 @@ class _GradeChoice:
     weights: dict[int, float]
     tuning_curve: dict[str, Any] | None
     settings: list[dict[str, Any]] | None = None
-    models: list[KnnModel] | None = None
+    models: list[StepModel] | None = None
     grid: dict[str, Any] | None = None
 
 
@@ -60,7 +60,7 @@ class _FitContext:
     target: _TargetSide
     inputs: _FitInputs
     example_features: Callable[[], FloatArray]
-    model_for: Callable[[int], KnnModel]
+    model_for: Callable[[int], StepModel]
     names: tuple[str, ...] = ()
     cols: list[int] | None = None
     twins: Mapping[int, FloatArray] | None = None
@@ -155,10 +155,10 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
 
         (The closures hold the context's parts, not the context: no reference cycle keeps
         a fit's arrays alive after it.)"""
-        models: dict[int, KnnModel] = {}
+        models: dict[int, StepModel] = {}
         cache: dict[str, Any] = {}
 
-        def model_for(grade: int) -> KnnModel:
+        def model_for(grade: int) -> StepModel:
             if grade not in models:
                 sa = by_grade[grade][0]
                 models[grade] = self._fit_grade_model(
@@ -181,7 +181,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                          names: tuple[str, ...], cols: list[int], seed: int,
                          twins: FloatArray | None = None,
                          noise_spectrum: NDArray[np.complex128] | None = None,
-                         kept: dict[str, Any] | None = None) -> KnnModel:
+                         kept: dict[str, Any] | None = None) -> StepModel:
         """Steps 4–8 for one grade: its simulated features with the target healthy, KNN.
 
         With twins (``simulated_reference="twin"``), step 6 subtracts each signal's twin
@@ -197,7 +197,8 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         X = np.vstack([X_sim, target.healthy_features[:, cols]])
         labels = np.concatenate([y, np.zeros(len(target.healthy_features))])
         opts = self._options()
-        return steps.fit_knn(X, labels, n_neighbors=opts.n_neighbors,
+        return fit_regressor(getattr(self, "estimator", "paper"), X, labels,
+                             n_neighbors=opts.n_neighbors,
                              validation_fraction=opts.validation_fraction, random_state=seed)
 
     # ------------------------------------------------------------------ fit: grade choice
@@ -217,7 +218,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         for st in settings:
             grade_w[st["grade"]] = grade_w.get(st["grade"], 0.0) + st["weight"]
         grade_w = dict(sorted(grade_w.items(), key=lambda kv: -kv[1]))
-        models: dict[int, KnnModel] = {}
+        models: dict[int, StepModel] = {}
         for st, m in zip(settings, setting_models):
             models.setdefault(st["grade"], m)   # settings come largest weight first
         joint = choice.settings is not None
@@ -288,7 +289,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         return _GradeChoice(grade, weights, tuning_curve)
 
     def _settings_of(self, choice: _GradeChoice, ctx: _FitContext
-                     ) -> tuple[list[dict[str, Any]], list[KnnModel]]:
+                     ) -> tuple[list[dict[str, Any]], list[StepModel]]:
         """The weighted settings and their models (grade strategies: one per grade)."""
         if choice.settings is not None and choice.models is not None:
             return choice.settings, choice.models

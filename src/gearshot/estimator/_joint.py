@@ -20,7 +20,7 @@ from .calibration import (
     setting_differences,
     setting_log_likelihoods,
 )
-from .knn import KnnModel
+from .regressors import StepModel, fit_regressor
 from .uncertainty import prune_weights
 
 FloatArray = NDArray[np.float64]
@@ -126,7 +126,7 @@ class _JointCalibration(BaseEstimator):  # type: ignore[misc,unused-ignore]
         loglik = np.sum([setting_log_likelihoods(x, sims, spread) for x in examples], axis=0)
         return keys, loglik
 
-    def _fit_setting_model(self, ctx: _FitContext, setting: Mapping[str, Any]) -> KnnModel:
+    def _fit_setting_model(self, ctx: _FitContext, setting: Mapping[str, Any]) -> StepModel:
         """Steps 4–8 for one calibration setting on its grade's whole simulated set."""
         assert ctx.twins is not None and ctx.cols is not None
         g = int(setting["grade"])
@@ -143,6 +143,7 @@ class _JointCalibration(BaseEstimator):  # type: ignore[misc,unused-ignore]
         X = np.vstack([feats, ctx.target.healthy_features[:, ctx.cols]])
         labels = np.concatenate([y, np.zeros(len(ctx.target.healthy_features))])
         opts = self._options()
-        return steps.fit_knn(X, labels, n_neighbors=opts.n_neighbors,
+        return fit_regressor(getattr(self, "estimator", "paper"), X, labels,
+                             n_neighbors=opts.n_neighbors,
                              validation_fraction=opts.validation_fraction,
                              random_state=ctx.knn_seed)

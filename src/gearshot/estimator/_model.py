@@ -61,8 +61,10 @@ from .calibration import (
     resolve_calibration,
 )
 from .comparability import fit_comparability
+from .detection import detection_limit
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
+from .regressors import ESTIMATORS
 
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
@@ -146,6 +148,11 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         88.9 % at the worst condition). With an unpaired database (the paper's first
         healthy reference) the same range picks 0.14. 0 gives pure split-conformal
         intervals. There is no upper bound (intervals are clipped to [0, 1]).
+    estimator : {"paper", "isotonic", "boosting"}, default "paper"
+        Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): the
+        paper's KNN, an isotonic map of a learned linear score, or gradient-boosted trees.
+        Screened on the rig family's development range (issue #30, benchmarks/RESULTS.md
+        "Estimator: information limit and new default").
     random_state : int >= 0, numpy RandomState or Generator, or None
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
         step 1, the validation split of step 8 and the matched noise) gets its own child
@@ -184,14 +191,12 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     target_residue_power_ : ndarray (n_points // 2 + 1,)
         Power spectrum of the target's healthy difference signals (step 6 output): what
         the twin reference adds to the simulated differences as noise.
-    n_neighbors_ : int
-    n_points_ : int
+    n_neighbors_, n_points_ : int
     faulty_size_ : float or None
     step_seeds_ : dict step → int
         The seeds the random steps used.
     simulated_reference_ : {"first_healthy", "twin"}
-        The simulated reference step 6 used (``options.simulated_reference`` with "auto"
-        resolved).
+        Step 6's reference (``options.simulated_reference``, "auto" resolved).
     calibration_ : dict
         What the example calibrated: ``strategy`` ("grade" or "joint"), ``settings`` (list
         of dicts ``grade, gain, width, tf, noise, weight`` — and ``log_likelihood`` with
@@ -208,11 +213,12 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     mesh_orders_ : tuple of int
         The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
     fit_check_ : FitCheck
-        The fit's own hold-outs read back (:mod:`gearshot.estimator.fit_check`): healthy
-        SAs kept out of the fit against 0, the example record's other segments against
-        ``faulty_size``, their counts and a ``verdict`` ("passed" or the reason;
-        "unchecked: ..." with too few hold-outs). Its residuals calibrate
-        :meth:`predict_interval`.
+        The fit's hold-outs read back against 0 and ``faulty_size`` and a ``verdict``
+        (:mod:`~gearshot.estimator.fit_check`); they calibrate :meth:`predict_interval`.
+    detection_limit_, detection_threshold_ : float
+        The smallest size told apart from healthy at 95 % confidence, and the healthy
+        validation estimates' 95 % quantile it starts from
+        (:mod:`~gearshot.estimator.detection`).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -229,6 +235,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
         "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
         "model_discrepancy": [Interval(float, 0, None)],
+        "estimator": [Options(ESTIMATORS)],
         "random_state": [RandomStateValue()],
         "options": [NoneValue(), Resolvable(
             resolve_options, "an EstimatorOptions or a mapping of its fields")],
@@ -242,7 +249,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                  rms_normalization: bool = True,
                  mesh_order: int | Sequence[int] | None = None,
                  fault_type: str | None = None, model_discrepancy: float = 0.12,
-                 random_state: Any = None,
+                 estimator: str = "paper", random_state: Any = None,
                  options: EstimatorOptions | Mapping[str, Any] | None = None) -> None:
         self.features = features
         self.feature_selection = feature_selection
@@ -254,6 +261,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         self.mesh_order = mesh_order
         self.fault_type = fault_type
         self.model_discrepancy = model_discrepancy
+        self.estimator = estimator
         self.random_state = random_state
         self.options = options
 
@@ -368,6 +376,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"], twins, seeds["match_noise"])
         grade_choice = self._choose_grades(ctx, grades, twins is not None)
+        detection = detection_limit(grade_choice["setting_models_"],
+                                    [st["weight"] for st in
+                                     grade_choice["calibration_"]["settings"]])
         comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
                                           faulty_example=inputs.faulty_example,
                                           faulty_size=inputs.faulty_size)
@@ -382,7 +393,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             selection_features_=selection.features, selected_columns_=cols,
             faulty_size_=inputs.faulty_size, step_seeds_=seeds,
             simulated_reference_=reference, comparability_reference_=comparability,
-            mesh_orders_=orders, **grade_choice)
+            mesh_orders_=orders, detection_limit_=detection.limit,
+            detection_threshold_=detection.threshold, **grade_choice)
         for name, value in learned.items():
             setattr(self, name, value)
         return self

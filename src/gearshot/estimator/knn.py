@@ -46,6 +46,9 @@ class KnnModel:
         Labels of the validation split.
     validation_indices : ndarray of int
         Rows of the training data in the validation split.
+    validation_prediction : ndarray or None
+        ``ŷ`` on the validation split at the chosen K (the detection limit reads the
+        healthy rows' estimates from it; None in models saved before it existed).
     """
 
     pipeline: Pipeline
@@ -54,6 +57,7 @@ class KnnModel:
     validation_residuals: FloatArray
     validation_y: FloatArray
     validation_indices: NDArray[np.intp]
+    validation_prediction: FloatArray | None = None
 
     def predict(self, X: ArrayLike) -> FloatArray:
         """Fault sizes of feature rows ``X`` (n_samples, n_features): the pipeline's
@@ -177,4 +181,5 @@ def fit_knn(X: ArrayLike, y: ArrayLike, *, n_neighbors: Iterable[int] = range(1,
         scaler = StandardScaler(with_mean=False).fit(X)
         knn = KNeighborsRegressor(n_neighbors=best).fit(X / scaler.scale_, y)
     final = Pipeline([("scale", scaler), ("knn", knn)])
-    return KnnModel(final, best, mae_all, residuals, y[val], val)
+    return KnnModel(final, best, mae_all, residuals, y[val], val,
+                    np.asarray(running_mean[:, best - 1], dtype=np.float64))

@@ -37,6 +37,8 @@ SAFE_TYPES = (
     "builtins.range",
     "gearshot.estimator._model.OneFaultShotEstimator",
     "gearshot.estimator.knn.KnnModel",
+    "gearshot.estimator.regressors.LearnedModel",
+    "gearshot.estimator.regressors.ScoreIsotonic",
     "gearshot.estimator.calibration.CalibrationOptions",
     "gearshot.estimator.options.EstimatorOptions",
     "gearshot.estimator.comparability.Comparability",

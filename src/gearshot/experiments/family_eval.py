@@ -87,6 +87,19 @@ def _interval_sweep(est, test_sa, test_size, coverage=0.9):
             "n_selected": len(est.selected_features_)}
 
 
+def _detection_check(est, pred, test_size) -> dict:
+    """The fit's ``detection_limit_`` and how the test segments fall about it (issue #30):
+    the share of healthy segments below it and of faulty ones of size ≥ 2 × limit above."""
+    limit = getattr(est, "detection_limit_", None)
+    if limit is None:
+        return {}
+    below = pred < limit
+    healthy, big = test_size == 0, test_size >= 2 * limit
+    return dict(detection_limit=float(limit), n_healthy_test=int(healthy.sum()),
+                healthy_below=int(np.sum(below & healthy)), n_faulty_2x=int(big.sum()),
+                faulty_2x_above=int(np.sum(~below & big)))
+
+
 def family_task(spec: dict) -> list[dict]:
     """Every (draw, variant) of one rig; runs on a Dask worker or in-process."""
     import dask
@@ -143,7 +156,9 @@ def _family_rows(spec: dict) -> list[dict]:
         for row in out:
             pred = row.pop("prediction")
             row["fitted_grade"] = row.pop("grade")  # "grade" is the rig's true grade
-            row.update(_interval_sweep(row.pop("estimator"), ds.test_sa, ds.test_size))
+            est = row.pop("estimator")
+            row.update(_interval_sweep(est, ds.test_sa, ds.test_size))
+            row.update(_detection_check(est, pred, ds.test_size))
             by_size = {f"{y:.2f}": float(np.mean(pred[ds.test_size == y]))
                        for y in np.unique(ds.test_size)}
             rows.append(dict(config=spec["config"], **asdict(rig), draw=draw,

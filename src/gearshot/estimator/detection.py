@@ -1,0 +1,148 @@
+"""The smallest fault size a fit can tell apart from healthy: ``detection_limit_``.
+
+Every model that predicts (a grade or a calibration setting, with its weight) held out a
+validation split of its simulated rows with the target's matched noise and the target's
+own healthy rows. Its healthy validation rows show what a healthy gear reads as under this
+machine's noise and grade; its faulty rows how the estimate grows with the size:
+
+* **threshold**: the ``confidence`` quantile (default 95 %) of the healthy rows'
+  estimates, pooled over the models with their weights: a healthy segment reads below it
+  with that probability;
+* **size-to-estimate curve**: the weighted isotonic (increasing) fit of the validation
+  estimates on the true sizes;
+* **limit**: the smallest size whose curve reaches the threshold (where an estimate of a
+  fault that size is as likely above as below it), and at least the threshold itself.
+
+An estimate below the limit says "not told apart from healthy at this confidence", not a
+small size (:func:`below_detection_limit`, the ``below_detection_limit`` column of
+``gearshot predict``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from sklearn.isotonic import IsotonicRegression
+
+from .._errors import GearshotError, NotFittedError
+
+__all__ = ["DETECTION_CONFIDENCE", "DetectionLimit", "below_detection_limit",
+           "detection_limit"]
+
+FloatArray = NDArray[np.float64]
+
+#: Share of healthy estimates below the threshold (the limit's stated confidence).
+DETECTION_CONFIDENCE = 0.95
+
+
+@dataclass(frozen=True)
+class DetectionLimit:
+    """What :func:`detection_limit` found.
+
+    Attributes
+    ----------
+    limit : float
+        Smallest size told apart from healthy (in [0, 1]).
+    threshold : float
+        The healthy estimates' ``confidence`` quantile.
+    confidence : float
+    """
+
+    limit: float
+    threshold: float
+    confidence: float
+
+
+def _weighted_quantile(values: FloatArray, weights: FloatArray, q: float) -> float:
+    order = np.argsort(values, kind="stable")
+    cum = np.cumsum(weights[order])
+    return float(values[order][min(int(np.searchsorted(cum, q * cum[-1])), len(cum) - 1)])
+
+
+def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
+                    confidence: float = DETECTION_CONFIDENCE,
+                    n_grid: int = 201) -> DetectionLimit:
+    """The detection limit of weighted step-8 models from their validation splits.
+
+    Parameters
+    ----------
+    models : sequence of KnnModel or LearnedModel
+        Each with ``validation_y`` and ``validation_prediction``.
+    weights : sequence of float >= 0
+        One per model (e.g. the calibration settings' weights).
+    confidence : float in (0, 1), default 0.95
+    n_grid : int, default 201
+        Sizes on [0, 1] where the curve is read.
+
+    Returns
+    -------
+    DetectionLimit
+
+    Raises
+    ------
+    GearshotError
+        When no model holds healthy and faulty validation rows with their estimates, or
+        on a bad ``confidence`` or weights.
+    """
+    if not 0 < confidence < 1:
+        raise GearshotError(f"confidence must lie in (0, 1); got {confidence!r}")
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (len(models),) or not np.all(np.isfinite(w)) or np.any(w < 0) \
+            or w.sum() <= 0:
+        raise GearshotError(f"weights must hold one finite weight >= 0 per model "
+                            f"({len(models)}), not all 0; got {list(w)!r}")
+    ys, preds, row_w = [], [], []
+    for model, weight in zip(models, w):
+        pred = getattr(model, "validation_prediction", None)
+        if pred is None or weight == 0:
+            continue
+        y = np.asarray(model.validation_y, dtype=float)
+        ys.append(y)
+        preds.append(np.asarray(pred, dtype=float))
+        row_w.append(np.full(y.size, weight / y.size))
+    if not ys:
+        raise GearshotError("detection_limit needs models with validation estimates "
+                            "(fitted by this version of gearshot)")
+    y, pred, rw = np.concatenate(ys), np.concatenate(preds), np.concatenate(row_w)
+    healthy = y == 0
+    if not healthy.any() or healthy.all():
+        raise GearshotError(f"detection_limit needs healthy and faulty validation rows; got "
+                            f"{int(healthy.sum())} healthy of {y.size}")
+    threshold = _weighted_quantile(pred[healthy], rw[healthy], confidence)
+    curve = IsotonicRegression(increasing=True, out_of_bounds="clip").fit(
+        y, pred, sample_weight=rw)
+    grid = np.linspace(0.0, 1.0, n_grid)
+    reached = np.flatnonzero(curve.predict(grid) >= threshold)
+    crossing = float(grid[reached[0]]) if reached.size else 1.0
+    return DetectionLimit(float(min(1.0, max(crossing, threshold))), threshold,
+                          float(confidence))
+
+
+def below_detection_limit(estimator: Any, estimates: ArrayLike) -> NDArray[np.bool_]:
+    """Whether each estimate lies below the fitted estimator's ``detection_limit_``.
+
+    Parameters
+    ----------
+    estimator : OneFaultShotEstimator
+        Fitted.
+    estimates : array_like (n,)
+        Its size estimates (``predict``).
+
+    Returns
+    -------
+    ndarray of bool (n,)
+        True where the estimate does not tell the segment apart from healthy (an estimator
+        fitted before ``detection_limit_`` existed: all False).
+    """
+    if not hasattr(estimator, "model_"):
+        raise NotFittedError(f"{type(estimator).__name__} is not fitted; fit it before "
+                             f"asking for its detection limit")
+    limit = getattr(estimator, "detection_limit_", None)
+    values = np.asarray(estimates, dtype=float)
+    if limit is None:
+        return np.zeros(values.shape, dtype=bool)
+    return np.asarray(values < float(limit), dtype=bool)

@@ -1,0 +1,165 @@
+"""Step 8's regressor, by name: the paper's KNN and the learners screened beyond it.
+
+:func:`fit_regressor` fits one grade's (or one setting's) model on its feature rows and
+returns an object with :class:`~gearshot.estimator.knn.KnnModel`'s interface (``predict``,
+``n_neighbors``, ``validation_mae``, ``validation_residuals``, ``validation_y``,
+``validation_indices``), which is what the grade choice, the intervals and the floors read:
+
+================  =====================================================================
+``"paper"``       KNN, K chosen on one validation split (:func:`~.steps.fit_knn`; the paper)
+``"isotonic"``    a monotone map of one learned score: the least-squares linear score of
+                  the standardised features, then isotonic regression of the size on it
+``"boosting"``    gradient-boosted trees (``HistGradientBoostingRegressor``, absolute
+                  error loss)
+================  =====================================================================
+
+The non-KNN learners hold out the same validation split as the KNN (a ``ShuffleSplit``
+seeded alike), keep its residuals for the intervals, and refit on every row. Their
+``n_neighbors`` is 1 and ``validation_mae`` holds one value: the validation MAE.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import sklearn
+from numpy.typing import ArrayLike, NDArray
+from sklearn.ensemble import HistGradientBoostingRegressor
+from sklearn.isotonic import IsotonicRegression
+from sklearn.model_selection import ShuffleSplit
+from sklearn.utils import check_random_state
+
+from .._errors import GearshotError
+from .._validation import as_signal_array
+from . import steps
+from .knn import KnnModel
+
+__all__ = ["ESTIMATORS", "LearnedModel", "ScoreIsotonic", "StepModel", "fit_regressor"]
+
+FloatArray = NDArray[np.float64]
+RandomStateLike = int | np.random.RandomState | None
+
+#: The names ``OneFaultShotEstimator(estimator=...)`` accepts.
+ESTIMATORS = ("paper", "isotonic", "boosting")
+
+
+class ScoreIsotonic:
+    """Isotonic regression of ``y`` on a linear score of the standardised features.
+
+    The score's direction is the least-squares fit of ``y`` on the features (a tiny ridge
+    keeps it defined for constant or collinear columns); the isotonic fit then takes
+    whatever monotone shape the size has along it, increasing or decreasing.
+    """
+
+    def fit(self, X: FloatArray, y: FloatArray) -> ScoreIsotonic:
+        self.mean_ = X.mean(axis=0)
+        self.scale_ = X.std(axis=0)
+        self.scale_[self.scale_ == 0] = 1.0
+        Z = (X - self.mean_) / self.scale_
+        gram = Z.T @ Z + 1e-6 * len(Z) * np.eye(Z.shape[1])
+        self.coef_ = np.linalg.solve(gram, Z.T @ (y - y.mean()))
+        self.isotonic_ = IsotonicRegression(increasing="auto", out_of_bounds="clip").fit(
+            Z @ self.coef_, y)
+        return self
+
+    def predict(self, X: FloatArray) -> FloatArray:
+        Z = (np.asarray(X, float) - self.mean_) / self.scale_
+        return np.asarray(self.isotonic_.predict(Z @ self.coef_), dtype=np.float64)
+
+
+def _learner(name: str, seed: int) -> Any:
+    if name == "isotonic":
+        return ScoreIsotonic()
+    return HistGradientBoostingRegressor(loss="absolute_error", max_iter=60,
+                                         learning_rate=0.1, max_leaf_nodes=15,
+                                         min_samples_leaf=10, random_state=seed)
+
+
+@dataclass(frozen=True)
+class LearnedModel:
+    """A fitted non-KNN step-8 regressor with its validation split's residuals.
+
+    Attributes
+    ----------
+    learner : object with ``predict``
+        Fitted on every training row.
+    n_neighbors : int
+        Always 1 (the KNN's K has no meaning here).
+    validation_mae : ndarray (1,)
+        MAE on the validation split (of a learner fitted on the other rows).
+    validation_residuals, validation_y : ndarray
+        ``|y - ŷ|`` and ``y`` on the validation split.
+    validation_indices : ndarray of int
+    validation_prediction : ndarray
+        ``ŷ`` on the validation split.
+    """
+
+    learner: Any
+    n_neighbors: int
+    validation_mae: FloatArray
+    validation_residuals: FloatArray
+    validation_y: FloatArray
+    validation_indices: NDArray[np.intp]
+    validation_prediction: FloatArray | None = None
+
+    def predict(self, X: ArrayLike) -> FloatArray:
+        """Fault sizes of feature rows ``X`` (n_samples, n_features), clipped to [0, 1]."""
+        raw = np.asarray(self.learner.predict(np.asarray(X, float)), dtype=np.float64)
+        return np.asarray(np.clip(raw, 0.0, 1.0), dtype=np.float64)
+
+
+#: What step 8 fits: the paper's KNN or another learner, with the same interface.
+StepModel = KnnModel | LearnedModel
+
+
+def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
+                  n_neighbors: Iterable[int] = range(1, 101),
+                  validation_fraction: float = 0.3,
+                  random_state: RandomStateLike = None) -> StepModel:
+    """Step 8 with the regressor ``name`` (one of :data:`ESTIMATORS`).
+
+    Parameters
+    ----------
+    name : {"paper", "isotonic", "boosting"}
+    X : ndarray (n_samples, n_features)
+    y : ndarray (n_samples,)
+    n_neighbors : iterable of int
+        The KNN's candidate K ("paper" only).
+    validation_fraction : float in (0, 1)
+        Share of rows in the validation split.
+    random_state : int, RandomState or None
+        Seeds the split (and the learner): the same split as :func:`fit_knn`'s.
+
+    Returns
+    -------
+    KnnModel or LearnedModel
+    """
+    if name == "paper":   # step 8 as the paper's steps module has it
+        return steps.fit_knn(X, y, n_neighbors=n_neighbors, validation_fraction=validation_fraction,
+                       random_state=random_state)
+    if name not in ESTIMATORS:
+        raise GearshotError(f"estimator must be one of {ESTIMATORS}; got {name!r}")
+    X = as_signal_array(X, "X", min_ndim=2, max_ndim=2, max_abs=None)
+    y = as_signal_array(y, "y", max_ndim=1, max_abs=None)
+    if y.shape != X.shape[:1]:
+        raise GearshotError(f"y must hold one label per row of X ({X.shape[0]}); got shape "
+                            f"{y.shape}")
+    if not 0 < validation_fraction < 1:
+        raise GearshotError(f"validation_fraction must lie in (0, 1); got "
+                            f"{validation_fraction!r}")
+    if X.shape[0] < 4:
+        raise GearshotError(f"fit_regressor needs at least 4 training samples; got "
+                            f"{X.shape[0]}")
+    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
+    split = ShuffleSplit(n_splits=1, test_size=validation_fraction, random_state=seed)
+    train, val = next(split.split(X))
+    with sklearn.config_context(assume_finite=True):
+        probe = _learner(name, seed).fit(X[train], y[train])
+        estimate = np.clip(probe.predict(X[val]), 0, 1)
+        residuals = np.abs(estimate - y[val])
+        final = _learner(name, seed).fit(X, y)
+    return LearnedModel(final, 1, np.array([residuals.mean()]), residuals, y[val],
+                        np.asarray(val, dtype=np.intp), np.asarray(estimate, np.float64))

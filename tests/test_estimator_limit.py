@@ -1,0 +1,135 @@
+"""The information-limit oracle (estimator/oracle.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gearshot import GearshotError
+from gearshot.estimator._simulated import residue_noise_spectrum
+from gearshot.estimator.oracle import fault_bins, fit_template_oracle
+
+N = 256
+MESH = 19
+
+
+def _components(y: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """One-sided spectra of a fault component whose shape changes with size: a pulse that
+    grows in height (∝ y) and in width (∝ 1 + 3 y), at a fixed place in the cycle."""
+    theta = np.arange(N) / N
+    width = 0.01 * (1 + 3 * y[:, None])
+    pulse = y[:, None] * np.exp(-0.5 * ((theta[None, :] - 0.3) / width) ** 2)
+    return np.fft.rfft(pulse, axis=1)
+
+
+def test_fault_bins_leave_out_dc_and_mesh_bands():
+    bins = fault_bins(N, MESH)
+    assert bins[0] == 1
+    assert bins[-1] == N // 2
+    assert 0 not in bins
+    for k in (MESH, 2 * MESH, 6 * MESH):
+        for s in range(-2, 3):
+            assert k + s not in bins
+    assert MESH + 3 in bins and MESH - 3 in bins
+
+
+def test_oracle_recovers_size_from_templates_and_known_noise():
+    rng = np.random.default_rng(0)
+    y_train = np.r_[np.zeros(40), rng.uniform(0, 1, 400)]
+    y_test = np.r_[np.zeros(10), rng.uniform(0.02, 1, 60)]
+    power = np.full(N // 2 + 1, 0.02)
+    oracle = fit_template_oracle(_components(y_train, rng), y_train, power,
+                                 mesh_order=MESH, n_points=N, bandwidth=0.01)
+    noisy = _components(y_test, rng) + residue_noise_spectrum(power, y_test.size, N, rng)
+    pred = oracle.predict(noisy)
+    err = np.abs(pred - y_test)
+    assert np.mean(err) < 0.02
+    assert np.all(pred[:10] <= 0.02)           # healthy read as healthy
+    post = oracle.posterior(noisy)
+    assert np.allclose(post.sum(axis=1), 1)
+    # magnitudes only (the fault's place in the cycle unknown): still close, not better
+    blind = fit_template_oracle(_components(y_train, rng), y_train, power, mesh_order=MESH,
+                                n_points=N, bandwidth=0.01, phase=False)
+    err_blind = np.abs(blind.predict(noisy) - y_test)
+    assert np.mean(err_blind) < 0.05
+    assert np.mean(err_blind) >= np.mean(err) - 0.005
+
+
+def test_oracle_error_grows_with_noise():
+    rng = np.random.default_rng(1)
+    y_train = rng.uniform(0, 1, 400)
+    y_test = rng.uniform(0, 1, 200)
+    errors = []
+    for level in (0.01, 1.0, 300.0):
+        power = np.full(N // 2 + 1, level)
+        oracle = fit_template_oracle(_components(y_train, rng), y_train, power,
+                                     mesh_order=MESH, n_points=N)
+        noisy = _components(y_test, rng) + residue_noise_spectrum(
+            power, y_test.size, N, np.random.default_rng(2))
+        errors.append(np.mean(np.abs(oracle.predict(noisy) - y_test)))
+    assert errors[0] < errors[1] < errors[2]
+    assert errors[2] > 0.1                     # noise far above the signal: little left
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    (dict(differences=np.zeros((3, N // 2 + 1))), "differences"),
+    (dict(fault_size=np.array([0.1, 0.2, 1.5])), "fault_size"),
+    (dict(noise_power=np.zeros(N // 2 + 1)), "noise_power"),
+    (dict(bandwidth=0.0), "bandwidth"),
+])
+def test_oracle_bad_inputs_name_the_argument(kwargs, word):
+    args = dict(differences=np.zeros((3, N // 2 + 1), complex),
+                fault_size=np.array([0.0, 0.2, 0.5]), noise_power=np.ones(N // 2 + 1),
+                mesh_order=MESH, n_points=N)
+    args.update(kwargs)
+    with pytest.raises(GearshotError, match=word):
+        fit_template_oracle(**args)
+
+
+# ------------------------------------------------------------------ detection limit
+def _fit_with_noise(noise):
+    from estimator_data import paired_synthetic_database, synthetic_target, tf_pair
+
+    from gearshot.estimator import OneFaultShotEstimator
+
+    tfs = tf_pair()
+    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
+    healthy, long, faulty, y = synthetic_target(6, tfs[0], n_healthy=15, n_each=5,
+                                                noise=noise)
+    est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0)
+    return est.fit(db, healthy, faulty[7], y[7], long, selection_tf=tfs[1]), faulty, y
+
+
+def test_detection_limit_exists_and_grows_with_noise():
+    from gearshot.estimator import below_detection_limit
+
+    limits = []
+    for noise in (0.2, 2.0, 8.0):
+        est, faulty, y = _fit_with_noise(noise)
+        assert 0 <= est.detection_limit_ <= 1
+        assert est.detection_limit_ >= est.detection_threshold_
+        limits.append(est.detection_limit_)
+        pred = est.predict(faulty)
+        flags = below_detection_limit(est, pred)
+        assert flags.dtype == bool and flags.shape == pred.shape
+        np.testing.assert_array_equal(flags, pred < est.detection_limit_)
+    assert limits[0] < limits[1] < limits[2]
+
+
+def test_detection_limit_from_validation_rows():
+    from types import SimpleNamespace
+
+    from gearshot.estimator.detection import detection_limit
+
+    rng = np.random.default_rng(0)
+    y = np.r_[np.zeros(200), rng.uniform(0, 1, 800)]
+    pred = np.where(y == 0, np.abs(rng.normal(0, 0.05, y.size)), y + rng.normal(0, 0.02, y.size))
+    model = SimpleNamespace(validation_y=y, validation_prediction=pred)
+    found = detection_limit([model], [1.0])
+    # healthy estimates |N(0, 0.05)|: 95 % quantile 1.96 * 0.05; unbiased faulty estimates
+    assert found.threshold == pytest.approx(0.098, abs=0.015)
+    assert found.limit == pytest.approx(found.threshold, abs=0.02)
+    with pytest.raises(GearshotError, match="weights"):
+        detection_limit([model], [-1.0])
+    with pytest.raises(GearshotError, match="confidence"):
+        detection_limit([model], [1.0], confidence=1.5)
