@@ -78,7 +78,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         :meth:`~gearshot.estimator.fit_check.FitCheck.as_dict`. A healthy or faulty
         recording that fails an input check is refused.
     """
-    from ..estimator import OneFaultShotEstimator, below_detection_limit, default_selection_tf
+    from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..sim import load_database
     from .conditions import choose_condition
     from .files import expand_recordings
