@@ -245,7 +245,7 @@ def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(sp
     csv = pd.read_csv(write_predictions(frame, tmp_path / "p.csv"))
     assert csv["trusted"].tolist() == frame["trusted"].tolist()
     assert (csv["fit_check"] == "passed").all()
-    rows = json.loads(write_predictions(frame, tmp_path / "p.json").read_text())
+    rows = json.loads(write_predictions(frame, tmp_path / "p.json").read_text())["rows"]
     assert all(isinstance(r["trusted"], bool) and r["fit_check"] == "passed" for r in rows)
     report = report_from_any_json(tmp_path / "p.json", tmp_path / "report")
     md = report.read_text()
