@@ -122,7 +122,7 @@ def test_readme_journey_flags_the_low_records_of_the_healthy_gears(journey):
     machine's distribution (not comparable); the fit's own hold-outs and the example
     record's other segments are comparable. (The chipped gear's Low record reads within
     the example's fault states on this sensor: the measured miss, benchmarks/RESULTS.md.)"""
-    frame = pd.DataFrame(json.loads((journey["work"] / "estimates.json").read_text()))
+    frame = pd.DataFrame(json.loads((journey["work"] / "estimates.json").read_text())["rows"])
     name = frame["recording"].map(lambda r: Path(r).name)
     for case in ("spur1", "spur3"):
         rows = frame[name == f"{case}_30hz_Low_1.zip"]
