@@ -43,8 +43,8 @@ from ._typing import ComplexArray, FloatArray
 from ._validation import as_signal_array, check_int, check_positive, describe, finite_result
 from .signal.orders import MeshOrders, check_mesh_orders
 
-__all__ = ["FEATURES", "PAPER_FEATURES", "available_features", "extract_features",
-           "spectrum_features", "na4_baseline_variance"]
+__all__ = ["FEATURES", "PAPER_FEATURES", "CONDITION_INDICATORS", "available_features",
+           "extract_features", "spectrum_features", "na4_baseline_variance"]
 
 PAPER_FEATURES = ("rms_diff", "kurtosis_diff", "rms_env_diff", "skewness_env_diff")
 #: Values per block of signals: the features' temporaries of one block (1 MB each) stay in
@@ -128,6 +128,10 @@ def _er(p: _Parts) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         return cast(FloatArray, np.where(den < _TINY_RMS, 0.0, _rms(p.zakrajsek_diff) / den))
 
+
+#: The condition indicators a user reads (``gearshot indicators``): the paper's four and
+#: the eight of the reference toolchain; the order bands below are estimator features.
+CONDITION_INDICATORS: tuple[str, ...] = tuple(_REGISTRY)
 
 #: Equal-width order bands of the difference spectrum (``band_rms_1`` … ``band_rms_8``).
 N_BANDS = 8

@@ -68,7 +68,7 @@ def shaft_indicators(rec, machine, *, shaft: str, sensors: Sequence[str] | None 
     dict
         sensor name -> ``{"n_cycles": int, "indicators": {name: float}}``.
     """
-    from ..features import available_features, extract_features
+    from ..features import CONDITION_INDICATORS, extract_features
 
     machine.check_shaft(shaft, "--shaft")
     names = [machine.sensor(s).name for s in (sensors or [s.name for s in machine.sensors])]
@@ -83,7 +83,7 @@ def shaft_indicators(rec, machine, *, shaft: str, sensors: Sequence[str] | None 
         if blocks.ndim == 2:
             blocks, sa = blocks[None], sa[None]
         blocks, sa = blocks[idx], sa[idx]
-    feats = available_features()
+    feats = CONDITION_INDICATORS
     values = extract_features(sa, list(machine.mesh_orders(shaft)), names=feats,
                               n_sidebands=machine.n_sidebands, baseline_variance=baseline,
                               shaft_orders=machine.shaft_orders)
@@ -109,11 +109,11 @@ _UNIT_OF = {"rms_diff": "{unit}", "rms_env_diff": "{unit}", "rms_raw": "{unit}",
 def indicator_units(machine, sensor: str) -> dict[str, str]:
     """{indicator: unit} for one sensor (``"g"`` for the RMS values of a 10 mV/g
     accelerometer, ``"1"`` for the dimensionless ones)."""
-    from ..features import available_features
+    from ..features import CONDITION_INDICATORS
 
     unit = machine.sensor(sensor).unit
     return {f: _UNIT_OF.get(f, "1").format(unit=unit)
-            for f in (*available_features(), *INDICATOR_EXTRAS)}
+            for f in (*CONDITION_INDICATORS, *INDICATOR_EXTRAS)}
 
 
 def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
@@ -268,7 +268,7 @@ def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
                  rec: Any, checks: dict) -> list[dict[str, Any]]:
     """The payload records of one file (``rec``, ``checks``: :func:`_read`'s): one per
     sensor."""
-    from ..features import available_features
+    from ..features import CONDITION_INDICATORS
 
     tacho = float(rec.shaft_speed())
     rows = []
@@ -278,7 +278,7 @@ def _record_rows(path: str | Path, machine, shaft: str, names: Sequence[str],
                                    baseline=baselines[name])[name]
         else:   # no indicator of a failed channel: null, with the check named
             res = {"n_cycles": None, "indicators": dict.fromkeys(
-                (*available_features(), *INDICATOR_EXTRAS))}
+                (*CONDITION_INDICATORS, *INDICATOR_EXTRAS))}
         rows.append({"file": Path(path).name, "sensor": name,
                      "tacho_speed_hz": tacho, "shaft_speed_hz": tacho * ratio,
                      "speed_source": rec.speed_source,
