@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,8 @@ from .._errors import GearshotError
 from .._validation import check_in_range
 from ..paper import GEAR_TEETH, PINION_TEETH
 
-__all__ = ["predict_from_files", "predict_recordings", "write_predictions",
+__all__ = ["predict_from_files", "fit_from_files", "estimate_segments", "FittedFiles",
+           "predict_recordings", "write_predictions",
            "format_predictions", "comparable_summary", "summary_table", "ROLES"]
 
 #: The ``role`` column of every ``gearshot predict`` output: what a row's segment was to
@@ -58,46 +60,94 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         (roles: :data:`ROLES`; the last two from
         :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`).
     """
-    from ..estimator import OneFaultShotEstimator, default_selection_tf
-    from ..sim import load_database
-    from .conditions import choose_condition
     from .files import expand_recordings
 
-    for p in [*healthy, faulty]:
-        if not Path(p).is_file():
-            raise GearshotError(f"recording {str(p)!r} does not exist")
-    faulty_size = check_in_range(faulty_size, "faulty_size (--faulty-size)", 0.0, 1.0,
-                                 low_inclusive=False)
-    coverage = check_in_range(coverage, "coverage (--coverage)", 0.0, 1.0,
-                              low_inclusive=False, high_inclusive=False)
     if isinstance(recordings, (str, Path)):
         recordings = [recordings]
     files = expand_recordings(recordings, "--recordings")
+    est, fitted_files = fit_from_files(database, healthy, faulty, faulty_size, speed=speed,
+                                       load=load, coverage=coverage, gear_teeth=gear_teeth,
+                                       pinion_teeth=pinion_teeth, seed=seed,
+                                       selection_tf=selection_tf, recordings=files)
+    fitted = {_key(p) for p in healthy}
+    frames = []
+    for path, sa in fitted_files.targets:
+        rows = estimate_segments(est, sa, coverage=coverage)
+        rows.insert(0, "recording", str(path))
+        rows.insert(1, "role", _roles(path, len(sa), fitted, faulty))
+        frames.append(rows)
+    frame = pd.concat(frames, ignore_index=True)
+    frame.attrs["speed"], frame.attrs["load"] = fitted_files.speed, fitted_files.load
+    return frame
+
+
+@dataclass
+class FittedFiles:
+    """What :func:`fit_from_files` found besides the estimator: the database condition
+    (``speed`` rps, ``load`` N m), the gear pair the recordings were segmented for
+    (``teeth``: ``gear_teeth``, ``pinion_teeth``) and the SA segments of ``recordings``
+    (``targets``: (path, SAs) pairs)."""
+
+    speed: float
+    load: float
+    teeth: dict
+    targets: list = field(default_factory=list)
+
+
+def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
+                   coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
+                   selection_tf=None, recordings=()):
+    """Fit the estimator from recording files (the fit of ``gearshot predict`` and
+    ``gearshot fit`` without ``--machine``).
+
+    ``faulty`` None fits zero-shot (``calibration="zero_shot"``, ``faulty_size`` ignored).
+    Every recording (``recordings`` too, segmented into ``FittedFiles.targets``) is read
+    and segmented before the fit: a bad file fails now, not after minutes of fitting.
+
+    Returns
+    -------
+    estimator : OneFaultShotEstimator
+    fitted : FittedFiles
+    """
+    from ..estimator import OneFaultShotEstimator, default_selection_tf
+    from ..sim import load_database
+    from .conditions import choose_condition
+
+    for p in [*healthy, *([] if faulty is None else [faulty])]:
+        if not Path(p).is_file():
+            raise GearshotError(f"recording {str(p)!r} does not exist")
+    if faulty is not None:
+        faulty_size = check_in_range(faulty_size, "faulty_size (--faulty-size)", 0.0, 1.0,
+                                     low_inclusive=False)
+    check_in_range(coverage, "coverage (--coverage)", 0.0, 1.0, low_inclusive=False,
+                   high_inclusive=False)
     speed, load = choose_condition(database, None, speed=speed, load=load, measured=[])
     db = load_database(database, speed=speed, load=load)
     # the pair is the database's unless declared (a declared other pair is refused by fit)
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    targets, healthy_sa, long, example = _segments(files, healthy, faulty, kw)
+    targets, healthy_sa, long, example = _segments(recordings, healthy, faulty, kw)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
-    est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
-    fitted = {_key(p) for p in healthy}
-    frames = []
-    for path, sa in targets:
-        low, high = est.predict_interval(sa, coverage=coverage)
-        comp = est.comparability(sa)
-        frames.append(pd.DataFrame(dict(recording=str(path),
-                                        role=_roles(path, len(sa), fitted, faulty),
-                                        segment=np.arange(len(sa)),
-                                        predicted=est.predict(sa), low=low, high=high,
-                                        comparability=comp.score,
-                                        comparable=comp.comparable)))
-    frame = pd.concat(frames, ignore_index=True)
-    frame.attrs["speed"], frame.attrs["load"] = speed, load
-    return frame
+    if faulty is None:
+        est = OneFaultShotEstimator(random_state=seed, calibration="zero_shot")
+        est.fit(db, healthy_sa, None, None, long, selection_tf=selection_tf, **kw)
+    else:
+        est = OneFaultShotEstimator(random_state=seed)
+        est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
+    return est, FittedFiles(float(speed), float(load), kw, targets)
+
+
+def estimate_segments(est, sa, *, coverage=0.9) -> pd.DataFrame:
+    """Estimate SA segments with a fitted estimator: one row per segment with
+    ``segment, predicted, low, high, comparability, comparable`` (the estimate columns of
+    every ``gearshot predict`` row; ``gearshot monitor`` estimates through it too)."""
+    low, high = est.predict_interval(sa, coverage=coverage)
+    comp = est.comparability(sa)
+    return pd.DataFrame(dict(segment=np.arange(len(sa)), predicted=est.predict(sa),
+                             low=low, high=high, comparability=comp.score,
+                             comparable=comp.comparable))
 
 
 def _segments(files, healthy, faulty, kw):
@@ -117,7 +167,7 @@ def _segments(files, healthy, faulty, kw):
         else:
             sa = recording_segments(p, **kw)
         healthy_sa.append(sa)
-    example = recording_segments(faulty, **kw)[0]
+    example = None if faulty is None else recording_segments(faulty, **kw)[0]
     return targets, np.vstack(healthy_sa), long, example
 
 

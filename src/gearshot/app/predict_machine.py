@@ -15,7 +15,7 @@ from .._validation import check_in_range, check_int
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .load_choice import LoadChoice, choose_load
 
-__all__ = ["machine_segments", "predict_from_machine", "machine_database_path"]
+__all__ = ["machine_segments", "predict_from_machine", "fit_machine", "machine_database_path"]
 
 
 def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty: int,
@@ -143,10 +143,38 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade and the simulated
         reference.
     """
+    est, seg, cond = fit_machine(machine, database, healthy, faulty, faulty_size, recordings,
+                                 speed=speed, load=load,
+                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                 holdout=holdout, example_segment=example_segment, seed=seed,
+                                 params=params, speed_tolerance=speed_tolerance)
+    frame = _estimates(est, seg, cond, coverage)
+    frame.attrs["grade"] = getattr(est, "grade_", None)
+    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
+    return frame
+
+
+def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | Path | None,
+                faulty_size: float | None, recordings: Sequence[str | Path] = (), *,
+                speed: float | None = None, load: float | None = None,
+                cycles_per_segment: int | None = None, sensor: str | None = None,
+                holdout: float = 0.25, example_segment: int = 0, seed: int = 0,
+                params: dict | None = None, speed_tolerance: float = SPEED_TOLERANCE):
+    """The fit of :func:`predict_from_machine` (same parameters); ``faulty`` None fits
+    zero-shot (``calibration="zero_shot"``).
+
+    Returns
+    -------
+    estimator : OneFaultShotEstimator
+    segments : _Segments
+        Every recording's SA segments by role (``rows``: file, role, segment, speed, SA).
+    condition : _Condition
+        The database condition estimated at.
+    """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
 
-    cps = _check_options(machine, healthy, [faulty, *recordings], cycles_per_segment,
-                         holdout)
+    others = [*([] if faulty is None else [faulty]), *recordings]
+    cps = _check_options(machine, healthy, others, cycles_per_segment, holdout)
     database_conditions(database, machine)   # a bad --database fails now
     seg = _segment_recordings(machine, healthy, faulty, recordings, cps=cps, sensor=sensor,
                               holdout=holdout, example_segment=example_segment)
@@ -155,16 +183,15 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
     # too), on the simulated side as on the recorded one
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
+    calibration = {} if faulty is not None else {"calibration": "zero_shot"}
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
-                                   "mesh_order": meshes})
+                                   "mesh_order": meshes, **calibration})
     # the database must be of the machine's monitored pair (refused otherwise)
-    est.fit(cond.slice, np.vstack(seg.train), seg.example, faulty_size, seg.long,
+    est.fit(cond.slice, np.vstack(seg.train), seg.example,
+            None if faulty is None else faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1])
-    frame = _estimates(est, seg, cond, coverage)
-    frame.attrs["grade"] = getattr(est, "grade_", None)
-    frame.attrs["simulated_reference"] = getattr(est, "simulated_reference_", None)
-    return frame
+    return est, seg, cond
 
 
 def _check_options(machine, healthy, others, cycles_per_segment, holdout) -> int:
@@ -220,12 +247,13 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
             seg.long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
         seg.rows.extend((str(p), "healthy_holdout", k, sp, sa[k])
                         for k in range(n_fit, sa.shape[0]))
-    fsa, _, fsp = cut(faulty)
-    example_segment = check_int(example_segment, "example_segment", minimum=0,
-                                maximum=fsa.shape[0] - 1)
-    seg.example = fsa[example_segment]
-    seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
-                    for k in range(fsa.shape[0]) if k != example_segment)
+    if faulty is not None:
+        fsa, _, fsp = cut(faulty)
+        example_segment = check_int(example_segment, "example_segment", minimum=0,
+                                    maximum=fsa.shape[0] - 1)
+        seg.example = fsa[example_segment]
+        seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
+                        for k in range(fsa.shape[0]) if k != example_segment)
     for p in recordings:
         sa, _, sp = cut(p)
         seg.rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))

@@ -36,7 +36,7 @@ def json_kind(payload) -> str | None:
 
 
 KINDS_TEXT = ("demo results.json, experiment simulated/rig --json, experiment rig-family "
-              "--json, predict --out X.json, indicators --json")
+              "--json, predict --out X.json, indicators --json, monitor --json")
 
 
 def report_from_any_json(path, out) -> Path:
@@ -57,6 +57,11 @@ def report_from_any_json(path, out) -> Path:
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise GearshotError(f"{str(path)!r} is not a JSON file ({type(exc).__name__}: "
                             f"{str(exc).splitlines()[0][:80]})") from None
+    from .monitor_report import is_monitor_payload, monitor_report
+
+    if is_monitor_payload(payload):
+        out.mkdir(parents=True, exist_ok=True)
+        return monitor_report(payload, out, source=path)
     kind = json_kind(payload)
     if kind is None:
         raise GearshotError(f"{str(path)!r} is not a JSON that gearshot writes (one of: "
