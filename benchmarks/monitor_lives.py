@@ -24,7 +24,7 @@ DB = None
 
 def true_crossing(index: pd.DataFrame, level: float) -> pd.Timestamp | None:
     """Time the true size first reaches ``level`` (linear between recordings)."""
-    t = pd.to_datetime(index["time"])
+    t = pd.to_datetime(index["time"], format="ISO8601")
     y = index["size"].to_numpy(float)
     above = np.nonzero(y >= level)[0]
     if not above.size:
@@ -73,7 +73,7 @@ def evaluate(seed: int, work: Path, database: str) -> list[dict]:
         cross = int(np.nonzero(recs["size"].to_numpy() > 0.2)[0][0])
         first = payload["alarm"]["first_time"]
         first_i = None if first is None else int(np.nonzero(
-            pd.to_datetime(recs["time"]) == pd.Timestamp(first))[0][0])
+            pd.to_datetime(recs["time"], format="ISO8601") == pd.Timestamp(first))[0][0])
         healthy_rows = recs["size"] == 0
         false_alarms = int((recs["alarm"] & healthy_rows).sum())
         events = recs["event"] != ""
@@ -84,7 +84,7 @@ def evaluate(seed: int, work: Path, database: str) -> list[dict]:
         keep = set(recs["recording"].iloc[:n70])
         part = monitor_payload(hist[hist["recording"].isin(keep)], model, limit=0.6)
         fc = part["forecast"]
-        t_now = pd.to_datetime(recs["time"]).iloc[n70 - 1]
+        t_now = pd.to_datetime(recs["time"], format="ISO8601").iloc[n70 - 1]
         t_true = true_crossing(truth, 0.6)
         remaining = (t_true - t_now) / pd.Timedelta(days=1)
         if fc["time"] is None:

@@ -31,7 +31,7 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
     recs = pd.DataFrame(payload["records"])
     fig, ax = plt.subplots(figsize=(9, 4.5))
     if len(recs):
-        t = pd.to_datetime(recs["time"])
+        t = pd.to_datetime(recs["time"], format="ISO8601")
         ok = recs["trusted"].to_numpy(bool)
         err = np.vstack([recs["predicted"] - recs["low"], recs["high"] - recs["predicted"]])
         ax.errorbar(t[ok], recs["predicted"][ok], yerr=err[:, ok], fmt="o", ms=4,
@@ -59,9 +59,9 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
         if fit and len(recs):
             t0 = pd.Timestamp(fit["days_from"])
             onset = (pd.Timestamp(fit["onset"]) - t0) / pd.Timedelta(days=1)
-            end = (max(hi, pd.to_datetime(recs["time"]).max()) - t0) / pd.Timedelta(days=1)
+            end = (max(hi, pd.to_datetime(recs["time"], format="ISO8601").max()) - t0) / pd.Timedelta(days=1)
             days = np.linspace(0, end, 200)
-            last = (pd.to_datetime(recs["time"]).max() - t0) / pd.Timedelta(days=1)
+            last = (pd.to_datetime(recs["time"], format="ISO8601").max() - t0) / pd.Timedelta(days=1)
             s = np.maximum(days - onset, 0) / max(last - onset, 1e-9)
             law, shape = fc["law"], fit["shape"]
             g = s if law == "linear" else np.expm1(shape * s) if law == "exponential" \

@@ -10,8 +10,8 @@ the last point):
 * ``power``: ``y = h + a s ** p``
 
 For every onset candidate (the history's own times) and every shape (``k`` or ``p`` on
-a grid) the linear parameters ``h, a`` are the least-squares solution; the best shape is
-then refined by :func:`scipy.optimize.curve_fit`. The law and onset with the smallest
+a grid) the linear parameters ``h, a`` are the least-squares solution; each law's best
+grid point is then refined by :func:`scipy.optimize.curve_fit`. The law and onset with the smallest
 Akaike information criterion win. The time the fitted law reaches ``limit`` comes with
 an interval from a parametric bootstrap (the fitted law plus normal residuals of the
 fit's spread, refitted with the law and onset kept; fixed seed).
@@ -44,6 +44,7 @@ _SHAPES = {"linear": np.array([1.0]),
            "exponential": np.geomspace(0.2, 12.0, 25),
            "power": np.geomspace(0.4, 6.0, 25)}
 _MAX_ONSETS = 40
+_REFINED = 3
 
 
 def _basis(law: str, s: np.ndarray, shape: float) -> np.ndarray:
@@ -172,18 +173,22 @@ def fit_growth(times: ArrayLike, sizes: ArrayLike, *, laws=LAWS,
         raise GearshotError(f"laws must be among {LAWS}; got {unknown}")
     n = t.size
     best: GrowthFit | None = None
-    for t0 in (_onsets(t) if onset is None else [float(onset)]):
-        span = float(t[-1] - t0)
-        if span <= 0:
-            continue
-        for law in laws:
-            found = _solve(law, t, y, t0, span, _SHAPES[law])
+    for law in laws:
+        # the grid over onsets and shapes first, then curve_fit from the law's best
+        # grid points (the best few onsets)
+        cands = []
+        for t0 in (_onsets(t) if onset is None else [float(onset)]):
+            span = float(t[-1] - t0)
+            if span > 0:
+                cands.append((_solve(law, t, y, t0, span, _SHAPES[law]), float(t0), span))
+        cands.sort(key=lambda c: c[0][0])
+        k = (2 if law == "linear" else 3) + (1 if onset is None else 0)
+        for found, t0, span in cands[:_REFINED]:
             rss, level, amp, shape = _refine(law, t, y, t0, span, found)
-            k = (2 if law == "linear" else 3) + (1 if onset is None else 0)
             aic = n * np.log(max(rss, 1e-12) / n) + 2 * k
             if best is None or aic < best.aic:
                 sigma = float(np.sqrt(rss / max(n - k, 1)))
-                best = GrowthFit(law, float(t0), span, level, amp, shape, sigma, float(aic))
+                best = GrowthFit(law, t0, span, level, amp, shape, sigma, float(aic))
     if best is None:
         raise GearshotError("fit_growth: the history spans no time")
     return best

@@ -185,7 +185,7 @@ def record_history(rig: VirtualRig, folder: str | os.PathLike, *, speed: float =
                                 repetition=i)
             name = f"life_{i:03d}.h5"
             rec.write(staging / name, dtype=dtype)
-            time = t0 + pd.Timedelta(hours=float(hours[i]))
+            time = (t0 + pd.Timedelta(hours=float(hours[i]))).floor("s")
             rows.append({"file": name, "time": time.isoformat(), "size": float(sizes[i]),
                          "event": events[i], "speed": round(float(speeds[i]), 3),
                          "load": round(float(loads[i]), 3)})
