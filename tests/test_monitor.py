@@ -42,7 +42,11 @@ def machine(tmp_path_factory):
                        remount=None, progress=False)
     healthy = sorted(p for p, y in zip(camp["path"], camp["fault_size"], strict=True) if y == 0)
     faulty = [p for p, y in zip(camp["path"], camp["fault_size"], strict=True) if y > 0][0]
-    return {"top": top, "db": db, "healthy": healthy, "faulty": faulty, "life": life}
+    from gearshot.app.monitor import fit_model
+
+    zero = fit_model(db, healthy, model=top / "zero.skops", speed=15)
+    return {"top": top, "db": db, "healthy": healthy, "faulty": faulty, "life": life,
+            "zero": zero}
 
 
 def test_model_file_carries_what_estimating_needs(machine, tmp_path):
@@ -66,9 +70,8 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     assert np.allclose(back.estimator.predict(sa), m.estimator.predict(sa))
     assert back.digest == m.digest and len(back.digest) == 16
     # a zero-shot fit says so
-    z = fit_model(machine["db"], machine["healthy"], model=tmp_path / "z.skops", speed=15)
-    assert z.calibration == "zero_shot" and z.faulty is None
-    assert "zero-shot" in load_model(tmp_path / "z.skops").describe()
+    z = load_model(machine["top"] / "zero.skops")
+    assert z.calibration == "zero_shot" and z.faulty is None and "zero-shot" in z.describe()
 
 
 def test_bad_model_files_and_options_are_refused(machine, tmp_path):
@@ -90,6 +93,32 @@ def test_bad_model_files_and_options_are_refused(machine, tmp_path):
     assert res.returncode == 2 and "must end in .skops" in res.stderr
 
 
+def test_rerun_adds_only_the_new_recordings_and_untrusts_the_load_change(machine, tmp_path):
+    from gearshot.app.monitor import monitor_history
+
+    life = machine["top"] / "life"
+    index = pd.read_csv(life / "index.csv", keep_default_na=False)
+    index["file"] = [str(life / f) for f in index["file"]]
+    index.iloc[:4].to_csv(tmp_path / "index.csv", index=False)
+    model, hist = machine["top"] / "zero.skops", tmp_path / "h.parquet"
+    first = monitor_history(model, tmp_path / "index.csv", hist)
+    assert first["new"] == 4 and len(first["records"]) == 4
+    stamp = pd.read_parquet(hist)["estimated_at"]
+    index.to_csv(tmp_path / "index.csv", index=False)
+    second = monitor_history(model, tmp_path / "index.csv", hist)
+    assert second["new"] == 6 and len(second["records"]) == 10
+    again = pd.read_parquet(hist)
+    assert len(again) == 10 and (again["estimated_at"].iloc[:4].values == stamp.values).all()
+    assert monitor_history(model, tmp_path / "index.csv", hist)["new"] == 0
+    for rec in second["records"]:
+        assert {"recording", "time", "predicted", "low", "high", "trusted", "alarm"} <= set(rec)
+    events = index["event"].tolist()
+    changed = [r for r, e in zip(second["records"], events, strict=True) if e == "load_change"]
+    assert len(changed) == 1 and not changed[0]["trusted"] and not changed[0]["alarm"]
+    assert "outside the fitted 10 N m" in again["note"].iloc[events.index("load_change")]
+
+
+@pytest.mark.slow
 def test_monitor_adds_only_the_new_then_reestimates_after_a_refit(machine, tmp_path):
     life = machine["top"] / "life"
     index = pd.read_csv(life / "index.csv")

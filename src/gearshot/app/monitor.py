@@ -30,7 +30,7 @@ __all__ = ["fit_model", "estimate_recordings", "monitor_history", "monitor_fleet
 LOAD_TOLERANCE = 0.15
 
 
-def _holdout_split(healthy: Sequence[Path], holdout: float) -> tuple[list, list]:
+def _holdout_split(healthy: Sequence[str | Path], holdout: float) -> tuple[list, list]:
     """(fit, baseline) healthy recordings: the last ``holdout`` share (at least one) is
     kept out of the fit for the alarm baseline."""
     healthy = list(healthy)
@@ -115,6 +115,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                                 f"fit; the alarm baseline needs some (raise --holdout)")
         baseline = estimate_segments(est, np.stack(held), coverage=coverage)["predicted"]
         cps = mach.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
+        assert cps is not None   # fit_machine refused a machine without one
         condition = {"speed": float(cond.speed), "load": float(cond.load),
                      "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
                      "sensor": mach.sensor(sensor).name,
@@ -126,8 +127,8 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         condition=condition, database=identity, baseline=baseline.tolist(),
         threshold=alarm_threshold(baseline, false_alarm_rate=rate),
         false_alarm_rate=float(rate), sustain=int(sustain), machine_toml=toml,
-        faulty=None if faulty is None else {"recording": str(Path(faulty).resolve()),
-                                            "size": float(faulty_size)},
+        faulty=None if faulty is None or faulty_size is None else {
+            "recording": str(Path(faulty).resolve()), "size": float(faulty_size)},
         fit_check=getattr(est, "fit_check_", None), coverage=float(coverage), seed=int(seed),
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
                 "grade": getattr(est, "grade_", None)})

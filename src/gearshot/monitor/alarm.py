@@ -29,7 +29,7 @@ FALSE_ALARM_RATE = 0.01
 SUSTAIN = 2
 #: Smallest threshold: a baseline of near-identical healthy estimates would otherwise set
 #: the threshold at the estimator's own resolution.
-MIN_THRESHOLD = 0.05
+MIN_THRESHOLD = 0.15
 
 
 def alarm_threshold(baseline: ArrayLike, *, false_alarm_rate: float = FALSE_ALARM_RATE

@@ -59,9 +59,10 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
         if fit and len(recs):
             t0 = pd.Timestamp(fit["days_from"])
             onset = (pd.Timestamp(fit["onset"]) - t0) / pd.Timedelta(days=1)
-            end = (max(hi, pd.to_datetime(recs["time"], format="ISO8601").max()) - t0) / pd.Timedelta(days=1)
+            latest = pd.to_datetime(recs["time"], format="ISO8601").max()
+            end = (max(hi, latest) - t0) / pd.Timedelta(days=1)
             days = np.linspace(0, end, 200)
-            last = (pd.to_datetime(recs["time"], format="ISO8601").max() - t0) / pd.Timedelta(days=1)
+            last = (latest - t0) / pd.Timedelta(days=1)
             s = np.maximum(days - onset, 0) / max(last - onset, 1e-9)
             law, shape = fc["law"], fit["shape"]
             g = s if law == "linear" else np.expm1(shape * s) if law == "exponential" \

@@ -162,7 +162,7 @@ def record_history(rig: VirtualRig, folder: str | os.PathLike, *, speed: float =
     events = [""] * n
     for i in range(lc_first, min(lc_first + lc_count, n)):
         events[i] = "load_change"
-        loads[i] = lc_load * (1.0 + variation * rng.standard_normal())
+        loads[i] = float(lc_load or load) * (1.0 + variation * rng.standard_normal())
     reality = rig.reveal()
     n_tfs = 8 if rig.tf_bank is None else None
     remounted = None
