@@ -66,7 +66,7 @@ def main() -> None:
             (tmp / f"r{i:04d}.h5").write_bytes(b"")
         t = pd.date_range("2026-01-01", periods=n, freq="6h")
         life = np.linspace(0, 1, n)
-        size = np.where(life < 0.3, 0.0, 0.8 * ((life - 0.3) / 0.7) ** 1.5)
+        size = 0.8 * (np.maximum(life - 0.3, 0.0) / 0.7) ** 1.5
         rng = np.random.default_rng(0)
         pred = np.clip(size + 0.04 * rng.standard_normal(n), 0, 1)
         pd.DataFrame({"file": [f"r{i:04d}.h5" for i in range(n)],
