@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -34,9 +34,6 @@ import pandas as pd
 from .._atomic import atomic_path, check_writable, commit_staged, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
-
-if TYPE_CHECKING:
-    from .virtual import VirtualRig
 
 __all__ = ["record_history", "growth_size", "LAWS", "HISTORY_COLUMNS"]
 
@@ -98,7 +95,7 @@ def _episode(value, name: str, n: int, *, with_load: bool) -> tuple[int, int, fl
     return int(round(frac * n)), count, load
 
 
-def record_history(rig: VirtualRig, folder: str | os.PathLike, *, speed: float = 15.0,
+def record_history(rig: Any, folder: str | os.PathLike, *, speed: float = 15.0,
                    load: float = 10.0, n_recordings: int = 40, duration: float = 16.0,
                    start: str = "2026-01-05T08:00:00", interval_hours: float = 24.0,
                    onset: float = 0.3, end_size: float = 0.8, law: str = "power",
@@ -111,6 +108,8 @@ def record_history(rig: VirtualRig, folder: str | os.PathLike, *, speed: float =
     Parameters
     ----------
     rig : VirtualRig
+        The rig (this module is imported by :mod:`.virtual`, so it names the type only
+        here).
     folder : path
         Created; its recordings ``life_NNN.h5`` and ``index.csv`` are replaced.
     speed, load : float
