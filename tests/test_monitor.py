@@ -217,3 +217,40 @@ def test_readme_monitoring_commands_run_as_written(tmp_path):
     assert len(payload["earlier_estimates"]) == 30
     assert (tmp_path / "trend" / "trend.png").is_file()
     assert (tmp_path / "monitor-report" / "report.md").is_file()
+
+
+@pytest.mark.slow
+def test_fit_and_monitor_with_a_machine_file_on_phm09(tmp_path):
+    """The machine-file path end to end on real PHM 2009 spur records (30 Hz, High load):
+    zero-shot fit on two healthy records, then the chipped and the other records
+    monitored; a Low-load record in the index is outside the fitted load."""
+    phm = ROOT.parent / "shared" / "data" / "phm09"
+    if not (phm / "spur1_30hz_High_1.zip").is_file():
+        pytest.skip(f"{phm} is absent")
+    spur = ROOT / "examples" / "machines" / "phm09_spur.toml"
+    env = {**os.environ, "GEARSHOT_DATA": str(tmp_path / "data")}
+    res = cli("simulate", "--machine", spur, "--speed", 30, "--load", 10, "--store",
+              tmp_path / "db", *SMALL_DATABASE.split(), env=env)
+    assert res.returncode == 0, res.stderr
+    res = cli("fit", "--machine", spur, "--database", tmp_path / "db", "--healthy",
+              phm / "spur1_30hz_High_1.zip", phm / "spur3_30hz_High_1.zip",
+              "--model", tmp_path / "m.skops", env=env)
+    assert res.returncode == 0, res.stderr
+    from gearshot.monitor import load_model
+
+    model = load_model(tmp_path / "m.skops")
+    assert model.machine.name and model.machine_toml == spur.read_text(encoding="utf-8")
+    assert model.condition["speed_unit"] == "Hz (tacho shaft)" and model.baseline
+    rows = [("spur2_30hz_High_1.zip", "2026-01-01T00:00:00", 10),
+            ("spur2_30hz_High_2.zip", "2026-01-02T00:00:00", 10),
+            ("spur2_30hz_Low_1.zip", "2026-01-03T00:00:00", 5)]
+    pd.DataFrame([(str(phm / f), t, ld) for f, t, ld in rows],
+                 columns=["file", "time", "load"]).to_csv(tmp_path / "index.csv",
+                                                          index=False)
+    res = cli("monitor", "--model", tmp_path / "m.skops", "--index", tmp_path / "index.csv",
+              "--history", tmp_path / "h.parquet", "--json", tmp_path / "out.json", env=env)
+    assert res.returncode == 0, res.stderr
+    payload = json.loads((tmp_path / "out.json").read_text())
+    assert [Path(r["recording"]).name for r in payload["records"]] == [r[0] for r in rows]
+    assert not payload["records"][2]["trusted"] and not payload["records"][2]["alarm"]
+    assert payload["forecast"]["time"] is None and "too few" in payload["forecast"]["reason"]
