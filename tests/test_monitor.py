@@ -118,6 +118,19 @@ def test_rerun_adds_only_the_new_recordings_and_untrusts_the_load_change(machine
     assert "outside the fitted 10 N m" in again["note"].iloc[events.index("load_change")]
 
 
+def test_an_unreadable_recording_is_kept_untrusted_with_its_reason(machine, tmp_path):
+    from gearshot.app.monitor import monitor_history
+
+    (tmp_path / "broken.h5").write_bytes(b"not a recording")
+    (tmp_path / "index.csv").write_text("file,time\nbroken.h5,2026-01-01T00:00:00\n")
+    payload = monitor_history(machine["top"] / "zero.skops", tmp_path / "index.csv",
+                              tmp_path / "h.parquet")
+    (rec,) = payload["records"]
+    assert rec["predicted"] is None and not rec["trusted"] and not rec["alarm"]
+    assert rec["note"].startswith("not estimated:") and "broken.h5" in rec["note"]
+    json.dumps(payload, allow_nan=False)       # strict JSON: no NaN
+
+
 @pytest.mark.slow
 def test_monitor_adds_only_the_new_then_reestimates_after_a_refit(machine, tmp_path):
     life = machine["top"] / "life"

@@ -312,9 +312,12 @@ def format_monitor(payload: dict) -> str:
              f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
     if recs:
         last = recs[-1]
-        lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
-                     f"[{last['low']:.3f}, {last['high']:.3f}]"
-                     + ("" if last["trusted"] else " (untrusted)"))
+        if last["predicted"] is None:
+            lines.append(f"latest {last['time']}: {last.get('note', 'not estimated')}")
+        else:
+            lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
+                         f"[{last['low']:.3f}, {last['high']:.3f}]"
+                         + ("" if last["trusted"] else " (untrusted)"))
     lines.append(f"alarm (threshold {al['threshold']:.3f}): "
                  + (f"raised {al['first_time']}" + (", active" if al["active"] else
                                                       ", cleared since")

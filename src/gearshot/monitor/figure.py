@@ -29,6 +29,9 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
     import matplotlib.pyplot as plt
 
     recs = pd.DataFrame(payload["records"])
+    if len(recs):   # recordings that could not be estimated have no point to draw
+        recs = recs[recs["predicted"].notna()].astype({"predicted": float, "low": float,
+                                                         "high": float})
     fig, ax = plt.subplots(figsize=(9, 4.5))
     if len(recs):
         t = pd.to_datetime(recs["time"], format="ISO8601")

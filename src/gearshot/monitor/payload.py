@@ -3,9 +3,10 @@
 :func:`monitor_payload` turns a history (:mod:`gearshot.monitor.history`) and the model in
 use into the JSON of ``gearshot monitor --json``: ``records`` (per recording, the current
 model's estimate: ``recording``, ``time``, ``predicted``, ``low``, ``high``, ``trusted``,
-``alarm``), ``alarm`` (``threshold``, ``first_time``) and ``forecast`` (``limit``,
-``time``, ``low``, ``high``, ``law``; the last four null with a ``reason`` when no
-forecast is made), and the estimates of earlier models (``earlier_estimates``).
+``alarm``; times in UTC; the estimate null for a recording that could not be
+estimated, with its ``note``), ``alarm`` (``threshold``, ``first_time``) and
+``forecast`` (``limit``, ``time``, ``low``, ``high``, ``law``; the last four null with a
+``reason`` when no forecast is made), and the estimates of earlier models (``earlier_estimates``).
 """
 
 from __future__ import annotations
@@ -35,6 +36,12 @@ def current_records(history: pd.DataFrame, model: str) -> pd.DataFrame:
     return rows.sort_values("time", kind="stable").reset_index(drop=True)
 
 
+def _num(value) -> float | None:
+    """A JSON number (None for a recording that could not be estimated)."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
 def _iso(value) -> str | None:
     return None if value is None else pd.Timestamp(value).isoformat()
 
@@ -60,10 +67,11 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                          rows["trusted"].to_numpy(bool), model.threshold,
                          sustain=model.sustain)
     records = [{"recording": r.recording, "time": _iso(r.time),
-                "predicted": float(r.predicted), "low": float(r.low), "high": float(r.high),
+                "predicted": _num(r.predicted), "low": _num(r.low), "high": _num(r.high),
                 "trusted": bool(r.trusted), "alarm": bool(a), "model": r.model,
                 "calibration": r.calibration, "segments": int(r.segments),
-                "trusted_segments": int(r.trusted_segments)}
+                "trusted_segments": int(r.trusted_segments),
+                "note": str(getattr(r, "note", "") or "")}
                for r, a in zip(rows.itertuples(index=False), state.alarm, strict=True)]
     first = None if state.first_index is None else _iso(rows["time"].iloc[state.first_index])
     ok = rows["trusted"].to_numpy(bool)
@@ -94,8 +102,8 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                   "sustain": int(model.sustain)},
         "forecast": forecast,
         "earlier_estimates": [
-            {"recording": r.recording, "time": _iso(r.time), "predicted": float(r.predicted),
-             "low": float(r.low), "high": float(r.high), "trusted": bool(r.trusted),
+            {"recording": r.recording, "time": _iso(r.time), "predicted": _num(r.predicted),
+             "low": _num(r.low), "high": _num(r.high), "trusted": bool(r.trusted),
              "model": r.model, "calibration": r.calibration}
             for r in earlier.itertuples(index=False)],
     }
