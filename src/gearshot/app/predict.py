@@ -62,6 +62,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     """
     from .files import expand_recordings
 
+    _check_files(healthy, faulty)        # before the recordings: the fit's files first
     if isinstance(recordings, (str, Path)):
         recordings = [recordings]
     files = expand_recordings(recordings, "--recordings")
@@ -113,9 +114,7 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     from ..sim import load_database
     from .conditions import choose_condition
 
-    for p in [*healthy, *([] if faulty is None else [faulty])]:
-        if not Path(p).is_file():
-            raise GearshotError(f"recording {str(p)!r} does not exist")
+    _check_files(healthy, faulty)
     if faulty is not None:
         faulty_size = check_in_range(faulty_size, "faulty_size (--faulty-size)", 0.0, 1.0,
                                      low_inclusive=False)
@@ -137,6 +136,13 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
         est = OneFaultShotEstimator(random_state=seed)
         est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf, **kw)
     return est, FittedFiles(float(speed), float(load), kw, targets)
+
+
+def _check_files(healthy, faulty) -> None:
+    """Every healthy recording and the faulty one (when given) exist."""
+    for p in [*healthy, *([] if faulty is None else [faulty])]:
+        if not Path(p).is_file():
+            raise GearshotError(f"recording {str(p)!r} does not exist")
 
 
 def estimate_segments(est, sa, *, coverage=0.9) -> pd.DataFrame:
