@@ -100,26 +100,10 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
     else:
-        from ..machine import Machine
-        from .predict_machine import fit_machine
-
-        mach = Machine.from_toml(machine)
-        est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size,
-                                     speed=speed, load=load,
-                                     cycles_per_segment=cycles_per_segment, sensor=sensor,
-                                     holdout=holdout, seed=seed,
-                                     speed_tolerance=speed_tolerance)
-        held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
-        if not held:
-            raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
-                                f"fit; the alarm baseline needs some (raise --holdout)")
-        baseline = estimate_segments(est, np.stack(held), coverage=coverage)["predicted"]
-        cps = mach.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
-        assert cps is not None   # fit_machine refused a machine without one
-        condition = {"speed": float(cond.speed), "load": float(cond.load),
-                     "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
-                     "sensor": mach.sensor(sensor).name,
-                     "speed_tolerance": float(speed_tolerance)}
+        est, baseline, condition = _fit_with_machine(
+            machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
+            coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
+            holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
         toml = Path(machine).read_text(encoding="utf-8")
     baseline = np.asarray(baseline, float)
     result = MonitorModel(
@@ -134,6 +118,33 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                 "grade": getattr(est, "grade_", None)})
     result.save(model)
     return result
+
+
+def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
+                      coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
+    """``fit_model`` through a machine file: (estimator, healthy baseline, condition)."""
+    from ..machine import Machine
+    from .predict import estimate_segments
+    from .predict_machine import fit_machine
+
+    mach = Machine.from_toml(machine)
+    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size,
+                                 speed=speed, load=load,
+                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                 holdout=holdout, seed=seed,
+                                 speed_tolerance=speed_tolerance)
+    held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
+    if not held:
+        raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
+                            f"fit; the alarm baseline needs some (raise --holdout)")
+    baseline = estimate_segments(est, np.stack(held), coverage=coverage)["predicted"]
+    cps = mach.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
+    assert cps is not None   # fit_machine refused a machine without one
+    condition = {"speed": float(cond.speed), "load": float(cond.load),
+                 "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
+                 "sensor": mach.sensor(sensor).name,
+                 "speed_tolerance": float(speed_tolerance)}
+    return est, baseline, condition
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:

@@ -52,6 +52,24 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
                label=f"alarm threshold {al['threshold']:.2f}")
     fc = payload["forecast"]
     ax.axhline(fc["limit"], color="tab:red", ls=":", label=f"limit {fc['limit']:g}")
+    _draw_forecast(ax, fc, recs)
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel("time")
+    ax.set_ylabel("estimated fault size")
+    calib = payload.get("calibration", "")
+    ax.set_title(title or f"fault size over time ({calib.replace('_', ' ')} model)")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, 0.92))
+    fig.autofmt_xdate()
+    fig.tight_layout()
+    path = Path(path)
+    with atomic_path(path, make_parents=True) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
+
+
+def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> None:
+    """The forecast band and the fitted law (or the reason there is none)."""
     if fc.get("time"):
         lo = pd.Timestamp(fc["low"]) if fc.get("low") else pd.Timestamp(fc["time"])
         hi = pd.Timestamp(fc["high"]) if fc.get("high") else pd.Timestamp(fc["time"])
@@ -75,16 +93,3 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
     else:
         ax.text(0.01, 0.97, f"no forecast: {fc.get('reason')}", transform=ax.transAxes,
                 va="top", fontsize=8)
-    ax.set_ylim(-0.05, 1.05)
-    ax.set_xlabel("time")
-    ax.set_ylabel("estimated fault size")
-    calib = payload.get("calibration", "")
-    ax.set_title(title or f"fault size over time ({calib.replace('_', ' ')} model)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, 0.92))
-    fig.autofmt_xdate()
-    fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path, make_parents=True) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
