@@ -21,6 +21,7 @@ __all__ = ["FILE_OPTIONS", "spread_file_options", "expand_recordings", "recordin
 #: Options that take recording files, each any number of them after one flag, by command
 #: (``gearshot rig --healthy N`` is a count, not files)
 FILE_OPTIONS = {"predict": frozenset({"--healthy", "--recordings"}),
+                "fit": frozenset({"--healthy"}),
                 "indicators": frozenset({"--baseline"})}
 
 

@@ -9,13 +9,13 @@ import numpy as np
 import pandas as pd
 
 from .._errors import GearshotError
-from .._validation import check_in_range
-from ..io.input_health import input_check_column, mark_rows, require_ok
-from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
+from ..io.input_health import input_check_column, mark_rows
 from .fit_summary import fit_attrs
+from .predict_fit import FittedFiles, _check_files, _key, estimate_segments, fit_from_files
 from .trust import add_trust_columns, fit_check_line, trust_summary
 
-__all__ = ["predict_from_files", "predict_recordings", "write_predictions",
+__all__ = ["predict_from_files", "fit_from_files", "estimate_segments", "FittedFiles",
+           "predict_recordings", "write_predictions",
            "predictions_payload", "FIT_KEYS",
            "format_predictions", "comparable_summary", "input_check_summary",
            "trust_summary", "fit_check_line", "add_trust_columns", "summary_table", "ROLES"]
@@ -78,54 +78,35 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
         :meth:`~gearshot.estimator.fit_check.FitCheck.as_dict`. A healthy or faulty
         recording that fails an input check is refused.
     """
-    from ..estimator import OneFaultShotEstimator, default_selection_tf
-    from ..sim import load_database
-    from .conditions import choose_condition
     from .files import expand_recordings
 
-    for p in [*healthy, faulty]:
-        if not Path(p).is_file():
-            raise GearshotError(f"recording {str(p)!r} does not exist")
-    faulty_size = check_in_range(faulty_size, "faulty_size (--faulty-size)", 0.0, 1.0,
-                                 low_inclusive=False)
-    coverage = check_in_range(coverage, "coverage (--coverage)", 0.0, 1.0,
-                              low_inclusive=False, high_inclusive=False)
+    _check_files(healthy, faulty)        # before the recordings: the fit's files first
     if isinstance(recordings, (str, Path)):
         recordings = [recordings]
     files = expand_recordings(recordings, "--recordings")
-    speed, load = choose_condition(database, None, speed=speed, load=load, measured=[])
-    db = load_database(database, speed=speed, load=load)
-    # the pair is the database's unless declared (a declared other pair is refused by fit)
-    teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
-    kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
-          for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
-    targets, healthy_sa, long, example, rest, held, health = _segments(
-        files, healthy, faulty, kw, holdout)
-    if selection_tf is None:
-        selection_tf = default_selection_tf(seed)
-    est = OneFaultShotEstimator(random_state=seed)
-    est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf,
-            holdout=holdout, healthy_holdout=np.vstack([sa for _, sa, _ in held]),
-            example_record=rest, **kw)
+    est, fit = fit_from_files(database, healthy, faulty, faulty_size, speed=speed, load=load,
+                              coverage=coverage, gear_teeth=gear_teeth,
+                              pinion_teeth=pinion_teeth, seed=seed,
+                              selection_tf=selection_tf, recordings=files, holdout=holdout)
     fitted = {_key(p) for p in healthy}
     estimated = {_key(p) for p in files}
     frames = []
-    for path, sa in targets:
+    for path, sa in fit.targets:
         roles = _roles(path, len(sa), fitted, faulty)
-        n_held = sum(len(h) for p, h, _ in held if _key(p) == _key(path))
+        n_held = sum(len(h) for p, h, _ in fit.held if _key(p) == _key(path))
         if n_held:
             roles[len(sa) - n_held:] = ["healthy_holdout"] * n_held
-        frames.append(_rows(est, path, roles, sa, coverage, health))
+        frames.append(_rows(est, path, roles, sa, coverage, fit.health))
     # the hold-outs that check the fit are estimated even when not asked for
-    for path, sa, n_fit in held:
+    for path, sa, n_fit in fit.held:
         if len(sa) and _key(path) not in estimated:
             frames.append(_rows(est, path, ["healthy_holdout"] * len(sa), sa, coverage,
-                                health, start=n_fit))
-    if _key(faulty) not in estimated and len(rest):
-        frames.append(_rows(est, faulty, ["faulty_rest"] * len(rest), rest, coverage,
-                            health, start=1))
+                                fit.health, start=n_fit))
+    if _key(faulty) not in estimated and len(fit.rest):
+        frames.append(_rows(est, faulty, ["faulty_rest"] * len(fit.rest), fit.rest, coverage,
+                            fit.health, start=1))
     frame = pd.concat(frames, ignore_index=True)
-    frame.attrs["speed"], frame.attrs["load"] = speed, load
+    frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
     add_trust_columns(frame, est.fit_check_)
     frame.attrs.update(fit_attrs(est))
     return frame
@@ -145,49 +126,6 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
                              below_detection_limit=below_detection_limit(est, predicted),
                              comparability=comp.p_value, comparable=comp.comparable))
     return mark_rows(rows, input_check_column(**health[_key(path)], rows=rows["segment"]))
-
-
-def _segments(files, healthy, faulty, kw, holdout=0.0):
-    """SA segments of the targets; the healthy recordings' fitted segments (stacked; the
-    first one's long angle-domain signal too, without its hold-outs); the faulty example
-    (the faulty recording's first segment) and its record's other segments; each healthy
-    recording's hold-outs (its last ``floor(holdout · n)`` segments) as (path, SAs).
-
-    Every recording is read and segmented before the fit: a file too short for one SA
-    segment (or unreadable) fails now, not after minutes of fitting.
-    """
-    from ..estimator.fit_check import holdout_count
-    from ..io import recording_segments
-
-    health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)
-
-    def cut(path, role=None, **more):
-        found: dict = {}
-        out = recording_segments(path, health=found, **more, **kw)
-        health[_key(path)] = found
-        if role is not None:   # a recording the fit uses: refused unless every check passes
-            for check in (found["recording"], *found["segments"]):
-                require_ok(check, path, role)
-        return out
-
-    targets = [(path, cut(path)) for path in files]
-    healthy_sa, long, held = [], None, []
-    for i, p in enumerate(healthy):
-        if i == 0:
-            sa, long = cut(p, "healthy", long=True)
-        else:
-            sa = cut(p, "healthy")
-        n_fit = len(sa) - holdout_count(len(sa), holdout)
-        if i == 0 and n_fit < len(sa):  # held-out segments stay out of the TF estimate
-            long = long[: n_fit * CYCLES_PER_SEGMENT * SAMPLES_PER_CYCLE]
-        healthy_sa.append(sa[:n_fit])
-        held.append((p, sa[n_fit:], n_fit))
-    faulty_sa = cut(faulty, "faulty")
-    return targets, np.vstack(healthy_sa), long, faulty_sa[0], faulty_sa[1:], held, health
-
-
-def _key(path) -> Path:
-    return Path(path).resolve()
 
 
 def _roles(path, n: int, fitted: set, faulty) -> list[str]:

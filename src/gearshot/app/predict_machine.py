@@ -15,10 +15,11 @@ from .._validation import check_in_range, check_int
 from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
+from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
 from .trust import add_trust_columns
 
-__all__ = ["machine_segments", "predict_from_machine", "machine_database_path",
+__all__ = ["machine_segments", "predict_from_machine", "fit_machine", "machine_database_path",
            "check_database_pair"]
 
 
@@ -154,34 +155,51 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     -------
     pandas.DataFrame
         ``recording, role, segment, speed_hz, database_speed_hz, database_load,
-        load_source, load_clarity, predicted, low, high, comparability, comparable,
-        input_check, speed_source, speed_uncertainty_hz, speed_check, fit_check, trusted``
-        (``database_load``: the load
-        estimated at, N m, ``load_source`` ``given``, ``only`` (the database's one load) or
-        ``chosen`` (from the healthy recordings, with its ``load_clarity``); ``speed_hz``: the
-        recording's reference-shaft speed; ``database_speed_hz``: the condition it is
-        estimated at, both in Hz of the tacho (reference) shaft;
-        ``comparability``/``comparable``: the p-value of
-        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability` (the share of the
-        fitted machine's healthy segments that look at least as far from it) and whether
-        it is at least the stated false-alarm rate (0.01); ``speed_source``: ``tacho`` or
-        ``vibration``, with the standard uncertainty of the instantaneous speed, rev/s, for
-        ``vibration``; ``speed_check``: ``ok`` or why a tracked speed is not to be trusted
-        (such a row is not trusted); ``input_check``: ``"ok"`` or the failed check of
-        :mod:`gearshot.io.input_health`, per recording and segment, with the row's
-        ``predicted``/``low``/``high`` withdrawn (NaN) when it failed; a healthy or faulty
-        recording that fails is refused), ``fit_check`` (the fit's verdict on its own
-        hold-outs, the same in every row: "passed" or the reason,
-        :attr:`OneFaultShotEstimator.fit_check_`) and ``trusted``
-        (:func:`gearshot.estimator.trusted_column`: every check passes); ``attrs`` hold
-        the ``fit_check`` (:meth:`FitCheck.as_dict`), the condition (``speed_hz``, ``load``,
-        ``load_source``, ``load_choice``: :meth:`LoadChoice.as_dict` or None), the grade
-        and the simulated reference.
+        load_source, load_clarity, predicted, low, high, below_detection_limit,
+        comparability, comparable, input_check, speed_source, speed_uncertainty_hz,
+        speed_check, fit_check, trusted``: ``database_load`` the load estimated at (N m;
+        ``load_source`` ``given``, ``only`` or ``chosen`` with its ``load_clarity``);
+        ``speed_hz`` the recording's and ``database_speed_hz`` the condition's speed (Hz of
+        the tacho shaft); ``comparability`` the p-value of
+        :meth:`~gearshot.estimator.OneFaultShotEstimator.comparability`; ``speed_check``
+        ``ok`` or why a tracked speed is not to be trusted; ``input_check`` ``ok`` or the
+        failed check (:mod:`gearshot.io.input_health`; the estimate withdrawn); ``fit_check``
+        the fit's verdict; ``trusted`` every check passed
+        (:func:`gearshot.estimator.trusted_column`). ``attrs``: the ``fit_check``, the
+        condition, the grade and the simulated reference.
+    """
+    est, seg, cond = fit_machine(machine, database, healthy, faulty, faulty_size, recordings,
+                                 speed=speed, load=load,
+                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                 holdout=holdout, example_segment=example_segment, seed=seed,
+                                 params=params, speed_tolerance=speed_tolerance)
+    frame = _estimates(est, seg, cond, coverage)
+    add_trust_columns(frame, est.fit_check_)
+    frame.attrs.update(fit_attrs(est))
+    return frame
+
+
+def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | Path | None,
+                faulty_size: float | None, recordings: Sequence[str | Path] = (), *,
+                speed: float | None = None, load: float | None = None,
+                cycles_per_segment: int | None = None, sensor: str | None = None,
+                holdout: float = 0.25, example_segment: int = 0, seed: int = 0,
+                params: dict | None = None, speed_tolerance: float = SPEED_TOLERANCE):
+    """The fit of :func:`predict_from_machine` (same parameters); ``faulty`` None fits
+    zero-shot (``calibration="zero_shot"``).
+
+    Returns
+    -------
+    estimator : OneFaultShotEstimator
+    segments : _Segments
+        Every recording's SA segments by role (``rows``: file, role, segment, speed, SA).
+    condition : _Condition
+        The database condition estimated at.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
 
-    cps = _check_options(machine, healthy, [faulty, *recordings], cycles_per_segment,
-                         holdout)
+    others = [*([] if faulty is None else [faulty]), *recordings]
+    cps = _check_options(machine, healthy, others, cycles_per_segment, holdout)
     database_conditions(database, machine)   # a bad --database fails now
     check_database_pair(database, machine)
     # the machine file must put its mesh orders where the healthy recordings have them
@@ -193,20 +211,17 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
     # too), on the simulated side as on the recorded one
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
+    calibration = {} if faulty is not None else {"calibration": "zero_shot"}
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
-                                   "mesh_order": meshes})
+                                   "mesh_order": meshes, **calibration})
     # the database must be of the machine's monitored pair (refused otherwise)
-    est.fit(cond.slice, np.vstack(seg.train), seg.example, faulty_size, seg.long,
+    est.fit(cond.slice, np.vstack(seg.train), seg.example,
+            None if faulty is None else faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1], holdout=holdout,
             healthy_holdout=seg.holdout_sas("healthy_holdout"),
-            example_record=seg.holdout_sas("faulty_rest"))
-    frame = _estimates(est, seg, cond, coverage)
-    add_trust_columns(frame, est.fit_check_)
-    from .fit_summary import fit_attrs
-
-    frame.attrs.update(fit_attrs(est))
-    return frame
+            example_record=None if faulty is None else seg.holdout_sas("faulty_rest"))
+    return est, seg, cond
 
 
 def check_database_pair(database: str | Path, machine) -> None:
@@ -298,13 +313,14 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
             seg.long = x[: n_fit * cps * spc]  # held-out segments stay out of the TF estimate
         seg.rows.extend((str(p), "healthy_holdout", k, sp, sa[k])
                         for k in range(n_fit, sa.shape[0]))
-    fsa, _, fsp = cut(faulty)
-    _require_fit_input(seg.sources[str(faulty)], faulty, "faulty")
-    example_segment = check_int(example_segment, "example_segment", minimum=0,
-                                maximum=fsa.shape[0] - 1)
-    seg.example = fsa[example_segment]
-    seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
-                    for k in range(fsa.shape[0]) if k != example_segment)
+    if faulty is not None:
+        fsa, _, fsp = cut(faulty)
+        _require_fit_input(seg.sources[str(faulty)], faulty, "faulty")
+        example_segment = check_int(example_segment, "example_segment", minimum=0,
+                                    maximum=fsa.shape[0] - 1)
+        seg.example = fsa[example_segment]
+        seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
+                        for k in range(fsa.shape[0]) if k != example_segment)
     for p in recordings:
         sa, _, sp = cut(p)
         seg.rows.extend((str(p), "test", k, sp, sa[k]) for k in range(sa.shape[0]))

@@ -19,6 +19,7 @@ from . import report_schema as schema
 from . import report_tables
 from .markdown import md_table as _md_table
 from .markdown import write_markdown, write_report
+from .monitor_report import check_monitor, monitor_report
 from .report_predict import predict_report, predict_rows, short_value
 
 __all__ = ["write_report", "json_kind", "report_from_any_json", "read_output", "KINDS",
@@ -26,9 +27,9 @@ __all__ = ["write_report", "json_kind", "report_from_any_json", "read_output", "
 
 KINDS_TEXT = ("predict --out X.csv or X.json, demo results.json, ablations.csv or "
               "predictions.csv, experiment simulated/rig --json, experiment rig-family "
-              "--json, indicators --json or its ranking.csv")
+              "--json, indicators --json or its ranking.csv, monitor --json")
 #: The kinds a JSON declares (``kind`` or ``experiment``); the others are CSV tables.
-JSON_KINDS = ("predict", "demo", "simulated", "rig", "rig-family", "indicators")
+JSON_KINDS = ("predict", "demo", "simulated", "rig", "rig-family", "indicators", "monitor")
 #: The deepest nesting of lists and objects an output may have (gearshot writes at most 5).
 MAX_DEPTH = 16
 #: The largest output file ``report`` reads (bytes).
@@ -298,6 +299,7 @@ KINDS: dict[str, tuple[Check, Render]] = {
     "rig": (_check_experiment, _experiment_report),
     "rig-family": (_check_family, _family_report),
     "indicators": (_check_indicators, _indicators_report),
+    "monitor": (check_monitor, monitor_report),
     "ranking": (report_tables.check_ranking, report_tables.ranking_report),
     "sizes": (report_tables.check_sizes, report_tables.sizes_report),
 }

@@ -26,7 +26,7 @@ from .. import __version__
 from .._atomic import atomic_path
 from .._errors import GearshotError, NotFittedError
 
-__all__ = ["save_estimator", "load_estimator", "SAFE_TYPES"]
+__all__ = ["save_estimator", "load_estimator", "read_skops", "SAFE_TYPES"]
 
 _FORMAT = "gearshot-estimator/2"
 _PICKLE_FORMAT = "gearshot-estimator/1"
@@ -92,9 +92,17 @@ def load_estimator(path: str | os.PathLike[str], *, trusted: bool = False) -> An
         raise GearshotError(f"estimator file {str(path)!r} does not exist")
     if not zipfile.is_zipfile(path):
         return _load_pickle(path, trusted)
-    _check_schema_size(path)
+    return _checked(path, read_skops(path, trusted=trusted), _FORMAT)
+
+
+def read_skops(path: str | os.PathLike[str], *, trusted: bool = False) -> Any:
+    """The object of a skops file, constructed only when every type it names is in
+    :data:`SAFE_TYPES` (or ``trusted=True``); a damaged file is a GearshotError. For
+    files that carry a fitted estimator with more (the monitor's model file)."""
     import skops.io as sio
 
+    path = Path(path)
+    _check_schema_size(path)
     try:
         found = sio.get_untrusted_types(file=path)
     except Exception as exc:
@@ -106,11 +114,10 @@ def load_estimator(path: str | os.PathLike[str], *, trusted: bool = False) -> An
                             f"estimator holds ({', '.join(unknown[:5])}); not loaded. Load "
                             f"it only if you made it: load_estimator(path, trusted=True)")
     try:
-        payload = sio.load(path, trusted=list(found))
+        return sio.load(path, trusted=list(found))
     except Exception as exc:
         raise GearshotError(f"{str(path)!r} is not a readable gearshot estimator "
                             f"({type(exc).__name__}: {exc})") from None
-    return _checked(path, payload, _FORMAT)
 
 
 #: Largest ``schema.json`` member of a skops file read (a saved estimator's is tens of kB):

@@ -304,6 +304,15 @@ class VirtualRig:
         out["path"] = [str((folder / p).resolve()) for p in out["path"]]
         return out
 
+    def history(self, folder: str | os.PathLike, **options: Any) -> pd.DataFrame:
+        """Record a machine's life into ``folder``: healthy first, then a fault growing by a
+        stated law, with run-to-run variation, a load change and a sensor remount partway;
+        writes ``index.csv`` (``file``, ``time``, ``size``, ``event``). The options and
+        defaults are :func:`gearshot.rig.history.record_history`'s."""
+        from .history import record_history
+
+        return record_history(self, folder, **options)
+
     def _record_jobs(self, staging: Path, folder: Path, jobs: list[tuple[float, int]], *,
                      speed: float, load: float, duration: float, dtype: str,
                      progress: bool) -> pd.DataFrame:

@@ -17,7 +17,7 @@ import typer
 
 from ..._atomic import os_error_text
 from ..._errors import GearshotError
-from . import build, estimate, experiment  # noqa: F401  (they register the commands)
+from . import build, estimate, experiment, monitor  # noqa: F401  (they register the commands)
 from ._apps import VERBOSITY, app, experiment_app
 from ._options import empty_value
 

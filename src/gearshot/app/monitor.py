@@ -1,0 +1,345 @@
+"""``gearshot fit`` and ``gearshot monitor``: fit once, then estimate every new recording.
+
+:func:`fit_model` fits through the fit of ``gearshot predict`` (with or without a machine
+file; without a faulty recording zero-shot) and writes a model file
+(:class:`gearshot.monitor.MonitorModel`) with the healthy baseline of recordings kept out
+of the fit. :func:`estimate_recordings` estimates recordings with a saved model through
+the estimate of ``gearshot predict`` (:func:`gearshot.app.predict.estimate_segments`), one
+combined row per recording. :func:`monitor_history` brings a history up to date with an
+index and returns the ``--json`` payload; :func:`monitor_fleet` does that for many
+machines in one call, on a Dask cluster.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .._errors import GearshotError
+from .._validation import check_in_range
+
+__all__ = ["fit_model", "estimate_recordings", "monitor_history", "monitor_fleet",
+           "write_monitor_outputs", "format_monitor", "LOAD_TOLERANCE"]
+
+#: Relative distance of an index's ``load`` from the model's load beyond which a
+#: recording is not covered by the fit (untrusted).
+LOAD_TOLERANCE = 0.15
+
+
+def _holdout_split(healthy: Sequence[str | Path], holdout: float) -> tuple[list, list]:
+    """(fit, baseline) healthy recordings: the last ``holdout`` share (at least one) is
+    kept out of the fit for the alarm baseline."""
+    healthy = list(healthy)
+    if len(healthy) < 2:
+        raise GearshotError(f"--healthy needs at least 2 recordings (one is kept out of the "
+                            f"fit for the alarm's healthy baseline); got {len(healthy)}")
+    n_hold = min(max(1, int(round(holdout * len(healthy)))), len(healthy) - 1)
+    return healthy[:-n_hold], healthy[-n_hold:]
+
+
+def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None = None,
+              faulty_size: float | None = None, *, model: str | Path,
+              machine: str | Path | None = None, speed: float | None = None,
+              load: float | None = None, coverage: float = 0.9,
+              gear_teeth: int | None = None, pinion_teeth: int | None = None, seed: int = 0,
+              cycles_per_segment: int | None = None, sensor: str | None = None,
+              holdout: float = 0.25, speed_tolerance: float = 0.05,
+              false_alarm_rate: float | None = None, sustain: int | None = None):
+    """Fit and write a model file (``gearshot fit``).
+
+    Parameters
+    ----------
+    database, healthy, faulty, faulty_size, machine, speed, load, coverage, gear_teeth,
+    pinion_teeth, seed, cycles_per_segment, sensor, speed_tolerance
+        As for ``gearshot predict`` (:func:`gearshot.app.predict.predict_recordings`);
+        ``faulty`` None fits zero-shot.
+    model : path
+        The model file to write (skops).
+    holdout : float
+        Without a machine file: the share of the healthy recordings (at least one) kept
+        out of the fit; with one: the share of each healthy recording's segments. Their
+        estimates are the healthy baseline the alarm threshold is set from.
+    false_alarm_rate, sustain
+        Of the alarm (default :data:`gearshot.monitor.alarm.FALSE_ALARM_RATE`,
+        :data:`~gearshot.monitor.alarm.SUSTAIN`).
+
+    Returns
+    -------
+    MonitorModel
+        Saved at ``model``.
+    """
+    from ..monitor import MonitorModel, alarm_threshold, database_identity
+    from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
+    from .predict import estimate_segments
+
+    rate = FALSE_ALARM_RATE if false_alarm_rate is None else false_alarm_rate
+    sustain = SUSTAIN if sustain is None else sustain
+    if (faulty is None) != (faulty_size is None):
+        raise GearshotError("--faulty and --faulty-size go together (neither: zero-shot)")
+    check_in_range(holdout, "holdout (--holdout)", 0.0, 1.0, low_inclusive=False,
+                   high_inclusive=False)
+    identity = database_identity(database)
+    if machine is None:
+        if speed is None:
+            raise GearshotError("--speed is required without --machine (the database's "
+                                "speed, rps)")
+        from .predict import fit_from_files
+
+        fit_files, base_files = _holdout_split(healthy, holdout)
+        est, fitted = fit_from_files(database, fit_files, faulty, faulty_size, speed=speed,
+                                     load=load, coverage=coverage, gear_teeth=gear_teeth,
+                                     pinion_teeth=pinion_teeth, seed=seed,
+                                     recordings=base_files)
+        baseline = np.concatenate([estimate_segments(est, sa, coverage=coverage)["predicted"]
+                                   for _, sa in fitted.targets])
+        condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
+                     **{k: int(v) for k, v in fitted.teeth.items()}}
+        toml = None
+    else:
+        est, baseline, condition = _fit_with_machine(
+            machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
+            coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
+            holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
+        toml = Path(machine).read_text(encoding="utf-8")
+    baseline = np.asarray(baseline, float)
+    result = MonitorModel(
+        estimator=est, calibration="zero_shot" if faulty is None else "one_fault_shot",
+        condition=condition, database=identity, baseline=baseline.tolist(),
+        threshold=alarm_threshold(baseline, false_alarm_rate=rate),
+        false_alarm_rate=float(rate), sustain=int(sustain), machine_toml=toml,
+        faulty=None if faulty is None or faulty_size is None else {
+            "recording": str(Path(faulty).resolve()), "size": float(faulty_size)},
+        fit_check=getattr(est, "fit_check_", None), coverage=float(coverage), seed=int(seed),
+        extras={"healthy": [str(Path(p).resolve()) for p in healthy],
+                "grade": getattr(est, "grade_", None)})
+    result.save(model)
+    return result
+
+
+def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
+                      coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
+    """``fit_model`` through a machine file: (estimator, healthy baseline, condition)."""
+    from ..machine import Machine
+    from .predict import estimate_segments
+    from .predict_machine import fit_machine
+
+    mach = Machine.from_toml(machine)
+    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size,
+                                 speed=speed, load=load,
+                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                 holdout=holdout, seed=seed,
+                                 speed_tolerance=speed_tolerance)
+    held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
+    if not held:
+        raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
+                            f"fit; the alarm baseline needs some (raise --holdout)")
+    baseline = estimate_segments(est, np.stack(held), coverage=coverage)["predicted"]
+    cps = mach.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
+    assert cps is not None   # fit_machine refused a machine without one
+    condition = {"speed": float(cond.speed), "load": float(cond.load),
+                 "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
+                 "sensor": mach.sensor(sensor).name,
+                 "speed_tolerance": float(speed_tolerance)}
+    return est, baseline, condition
+
+
+def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
+    """SA segments of one recording as the model's fit segmented its recordings, and a
+    note ("" or why the recording is not covered)."""
+    cond = model.condition
+    if machine is None:
+        from ..io import recording_segments
+
+        sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
+                                pinion_teeth=cond["pinion_teeth"])
+        return np.asarray(sa), ""
+    from .predict_machine import machine_segments
+
+    sa, _, hz = machine_segments(path, machine, cycles_per_segment=cond["cycles_per_segment"],
+                                 sensor=cond["sensor"])
+    off = abs(hz - cond["speed"]) / cond["speed"]
+    note = "" if off <= cond["speed_tolerance"] else (
+        f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
+    return sa, note
+
+
+def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
+    """Estimate recordings with a saved model: one history row per recording.
+
+    Parameters
+    ----------
+    model : MonitorModel
+        Saved (its digest names the rows).
+    recordings : pandas.DataFrame
+        Rows of :func:`gearshot.monitor.read_index` (``recording``, ``time``, optional
+        ``speed``/``load``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :data:`gearshot.monitor.HISTORY_COLUMNS`. A recording that cannot be
+        read or segmented, or whose index ``load`` (or ``speed``) lies outside the fitted
+        condition, is kept, untrusted, with the reason in ``note``.
+    """
+    from ..monitor import combine_segments
+    from .predict import estimate_segments
+
+    machine = model.machine
+    digest = model.digest
+    now = pd.Timestamp.now(tz="UTC").tz_localize(None)
+    rows = []
+    for rec in recordings.itertuples(index=False):
+        row = {"recording": rec.recording, "time": pd.Timestamp(rec.time), "model": digest,
+               "calibration": model.calibration, "estimated_at": now}
+        try:
+            sa, note = _segments_of(model, Path(rec.recording), machine)
+            frame = estimate_segments(model.estimator, sa, coverage=model.coverage)
+            row.update(combine_segments(frame))
+        except GearshotError as exc:
+            row.update(predicted=np.nan, low=np.nan, high=np.nan, segments=0,
+                       trusted_segments=0, trusted=False)
+            note = f"not estimated: {exc}"
+        note = note or _condition_note(model, rec)
+        if note:
+            row["trusted"] = False
+        row["note"] = note
+        rows.append(row)
+    from ..monitor import HISTORY_COLUMNS
+
+    return pd.DataFrame(rows, columns=HISTORY_COLUMNS)
+
+
+def _condition_note(model, rec) -> str:
+    """Why an index row's declared speed/load lies outside the fit ("" when it does not
+    or the index declares none)."""
+    cond = model.condition
+    load = getattr(rec, "load", None)
+    if load not in (None, "") and np.isfinite(float(load)):
+        off = abs(float(load) - cond["load"]) / cond["load"]
+        if off > LOAD_TOLERANCE:
+            return f"index load {float(load):g} N m is outside the fitted {cond['load']:g} N m"
+    speed = getattr(rec, "speed", None)
+    if speed not in (None, "") and np.isfinite(float(speed)):
+        tol = cond.get("speed_tolerance", 0.05)
+        off = abs(float(speed) - cond["speed"]) / cond["speed"]
+        if off > tol:
+            return f"index speed {float(speed):g} is outside the fitted {cond['speed']:g}"
+    return ""
+
+
+def _estimate_chunk(model_path: str, chunk: pd.DataFrame) -> pd.DataFrame:
+    """A worker's share: load the model once, estimate its recordings."""
+    from ..monitor import load_model
+
+    return estimate_recordings(load_model(model_path), chunk)
+
+
+def monitor_history(model: str | Path, index: str | Path, history: str | Path, *,
+                    limit: float = 0.6, client: Any = None, seed: int = 0) -> dict:
+    """Estimate the recordings of ``index`` that ``history`` holds no estimate of by this
+    model, append them (atomically) and return the ``--json`` payload.
+
+    Parameters
+    ----------
+    model : path
+        Model file (``gearshot fit --model``).
+    index : path
+        CSV (:func:`gearshot.monitor.read_index`).
+    history : path
+        Parquet history (created when missing).
+    limit : float
+        Size whose crossing is forecast.
+    client : dask.distributed.Client, optional
+        Spread the recordings over its workers.
+    """
+    from ..monitor import append_history, load_model, monitor_payload, pending, read_history
+    from ..monitor import read_index as read_idx
+
+    limit = check_in_range(limit, "limit (--limit)", 0.0, 1.0, low_inclusive=False)
+    mdl = load_model(model)
+    table = read_idx(index)
+    past = read_history(history)
+    todo = pending(table, past, mdl.digest)
+    if len(todo):
+        if client is None:
+            rows = estimate_recordings(mdl, todo)
+        else:
+            n = max(1, min(len(todo), 4 * len(client.nthreads())))
+            chunks = [c for c in np.array_split(np.arange(len(todo)), n) if c.size]
+            futures = client.map(_estimate_chunk, [str(Path(model).resolve())] * len(chunks),
+                                 [todo.iloc[c] for c in chunks], pure=False)
+            rows = pd.concat(client.gather(futures), ignore_index=True)
+        past = append_history(history, rows)
+    payload = monitor_payload(past, mdl, limit=limit, seed=seed)
+    payload["new"] = int(len(todo))
+    payload["history"] = str(Path(history))
+    return payload
+
+
+def monitor_fleet(jobs: Sequence[tuple[str | Path, str | Path, str | Path]], *,
+                  limit: float = 0.6, scheduler: str | None = None, workers: int = 2,
+                  seed: int = 0) -> list[dict]:
+    """:func:`monitor_history` for many machines, ``(model, index, history)`` each, the
+    new recordings of all of them estimated on one Dask cluster (``scheduler``, or a
+    LocalCluster of ``workers``; in-process with one worker)."""
+    from .._cluster import dask_client
+
+    with dask_client(scheduler, workers, needed=True) as client:
+        return [monitor_history(m, i, h, limit=limit, client=client, seed=seed)
+                for m, i, h in jobs]
+
+
+def write_monitor_outputs(payload: dict, *, json_out: Path | None = None,
+                          out: Path | None = None) -> list[Path]:
+    """Write the JSON and (``out``) the trend figure ``trend.png`` and the history as
+    CSV; returns the paths written."""
+    from .._atomic import atomic_path, write_json_atomic
+    from ..monitor.figure import trend_figure
+
+    written = []
+    if json_out is not None:
+        write_json_atomic(payload, json_out, make_parents=True, indent=2, sort_keys=False,
+                          default=float)
+        written.append(Path(json_out))
+    if out is not None:
+        written.append(trend_figure(payload, Path(out) / "trend.png"))
+        with atomic_path(Path(out) / "records.csv", make_parents=True) as tmp:
+            pd.DataFrame(payload["records"]).to_csv(tmp, index=False)
+        written.append(Path(out) / "records.csv")
+    return written
+
+
+def format_monitor(payload: dict) -> str:
+    """What ``gearshot monitor`` prints: the model, the counts, the alarm, the forecast."""
+    recs = payload["records"]
+    n_ok = sum(r["trusted"] for r in recs)
+    al, fc = payload["alarm"], payload["forecast"]
+    lines = [payload["model"]["description"],
+             f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
+             f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
+    if recs:
+        last = recs[-1]
+        if last["predicted"] is None:
+            lines.append(f"latest {last['time']}: {last.get('note', 'not estimated')}")
+        else:
+            lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
+                         f"[{last['low']:.3f}, {last['high']:.3f}]"
+                         + ("" if last["trusted"] else " (untrusted)"))
+    lines.append(f"alarm (threshold {al['threshold']:.3f}): "
+                 + (f"raised {al['first_time']}" + (", active" if al["active"] else
+                                                      ", cleared since")
+                    if al["first_time"] else "not raised"))
+    if fc["time"]:
+        lines.append(f"forecast ({fc['law']} law): size {fc['limit']:g} reached {fc['time']} "
+                     f"(interval {fc['low']} … {fc['high']})")
+    else:
+        lines.append(f"no forecast of size {fc['limit']:g}: {fc['reason']}")
+    if payload["calibration"] == "zero_shot":
+        lines.append("zero-shot model: sizes are from healthy data and simulation alone; "
+                     "refit with an inspected recording (gearshot fit --faulty … "
+                     "--faulty-size …) when one is measured")
+    return "\n".join(lines)

@@ -1,0 +1,82 @@
+"""``gearshot report`` of a ``gearshot monitor --json``: the trend figure and a summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from .markdown import md_table, write_markdown
+from .report_schema import Field, check_fields, check_rows
+
+__all__ = ["is_monitor_payload", "monitor_report", "check_monitor", "MONITOR_RECORD"]
+
+#: One record of ``gearshot monitor --json`` (more keys are allowed).
+MONITOR_RECORD = {
+    "recording": Field("str"),
+    "time": Field("str"),
+    "predicted": Field("number", nullable=True, low=0.0, high=1.0),
+    "low": Field("number", nullable=True, low=0.0, high=1.0),
+    "high": Field("number", nullable=True, low=0.0, high=1.0),
+    "trusted": Field("bool"),
+    "alarm": Field("bool"),
+}
+_ALARM = {"threshold": Field("number", low=0.0, high=1.0),
+          "first_time": Field("str", nullable=True)}
+_FORECAST = {"limit": Field("number", low=0.0, high=1.0),
+             "time": Field("str", nullable=True), "low": Field("str", nullable=True),
+             "high": Field("str", nullable=True), "law": Field("str", nullable=True),
+             "reason": Field("str", required=False, nullable=True)}
+
+
+def check_monitor(payload, where: str) -> None:
+    """Check a ``gearshot monitor --json`` against its declared keys (one line naming
+    the first bad field)."""
+    check_fields(payload, {"records": Field("any"), "alarm": Field("any"),
+                           "forecast": Field("any")}, where, "")
+    if payload["records"]:
+        check_rows(payload["records"], MONITOR_RECORD, where, "records")
+    check_fields(payload["alarm"], _ALARM, where, "alarm")
+    check_fields(payload["forecast"], _FORECAST, where, "forecast")
+
+
+def is_monitor_payload(payload) -> bool:
+    """Whether ``payload`` is a ``gearshot monitor --json``."""
+    return (isinstance(payload, dict) and payload.get("kind") == "monitor"
+            and isinstance(payload.get("records"), list) and "alarm" in payload
+            and "forecast" in payload)
+
+
+def monitor_report(payload: dict, out: Path, source: Path) -> Path:
+    """Write ``trend.png``, ``report.md`` and ``report.html`` (model, alarm, forecast, the
+    latest records) into ``out``; returns the Markdown's path."""
+    from ..monitor.figure import trend_figure
+
+    out = Path(out)
+    trend_figure(payload, out / "trend.png")
+    recs = pd.DataFrame(payload["records"])
+    al, fc = payload["alarm"], payload["forecast"]
+    model = payload.get("model", {})
+    lines = ["# gearshot monitor report", "", f"Source: `{source}`", "",
+             model.get("description", ""), ""]
+    if payload.get("calibration") == "zero_shot":
+        lines += ["**Zero-shot model**: no faulty example; sizes come from healthy data and "
+                  "simulation alone.", ""]
+    n_ok = int(recs["trusted"].sum()) if len(recs) else 0
+    lines += [f"Recordings: {len(recs)} ({n_ok} trusted, {len(recs) - n_ok} untrusted and "
+              f"not used).", "",
+              f"Alarm threshold {al['threshold']:.3f}: "
+              + (f"first raised {al['first_time']}." if al["first_time"] else "not raised."),
+              ""]
+    if fc.get("time"):
+        lines += [f"Forecast ({fc['law']} law): size {fc['limit']:g} reached {fc['time']} "
+                  f"(interval {fc['low']} … {fc['high']}).", ""]
+    else:
+        lines += [f"No forecast of size {fc['limit']:g}: {fc.get('reason')}.", ""]
+    lines += ["![trend](trend.png)", ""]
+    if len(recs):
+        last = recs.tail(20).copy()
+        last["recording"] = [Path(r).name for r in last["recording"]]
+        cols = ["recording", "time", "predicted", "low", "high", "trusted", "alarm"]
+        lines += ["## Latest recordings", "", *md_table(last[cols])]
+    return write_markdown(out, lines)

@@ -1,0 +1,106 @@
+"""The alarm of a monitored machine: a size threshold from its own healthy baseline.
+
+Gear indicators have no universal limits: the threshold is the size a healthy recording
+of this machine exceeds with probability ``false_alarm_rate`` (:func:`alarm_threshold`,
+from the healthy estimates the model file carries), and an alarm is believed only when
+``sustain`` consecutive trusted recordings exceed it (:func:`alarm_states`). Untrusted
+recordings neither raise nor clear an alarm: they are skipped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import stats
+
+from .._errors import GearshotError
+from .._validation import check_in_range, check_int
+
+__all__ = ["alarm_threshold", "alarm_states", "AlarmResult", "FALSE_ALARM_RATE", "SUSTAIN",
+           "MIN_THRESHOLD"]
+
+#: Per-recording false-alarm probability the threshold is set at (chosen on the
+#: development lives, benchmarks/RESULTS.md "Monitoring").
+FALSE_ALARM_RATE = 0.01
+#: Consecutive trusted recordings over the threshold that raise (or under it that clear)
+#: the alarm (chosen on the development lives).
+SUSTAIN = 2
+#: Smallest threshold: a baseline of near-identical healthy estimates would otherwise set
+#: the threshold at the estimator's own resolution.
+MIN_THRESHOLD = 0.15
+
+
+def alarm_threshold(baseline: ArrayLike, *, false_alarm_rate: float = FALSE_ALARM_RATE
+                    ) -> float:
+    """Size a healthy recording exceeds with probability ``false_alarm_rate``.
+
+    A normal law fitted to the baseline (mean and standard deviation of healthy
+    recordings' estimates): ``mean + z(1 - false_alarm_rate) * std``, at least
+    :data:`MIN_THRESHOLD`.
+
+    Parameters
+    ----------
+    baseline : array_like, shape (n,)
+        Estimated sizes of healthy recordings the fit did not see (n ≥ 2).
+    false_alarm_rate : float in (0, 0.5)
+
+    Raises
+    ------
+    GearshotError
+        Fewer than two finite baseline values, or a rate outside (0, 0.5).
+    """
+    rate = check_in_range(false_alarm_rate, "false_alarm_rate", 0.0, 0.5,
+                          low_inclusive=False, high_inclusive=False)
+    values = np.asarray(baseline, dtype=float).ravel()
+    values = values[np.isfinite(values)]
+    if values.size < 2:
+        raise GearshotError(f"baseline needs at least 2 finite healthy estimates; got "
+                            f"{values.size}")
+    z = float(stats.norm.isf(rate))
+    return max(float(values.mean() + z * values.std(ddof=1)), MIN_THRESHOLD)
+
+
+@dataclass(frozen=True)
+class AlarmResult:
+    """Alarm state per recording and when it was first raised.
+
+    Attributes
+    ----------
+    alarm : ndarray of bool
+        Per recording: a trusted recording while the alarm stands (untrusted: False).
+    first_index : int or None
+        Index of the recording that first raised the alarm.
+    """
+
+    alarm: np.ndarray
+    first_index: int | None
+
+
+def alarm_states(predicted: ArrayLike, trusted: ArrayLike, threshold: float, *,
+                 sustain: int = SUSTAIN) -> AlarmResult:
+    """Run the alarm over recordings in time order.
+
+    The alarm is raised at the ``sustain``-th consecutive trusted recording over
+    ``threshold`` and cleared at the ``sustain``-th consecutive trusted one at or under it;
+    untrusted recordings are skipped (they neither count nor break a run).
+    """
+    sustain = check_int(sustain, "sustain", minimum=1)
+    y = np.asarray(predicted, dtype=float)
+    ok = np.asarray(trusted, dtype=bool)
+    if y.shape != ok.shape:
+        raise GearshotError(f"predicted and trusted differ in shape: {y.shape} vs {ok.shape}")
+    alarm = np.zeros(y.size, dtype=bool)
+    state, run, first = False, 0, None
+    for i in range(y.size):
+        if not ok[i] or not np.isfinite(y[i]):
+            continue
+        crossing = bool(y[i] > threshold) != state
+        run = run + 1 if crossing else 0
+        if run >= sustain:
+            state, run = not state, 0
+            if state and first is None:
+                first = i
+        alarm[i] = state
+    return AlarmResult(alarm, first)

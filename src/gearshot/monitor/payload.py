@@ -1,0 +1,109 @@
+"""What ``gearshot monitor`` reports: the records, the alarm and the forecast of a history.
+
+:func:`monitor_payload` turns a history (:mod:`gearshot.monitor.history`) and the model in
+use into the JSON of ``gearshot monitor --json``: ``records`` (per recording, the current
+model's estimate: ``recording``, ``time``, ``predicted``, ``low``, ``high``, ``trusted``,
+``alarm``; times in UTC; the estimate null for a recording that could not be
+estimated, with its ``note``), ``alarm`` (``threshold``, ``first_time``) and
+``forecast`` (``limit``, ``time``, ``low``, ``high``, ``law``; the last four null with a
+``reason`` when no forecast is made), and the estimates of earlier models (``earlier_estimates``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .alarm import alarm_states
+from .forecast import forecast_crossing
+
+__all__ = ["monitor_payload", "current_records", "DEFAULT_LIMIT"]
+
+DEFAULT_LIMIT = 0.6
+_DAY = pd.Timedelta(days=1)
+
+
+def current_records(history: pd.DataFrame, model: str) -> pd.DataFrame:
+    """Per recording, the estimate of ``model`` (or, for a recording it has not estimated,
+    the latest other one), in time order."""
+    mine = history[history["model"] == model]
+    others = history[(history["model"] != model)
+                     & ~history["recording"].isin(set(mine["recording"]))]
+    latest = others.sort_values("estimated_at", kind="stable").drop_duplicates(
+        "recording", keep="last")
+    rows = pd.concat([mine, latest], ignore_index=True)
+    rows["time"] = pd.to_datetime(rows["time"])
+    return rows.sort_values("time", kind="stable").reset_index(drop=True)
+
+
+def _num(value) -> float | None:
+    """A JSON number (None for a recording that could not be estimated)."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def _iso(value) -> str | None:
+    return None if value is None else pd.Timestamp(value).isoformat()
+
+
+def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMIT,
+                    seed: int = 0) -> dict:
+    """The ``gearshot monitor --json`` payload (module docstring).
+
+    Parameters
+    ----------
+    history : pandas.DataFrame
+        :func:`gearshot.monitor.history.read_history`.
+    model : MonitorModel
+        The model in use (saved: its digest names its estimates).
+    limit : float
+        Size whose crossing is forecast.
+    seed : int
+        Of the forecast's bootstrap.
+    """
+    digest = model.digest
+    rows = current_records(history, digest)
+    state = alarm_states(rows["predicted"].to_numpy(float),
+                         rows["trusted"].to_numpy(bool), model.threshold,
+                         sustain=model.sustain)
+    records = [{"recording": r.recording, "time": _iso(r.time),
+                "predicted": _num(r.predicted), "low": _num(r.low), "high": _num(r.high),
+                "trusted": bool(r.trusted), "alarm": bool(a), "model": r.model,
+                "calibration": r.calibration, "segments": int(r.segments),
+                "trusted_segments": int(r.trusted_segments),
+                "note": str(getattr(r, "note", "") or "")}
+               for r, a in zip(rows.itertuples(index=False), state.alarm, strict=True)]
+    first = None if state.first_index is None else _iso(rows["time"].iloc[state.first_index])
+    ok = rows["trusted"].to_numpy(bool)
+    t0 = rows["time"].iloc[0] if len(rows) else pd.Timestamp(0)
+    days = ((rows["time"] - t0) / _DAY).to_numpy(float)
+    fc = forecast_crossing(days[ok], rows["predicted"].to_numpy(float)[ok], limit, seed=seed)
+
+    def when(d):
+        return None if d is None or not np.isfinite(d) else _iso(t0 + d * _DAY)
+
+    forecast = {"limit": float(limit), "time": when(fc.time), "low": when(fc.low),
+                "high": when(fc.high), "law": fc.law, "reason": fc.reason}
+    if fc.fit is not None:
+        forecast["fit"] = {"onset": when(fc.fit.onset), "level": fc.fit.level,
+                           "amplitude": fc.fit.amplitude, "shape": fc.fit.shape,
+                           "sigma": fc.fit.sigma, "days_from": _iso(t0)}
+    earlier = history[history["model"] != digest]
+    return {
+        "kind": "monitor",
+        "model": {"digest": digest, "calibration": model.calibration,
+                  "description": model.describe(), "database": model.database,
+                  "fit_check": model.fit_check, "condition": model.condition},
+        "calibration": model.calibration,
+        "records": records,
+        "alarm": {"threshold": float(model.threshold), "first_time": first,
+                  "active": bool(state.alarm[ok][-1]) if ok.any() else False,
+                  "false_alarm_rate": float(model.false_alarm_rate),
+                  "sustain": int(model.sustain)},
+        "forecast": forecast,
+        "earlier_estimates": [
+            {"recording": r.recording, "time": _iso(r.time), "predicted": _num(r.predicted),
+             "low": _num(r.low), "high": _num(r.high), "trusted": bool(r.trusted),
+             "model": r.model, "calibration": r.calibration}
+            for r in earlier.itertuples(index=False)],
+    }

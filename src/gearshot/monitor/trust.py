@@ -1,0 +1,52 @@
+"""Which estimates of a monitored machine can be acted on: one place for the trust rule.
+
+``gearshot predict`` rows carry the trust columns of the estimate they belong to:
+``comparable`` (the segment looks like the fitted machine), and, where the predict side
+provides them, ``input_check`` (``"ok"`` or the failed check of the recording) and
+``trusted`` (every check passed). :func:`row_trust` reads them the same way for every
+caller: ``trusted`` when present, else ``comparable`` (and ``input_check == "ok"`` when
+that column is present). :func:`recording_trust` combines the segments of one recording.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["row_trust", "recording_trust", "MIN_TRUSTED_SHARE"]
+
+#: Smallest share of a recording's segments that must be trusted for the recording to be.
+MIN_TRUSTED_SHARE = 0.5
+
+
+def row_trust(frame: pd.DataFrame) -> np.ndarray:
+    """Whether each row (segment) of a predict table can be acted on.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Rows of :func:`gearshot.app.predict.estimate_segments` (or of ``gearshot
+        predict``).
+
+    Returns
+    -------
+    ndarray of bool, shape (len(frame),)
+        ``frame["trusted"]`` when present; else ``frame["comparable"]`` and, when present,
+        ``frame["input_check"] == "ok"``; all True when the frame carries none of them.
+    """
+    n = len(frame)
+    if "trusted" in frame:
+        return np.asarray(frame["trusted"], dtype=bool)
+    ok = np.ones(n, dtype=bool)
+    if "comparable" in frame:
+        ok &= np.asarray(frame["comparable"], dtype=bool)
+    if "input_check" in frame:
+        ok &= np.asarray(frame["input_check"].astype(str) == "ok", dtype=bool)
+    return ok
+
+
+def recording_trust(frame: pd.DataFrame) -> bool:
+    """Whether one recording (the rows of its segments) is trusted: at least
+    :data:`MIN_TRUSTED_SHARE` of its segments are (:func:`row_trust`)."""
+    trust = row_trust(frame)
+    return bool(trust.size and trust.mean() >= MIN_TRUSTED_SHARE)

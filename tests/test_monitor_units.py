@@ -1,0 +1,176 @@
+"""Monitoring (issue #31), the parts with analytic answers: growth laws and the forecast,
+the alarm and its threshold, the trust rule, the history file, the rig's growth laws."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from gearshot import GearshotError
+from gearshot.monitor import (
+    alarm_states,
+    alarm_threshold,
+    append_history,
+    combine_segments,
+    fit_growth,
+    forecast_crossing,
+    pending,
+    read_history,
+    read_index,
+    row_trust,
+)
+from gearshot.monitor.alarm import MIN_THRESHOLD
+from gearshot.monitor.history import HISTORY_COLUMNS
+from gearshot.rig.history import growth_size
+
+DAYS = np.arange(40, dtype=float)
+
+
+def _hinge(t, onset, law, a, shape, level=0.02):
+    s = np.maximum(t - onset, 0) / (t[-1] - onset)
+    g = s if law == "linear" else np.expm1(shape * s) if law == "exponential" else s ** shape
+    return level + a * g
+
+
+def test_linear_law_is_recovered_with_its_onset_and_crossing():
+    y = _hinge(DAYS, 12.0, "linear", 0.5, 1.0)
+    fit = fit_growth(DAYS, y)
+    assert fit.law == "linear"
+    assert fit.onset == pytest.approx(12.0)
+    assert fit.amplitude == pytest.approx(0.5, rel=1e-6)
+    # analytic crossing of 0.4: 12 + 27 * (0.4 - 0.02) / 0.5
+    assert fit.crossing(0.4) == pytest.approx(12 + 27 * 0.38 / 0.5, rel=1e-6)
+
+
+def test_exponential_law_is_recovered_and_forecast_from_noisy_points():
+    truth = _hinge(DAYS, 10.0, "exponential", 0.05, 2.5)
+    fit = fit_growth(DAYS, truth)
+    assert fit.law == "exponential"
+    assert fit.shape == pytest.approx(2.5, rel=1e-3)
+    rng = np.random.default_rng(0)
+    noisy = truth + 0.01 * rng.standard_normal(DAYS.size)
+    limit = 0.5
+    # the true law reaches 0.5 beyond the data: onset + span * log1p(rise / a) / k
+    true_time = 10 + 29 * np.log1p((limit - 0.02) / 0.05) / 2.5
+    fc = forecast_crossing(DAYS, noisy, limit)
+    assert fc.reason is None and fc.law in ("exponential", "power")
+    assert fc.time == pytest.approx(true_time, abs=2.0)
+    assert fc.low <= fc.time <= fc.high
+    assert fc.low <= true_time <= fc.high
+
+
+def test_forecast_is_reproducible_with_its_seed():
+    rng = np.random.default_rng(1)
+    y = _hinge(DAYS, 15.0, "power", 0.4, 2.0) + 0.02 * rng.standard_normal(DAYS.size)
+    a, b = forecast_crossing(DAYS, y, 0.6), forecast_crossing(DAYS, y, 0.6)
+    assert (a.time, a.low, a.high) == (b.time, b.low, b.high)
+
+
+def test_no_forecast_from_a_flat_trend_or_too_few_points():
+    rng = np.random.default_rng(2)
+    flat = forecast_crossing(DAYS, 0.03 + 0.02 * rng.standard_normal(DAYS.size), 0.6)
+    assert flat.time is None and flat.law is None and "flat trend" in flat.reason
+    few = forecast_crossing(DAYS[:4], [0.0, 0.1, 0.2, 0.3], 0.6)
+    assert few.time is None and "too few" in few.reason
+    with pytest.raises(GearshotError, match="limit"):
+        forecast_crossing(DAYS, DAYS / 40, 1.5)
+
+
+def test_threshold_is_the_normal_quantile_of_the_baseline():
+    base = np.array([0.05, 0.10, 0.15, 0.20, 0.10])
+    expected = base.mean() + stats.norm.isf(0.01) * base.std(ddof=1)
+    assert alarm_threshold(base, false_alarm_rate=0.01) == pytest.approx(expected)
+    assert alarm_threshold(np.zeros(5)) == MIN_THRESHOLD
+    with pytest.raises(GearshotError, match="baseline"):
+        alarm_threshold([0.1])
+    with pytest.raises(GearshotError, match="false_alarm_rate"):
+        alarm_threshold(base, false_alarm_rate=0.7)
+
+
+def test_alarm_needs_sustained_trusted_crossings_and_untrusted_never_raise_or_clear():
+    y = np.array([0.1, 0.5, 0.1, 0.5, 0.9, 0.5, 0.9, 0.1, 0.1, 0.1])
+    ok = np.array([1, 1, 1, 1, 0, 1, 1, 1, 0, 1], bool)
+    res = alarm_states(y, ok, 0.3, sustain=2)
+    # index 3 and 5 are consecutive trusted crossings (4 is skipped): raised at 5
+    assert res.first_index == 5
+    assert res.alarm.tolist() == [0, 0, 0, 0, 0, 1, 1, 1, 0, 0]
+    # an untrusted recording far over the threshold raises nothing
+    quiet = alarm_states([0.1, 0.9, 0.9, 0.9], [1, 0, 0, 0], 0.3, sustain=1)
+    assert quiet.first_index is None and not quiet.alarm.any()
+
+
+def test_row_trust_prefers_trusted_then_comparable_and_input_check():
+    frame = pd.DataFrame({"comparable": [True, True, False],
+                          "input_check": ["ok", "clipped", "ok"]})
+    assert row_trust(frame).tolist() == [True, False, False]
+    assert row_trust(frame.drop(columns="input_check")).tolist() == [True, True, False]
+    frame["trusted"] = [False, True, True]
+    assert row_trust(frame).tolist() == [False, True, True]
+
+
+def test_combined_estimate_is_the_median_of_trusted_segments():
+    seg = pd.DataFrame({"predicted": [0.2, 0.3, 0.9], "low": [0.1, 0.2, 0.8],
+                        "high": [0.3, 0.4, 1.0], "comparable": [True, True, False]})
+    out = combine_segments(seg)
+    assert out == {"predicted": 0.25, "low": pytest.approx(0.15), "high": 0.35,
+                   "segments": 3, "trusted_segments": 2, "trusted": True}
+
+
+def _rows(names, model="m1", start="2026-01-01"):
+    t = pd.date_range(start, periods=len(names), freq="D")
+    return pd.DataFrame({"recording": names, "time": t, "predicted": 0.1, "low": 0.0,
+                         "high": 0.2, "segments": 2, "trusted_segments": 2, "trusted": True,
+                         "model": model, "calibration": "zero_shot",
+                         "estimated_at": pd.Timestamp("2026-02-01"), "note": ""},
+                        columns=HISTORY_COLUMNS)
+
+
+def test_history_append_is_atomic_and_keeps_both_models(tmp_path, monkeypatch):
+    path = tmp_path / "h.parquet"
+    append_history(path, _rows(["a", "b"]))
+    before = path.read_bytes()
+
+    def boom(self, *a, **k):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(pd.DataFrame, "to_parquet", boom)
+    with pytest.raises((OSError, GearshotError)):
+        append_history(path, _rows(["c"]))
+    monkeypatch.undo()
+    assert path.read_bytes() == before                  # the old history, whole
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["h.parquet"]   # no temporary
+    hist = append_history(path, _rows(["a", "b"], model="m2"))
+    assert len(hist) == 4 and set(hist["model"]) == {"m1", "m2"}
+    index = pd.DataFrame({"recording": ["a", "b", "c"]})
+    assert pending(index, hist, "m2")["recording"].tolist() == ["c"]
+    assert pending(index, read_history(tmp_path / "none.parquet"), "m2").shape[0] == 3
+
+
+def test_read_index_resolves_sorts_and_refuses_bad_tables(tmp_path):
+    for name in ("x.h5", "y.h5"):
+        (tmp_path / name).write_bytes(b"")
+    (tmp_path / "index.csv").write_text("file,time\ny.h5,2026-01-02T00:00:00\n"
+                                        "x.h5,2026-01-01T00:00:00\n")
+    idx = read_index(tmp_path / "index.csv")
+    assert [p.rsplit("/", 1)[1] for p in idx["recording"]] == ["x.h5", "y.h5"]
+    (tmp_path / "bad.csv").write_text("file,when\nx.h5,2026\n")
+    with pytest.raises(GearshotError, match="file .or path. and time"):
+        read_index(tmp_path / "bad.csv")
+    (tmp_path / "bad2.csv").write_text("file,time\nx.h5,yesterday\n")
+    with pytest.raises(GearshotError, match="ISO 8601"):
+        read_index(tmp_path / "bad2.csv")
+    (tmp_path / "bad3.csv").write_text("path,time\nz.h5,2026-01-01\n")
+    with pytest.raises(GearshotError, match="missing"):
+        read_index(tmp_path / "bad3.csv")
+
+
+@pytest.mark.parametrize("law", ["linear", "exponential", "power"])
+def test_rig_growth_laws_start_at_the_onset_and_end_at_the_end_size(law):
+    life = np.linspace(0, 1, 11)
+    y = growth_size(life, onset=0.3, end_size=0.8, law=law)
+    assert np.all(y[life <= 0.3] == 0) and y[-1] == pytest.approx(0.8)
+    assert np.all(np.diff(y[life >= 0.3]) > 0)
+    with pytest.raises(GearshotError, match="law"):
+        growth_size(life, onset=0.3, end_size=0.8, law="cubic")
