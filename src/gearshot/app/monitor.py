@@ -93,7 +93,8 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         est, fitted = fit_from_files(database, fit_files, faulty, faulty_size, speed=speed,
                                      load=load, coverage=coverage, gear_teeth=gear_teeth,
                                      pinion_teeth=pinion_teeth, seed=seed,
-                                     recordings=base_files)
+                                     recordings=base_files, holdout=0.0,
+                                     holdout_files=base_files)
         baseline = np.concatenate([estimate_segments(est, sa, coverage=coverage)["predicted"]
                                    for _, sa in fitted.targets])
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",

@@ -38,11 +38,14 @@ class FittedFiles:
 
 def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
                    coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                   selection_tf=None, recordings=(), holdout=0.25):
+                   selection_tf=None, recordings=(), holdout=0.25, holdout_files=()):
     """Fit the estimator from recording files (the fit of ``gearshot predict`` and
     ``gearshot fit`` without ``--machine``), its hold-outs checking it.
 
     ``faulty`` None fits zero-shot (``calibration="zero_shot"``, ``faulty_size`` ignored).
+    ``holdout`` keeps the last segments of each healthy recording out of the fit;
+    ``holdout_files`` (healthy recordings among ``recordings``) are kept out whole: both
+    are the healthy hold-outs that check the fit.
     Every recording (``recordings`` too, segmented into ``FittedFiles.targets``) is read,
     checked (:mod:`gearshot.io.input_health`: a fit recording that fails is refused) and
     segmented before the fit: a bad file fails now, not after minutes of fitting.
@@ -72,7 +75,9 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
         recordings, healthy, faulty, kw, holdout)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
-    checks = dict(holdout=holdout, healthy_holdout=np.vstack([sa for _, sa, _ in held]))
+    whole = {_key(p) for p in holdout_files}
+    checks = dict(holdout=holdout, healthy_holdout=np.vstack(
+        [sa for _, sa, _ in held] + [sa for p, sa in targets if _key(p) in whole]))
     if faulty is None:
         est = OneFaultShotEstimator(random_state=seed, calibration="zero_shot")
         est.fit(db, healthy_sa, None, None, long, selection_tf=selection_tf, **checks, **kw)
