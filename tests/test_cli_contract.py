@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from phm09_records import crop as _crop
 
 from gearshot import GearshotError
 
@@ -348,18 +349,6 @@ def test_a_huge_declared_schema_is_refused_before_it_is_read(tmp_path, monkeypat
 
 
 # ----------------------------------------- 4. indicators: batches and outputs
-def _crop(name: str, folder: Path, rows: int) -> Path:
-    src = PHM / name
-    if not src.is_file():
-        pytest.skip(f"{src} is absent; real-data checks need ../shared/data/phm09")
-    with zipfile.ZipFile(src) as zf:
-        member = zf.namelist()[0]
-        lines = zf.read(member).splitlines(keepends=True)[:rows]
-    out = folder / name
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(member, b"".join(lines))
-    return out
-
 
 @pytest.fixture(scope="module")
 def phm(tmp_path_factory):

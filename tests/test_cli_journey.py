@@ -9,12 +9,12 @@ import os
 import stat
 import subprocess
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from phm09_records import crop
 
 from gearshot import GearshotError
 
@@ -35,19 +35,6 @@ def one_line_error(res) -> str:
     assert len(err.splitlines()) == 1, err
     return err
 
-
-def crop(name: str, folder: Path, rows: int = 100_000) -> Path:
-    """A zipped copy of an original record holding its first ``rows`` rows."""
-    src = PHM / name
-    if not src.is_file():
-        pytest.skip(f"{src} is absent; real-data checks need ../shared/data/phm09")
-    with zipfile.ZipFile(src) as zf:
-        member = zf.namelist()[0]
-        lines = zf.read(member).splitlines(keepends=True)[:rows]
-    out = folder / name
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(member, b"".join(lines))
-    return out
 
 
 @pytest.fixture(scope="module")

@@ -6,11 +6,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-import zipfile
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from phm09_records import crop
 
 from gearshot.features import CONDITION_INDICATORS
 
@@ -23,19 +23,6 @@ def run(*args, env=None, timeout=300):
     return subprocess.run([sys.executable, "-m", "gearshot.app.cli", *args],
                           capture_output=True, text=True, timeout=timeout, env=env)
 
-
-def crop(name: str, folder: Path, rows: int) -> Path:
-    """A zipped copy of an original record holding its first ``rows`` rows."""
-    src = PHM / name
-    if not src.is_file():
-        pytest.skip(f"{src} is absent; real-data checks need ../shared/data/phm09")
-    with zipfile.ZipFile(src) as zf:
-        member = zf.namelist()[0]
-        lines = zf.read(member).splitlines(keepends=True)[:rows]
-    out = folder / name
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(member, b"".join(lines))
-    return out
 
 
 @pytest.fixture(scope="module")
