@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import shlex
 import subprocess
 import sys
@@ -14,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from readme_sections import readme_commands
 
 from gearshot import GearshotError
 
@@ -191,23 +191,13 @@ def test_monitor_refuses_bad_indexes_before_estimating(machine, tmp_path):
     assert res.returncode == 2 and "one --history per --index" in res.stderr
 
 
-def readme_commands() -> list[str]:
-    """The shell commands of the README section "Monitoring a machine"."""
-    text = (ROOT / "README.md").read_text()
-    section = text.split("\n## Monitoring a machine\n", 1)[1].split("\n## ", 1)[0]
-    commands = []
-    for block in re.findall(r"```bash\n(.*?)```", section, re.S):
-        for line in block.replace("\\\n", " ").splitlines():
-            if line.strip() and not line.strip().startswith("#"):
-                commands.append(" ".join(line.split()))
-    return commands
 
 
 @pytest.mark.slow
 def test_readme_monitoring_commands_run_as_written(tmp_path):
     env = {**os.environ, "GEARSHOT_DATA": str(tmp_path / "data")}
     py = shlex.quote(sys.executable)
-    commands = readme_commands()
+    commands = readme_commands("Monitoring a machine")
     assert [c.split()[1] if c.startswith("gearshot") else "python" for c in commands] == [
         "simulate", "rig", "python", "fit", "monitor", "fit", "monitor", "report"]
     runs = []

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import shlex
 import subprocess
 import sys
@@ -14,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from readme_sections import readme_commands
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
@@ -23,16 +23,6 @@ SPUR = ROOT / "examples" / "machines" / "phm09_spur.toml"
 SMALL_DATABASE = "--n-healthy 6 --n-faulty 24 --grade 6 --grade 7 --workers 1"
 
 
-def readme_commands() -> list[str]:
-    """The shell commands of the README section "Your own gearbox", continuations joined."""
-    text = (ROOT / "README.md").read_text()
-    section = text.split("\n## Your own gearbox\n", 1)[1].split("\n## ", 1)[0]
-    commands = []
-    for block in re.findall(r"```bash\n(.*?)```", section, re.S):
-        for line in block.replace("\\\n", " ").splitlines():
-            if line.strip() and not line.strip().startswith("#"):
-                commands.append(" ".join(line.split()))
-    return commands
 
 
 def cli(*args, cwd=None, env=None, timeout=900):
@@ -52,7 +42,7 @@ def journey(tmp_path_factory):
     env = {**os.environ, "GEARSHOT_DATA": str(top / "data")}
     gearshot = f"{shlex.quote(sys.executable)} -m gearshot.app.cli"
     runs = {}
-    for command in readme_commands():
+    for command in readme_commands("Your own gearbox"):
         assert command.startswith("gearshot "), command
         sub = command.split()[1]
         line = gearshot + command[len("gearshot"):]
