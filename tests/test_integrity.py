@@ -15,10 +15,15 @@ import threading
 import time
 from pathlib import Path
 
+import fake_store
 import numpy as np
 import pytest
 
 from gearshot import GearshotError
+
+KW = fake_store.KW
+# the stand-in simulator (autouse) and the tiny store, as this module's fixtures
+fast_simulator, store = fake_store.fast_simulator, fake_store.store
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -167,27 +172,6 @@ def test_killed_builder_leaves_no_stale_lock(tmp_path, next_seed):
 
 
 # ---------------------------------------------------------------------- manifest tampering
-def _fake_simulate_sa(pair, *, speed, load, grade, fault_sizes, n_points, rng,
-                      fault_type="ftff"):
-    return np.stack([np.random.default_rng(s).standard_normal(n_points) for s in rng])
-
-
-@pytest.fixture(autouse=True)
-def fast_simulator(monkeypatch):
-    monkeypatch.setattr("gearshot.sim.database.simulate_sa", _fake_simulate_sa)
-    monkeypatch.setattr("gearshot.sim.database.simulate_sa_paired",
-                        lambda pair, **kw: (_fake_simulate_sa(pair, **kw),) * 2)
-
-
-KW = dict(speeds=[15, 20], loads=[10], grades=[7, 8], n_healthy=1, n_faulty=2, seed=3,
-          n_points=64, client=False, progress=False)
-
-
-@pytest.fixture
-def store(tmp_path):
-    from gearshot.sim import build_database
-
-    return build_database(tmp_path / "db", **KW)
 
 
 @pytest.mark.parametrize("edit, load_kw", [
