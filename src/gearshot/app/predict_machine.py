@@ -33,30 +33,27 @@ def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty:
 
 
 def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
-                     sensor: str | None = None, info: dict | None = None
+                     sensor: str | None = None, info: dict | None = None, rec=None
                      ) -> tuple[np.ndarray, np.ndarray, float]:
-    """SA segments of the monitored gear's shaft for one recording file.
+    """SA segments of the monitored gear's shaft for one recording file (``rec``: the file
+    already read with ``machine``; default: read now).
 
-    ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``: a
-    machine without ``[tacho]``), ``speed_uncertainty_hz`` (rev/s of the reference
-    shaft, ``None`` with a tacho), ``speed_check`` (``"ok"`` or why the tracked speed
-    is not to be trusted, :func:`gearshot.machine.signal_check.speed_check`) and the
-    sensor's input checks (:mod:`gearshot.io.input_health`): ``recording`` and
-    ``segments``.
+    ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``),
+    ``speed_uncertainty_hz`` (rev/s; ``None`` with a tacho), ``speed_check``
+    (:func:`gearshot.machine.signal_check.speed_check`) and the sensor's input checks
+    ``recording`` and ``segments``.
 
     Returns
     -------
     sa : ndarray, shape (n_segments, samples_per_cycle)
-    x : ndarray, shape (n_cycles * samples_per_cycle,)
-        The whole angle-domain signal (whole cycles from the first pulse).
-    speed : float
-        Tacho-shaft speed read from the tacho, rev/s.
+    x : ndarray (n_cycles * samples_per_cycle,): the whole angle-domain signal
+    speed : float: the tacho shaft's speed, rev/s
     """
     from ..io import Recording
 
     if machine.monitored is None:
         raise GearshotError(f"machine {machine.name!r} names no [monitored] gear")
-    rec = Recording.read(path, machine=machine)
+    rec = Recording.read(path, machine=machine) if rec is None else rec
     name = machine.sensor(sensor).name
     spc = machine.samples_per_cycle
     x = rec.angle_domain(shaft=machine.monitored.shaft, sensor=name, samples_per_cycle=spc,
@@ -197,15 +194,17 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
         The database condition estimated at.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
+    from ..io import Recording
 
     others = [*([] if faulty is None else [faulty]), *recordings]
     cps = _check_options(machine, healthy, others, cycles_per_segment, holdout)
     database_conditions(database, machine)   # a bad --database fails now
     check_database_pair(database, machine)
     # the machine file must put its mesh orders where the healthy recordings have them
-    verify_machine(machine, healthy)
-    seg = _segment_recordings(machine, healthy, faulty, recordings, cps=cps, sensor=sensor,
-                              holdout=holdout, example_segment=example_segment)
+    read = {str(p): Recording.read(p, machine=machine) for p in healthy}   # read once
+    verify_machine(machine, list(read.values()))
+    seg = _segment_recordings(machine, healthy, faulty, recordings, read=read, cps=cps,
+                              sensor=sensor, holdout=holdout, example_segment=example_segment)
     cond = _condition(database, machine, seg, speed=speed, load=load,
                       speed_tolerance=speed_tolerance)
     # every mesh synchronous with the shaft leaves the difference signal (the second stage's
@@ -289,14 +288,16 @@ class _Segments:
 
 
 def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, holdout,
-                        example_segment) -> _Segments:
-    """Cut every recording into SA segments; healthy hold-outs, the example, the rest."""
+                        example_segment, read=None) -> _Segments:
+    """Cut every recording (``read``: those already read, by path) into SA segments;
+    healthy hold-outs, the example, the rest."""
     spc = machine.samples_per_cycle
     seg = _Segments()
 
     def cut(p):
         sa, x, sp = machine_segments(p, machine, cycles_per_segment=cps, sensor=sensor,
-                                     info=seg.sources.setdefault(str(p), {}))
+                                     info=seg.sources.setdefault(str(p), {}),
+                                     rec=(read or {}).get(str(p)))
         seg.speeds.setdefault(str(p), sp)
         return sa, x, sp
 
