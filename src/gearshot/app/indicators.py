@@ -194,10 +194,10 @@ def record_indicators(paths: Sequence[str | Path], machine, *, shaft: str,
     good = [r for r in reads.values() if r is not None]
     # the machine file must put its mesh orders where the recordings have them (the
     # healthy baseline recordings where given)
-    if baseline_paths or good:
-        verify_machine(machine, [Recording.read(p, machine=machine) for p in baseline_paths]
-                       if baseline_paths else [rec for rec, _ in good])
-    baselines = _baselines(baseline_paths, machine, shaft, names)
+    base_recs = [Recording.read(p, machine=machine) for p in baseline_paths]
+    if base_recs or good:
+        verify_machine(machine, base_recs or [rec for rec, _ in good])
+    baselines = _baselines(base_recs, machine, shaft, names)
     records: list[dict[str, Any]] = []
     for path in paths:
         read = reads[str(path)]
@@ -228,14 +228,12 @@ def check_speed_hints(speed_hints: Mapping[str, float] | None, machine) -> dict[
             speed_hints.items()}
 
 
-def _baselines(baseline_paths: Sequence[str | Path], machine, shaft: str,
+def _baselines(recs: Sequence[Any], machine, shaft: str,
                names: Sequence[str]) -> dict[str, float | None]:
-    """NA4's baseline variance per sensor from healthy recordings (None without any)."""
-    from ..io import Recording
-
-    if not baseline_paths:
+    """NA4's baseline variance per sensor from healthy recordings (read with ``machine``;
+    None without any)."""
+    if not recs:
         return {n: None for n in names}
-    recs = [Recording.read(p, machine=machine) for p in baseline_paths]
     return {n: baseline_variance(recs, machine, shaft=shaft, sensor=n) for n in names}
 
 
