@@ -1,7 +1,8 @@
 """Monitoring on virtual-rig lives: alarm delay, false alarms, forecast, untrusted events.
 
 For each rig seed: a fit campaign (6 healthy recordings + one faulty recording of size
-0.42, 30 s each), a life (``VirtualRig(seed).history``, defaults), a one-fault-shot model
+0.42, 30 s each, recorded on different runs: speed and load vary 1 % run to run, as in the
+life), a life (``VirtualRig(seed).history``, defaults), a one-fault-shot model
 and a zero-shot model (``gearshot.app.monitor.fit_model``), both run over the whole life
 (``monitor_history``); the forecast is then made from the first 70 % of the life's
 recordings. Prints one row per life and model and the summary against the targets.
@@ -46,7 +47,8 @@ def evaluate(seed: int, work: Path, database: str) -> list[dict]:
     t0 = time.perf_counter()
     if not (camp / "index.csv").is_file():
         VirtualRig(seed).campaign(camp, speed=15, load=10, duration=30, healthy=6,
-                                  sizes=(0.42,), repetitions=1, progress=False)
+                                  sizes=(0.42,), repetitions=1, variation=0.01,
+                                  progress=False)
     if not (life / "index.csv").is_file():
         VirtualRig(seed).history(life, progress=False)
     t_rec = time.perf_counter() - t0

@@ -19,6 +19,7 @@ from gearshot.estimator import NotFittedError, OneFaultShotEstimator
 from gearshot.estimator.comparability import (
     DEFAULT_FALSE_ALARM,
     FEATURE_GROUPS,
+    MIN_GROUPS,
     MIN_HEALTHY,
     fit_comparability,
     harmonic_orders,
@@ -228,6 +229,44 @@ def test_false_alarm_rate_holds_on_new_healthy_segments():
     assert 1 - res.comparable.mean() <= 0.04
     assert 0.05 <= np.mean(res.p_value < 0.3) <= 0.6   # p-values spread, not all 0 or 1
     assert res.record_comparable
+
+
+def _runs(rng, n_runs, per_run, spread=0.05, noise=0.05):
+    """Healthy SAs of ``n_runs`` runs: each run's 20 mesh harmonics off by its own few per
+    cent (run-to-run), its segments alike within the run."""
+    base = 1.0 / np.arange(1, 21)
+    return [_noisy_healthy(rng, per_run, noise=noise,
+                           amps=tuple(base * np.exp(spread * rng.standard_normal(20))))
+            for _ in range(n_runs)]
+
+
+def test_run_to_run_calibration_keeps_new_runs_comparable():
+    """Segments of one run are alike; a new run differs by the run-to-run spread. Left out
+    one SA at a time, the calibration sees only the within-run spread and flags most new
+    runs; left out one recording at a time it states the rate for a new run (≤ 10 % of
+    40 new runs flagged); another gain (x2) is still flagged."""
+    rng = np.random.default_rng(11)
+    runs = _runs(rng, 5, 4)
+    healthy = np.vstack(runs)
+    labels = np.repeat(np.arange(5), 4)
+    per_sa = fit_comparability(healthy, 38)
+    per_run = fit_comparability(healthy, 38, recordings=labels)
+    new = np.vstack(_runs(rng, 40, 2))
+    assert per_run.threshold(0.01) > per_sa.threshold(0.01)
+    assert 1 - per_sa.evaluate(new).comparable.mean() > 0.5
+    assert 1 - per_run.evaluate(new).comparable.mean() <= 0.10
+    assert not per_run.evaluate(2.0 * new[:4]).comparable.any()
+
+
+def test_fewer_than_min_groups_recordings_leave_one_sa_out():
+    rng = np.random.default_rng(12)
+    healthy = np.vstack(_runs(rng, MIN_GROUPS - 1, 4))
+    labels = np.repeat(np.arange(MIN_GROUPS - 1), 4)
+    a = fit_comparability(healthy, 38)
+    b = fit_comparability(healthy, 38, recordings=labels)
+    assert a.log_score_mean == b.log_score_mean and a.log_score_std == b.log_score_std
+    with pytest.raises(GearshotError, match="recordings has 3 labels for 8"):
+        fit_comparability(healthy, 38, recordings=labels[:3])
 
 
 def test_too_few_healthy_segments_are_not_calibrated():

@@ -116,6 +116,9 @@ def test_combined_estimate_is_the_median_of_trusted_segments():
     out = combine_segments(seg)
     assert out == {"predicted": 0.25, "low": pytest.approx(0.15), "high": 0.35,
                    "segments": 3, "trusted_segments": 2, "trusted": True}
+    # half of the segments is not a majority: untrusted, all segments' median
+    half = combine_segments(seg.iloc[1:])
+    assert half["trusted"] is False and half["predicted"] == pytest.approx(0.6)
 
 
 def _rows(names, model="m1", start="2026-01-01"):

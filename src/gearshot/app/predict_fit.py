@@ -15,7 +15,7 @@ from .._validation import check_in_range
 from ..io.input_health import require_ok
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
-__all__ = ["FittedFiles", "fit_from_files", "estimate_segments"]
+__all__ = ["FittedFiles", "fit_from_files", "estimate_segments", "recording_labels"]
 
 
 @dataclass
@@ -76,7 +76,8 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     whole = {_key(p) for p in holdout_files}
-    checks = dict(holdout=holdout, healthy_holdout=np.vstack(
+    labels, healthy_sa = recording_labels(healthy_sa), np.vstack(healthy_sa)
+    checks = dict(holdout=holdout, healthy_recordings=labels, healthy_holdout=np.vstack(
         [sa for _, sa, _ in held] + [sa for p, sa in targets if _key(p) in whole]))
     if faulty is None:
         est = OneFaultShotEstimator(random_state=seed, calibration="zero_shot")
@@ -114,10 +115,11 @@ def estimate_segments(est, sa, *, coverage=0.9, input_check=None) -> pd.DataFram
 
 
 def _segments(files, healthy, faulty, kw, holdout=0.0):
-    """SA segments of the targets; the healthy recordings' fitted segments (stacked; the
-    first one's long angle-domain signal too, without its hold-outs); the faulty example
-    (the faulty recording's first segment) and its record's other segments; each healthy
-    recording's hold-outs (its last ``floor(holdout · n)`` segments) as (path, SAs).
+    """SA segments of the targets; the healthy recordings' fitted segments (one array per
+    recording; the first one's long angle-domain signal too, without its hold-outs); the
+    faulty example (the faulty recording's first segment) and its record's other segments;
+    each healthy recording's hold-outs (its last ``floor(holdout · n)`` segments) as
+    (path, SAs).
 
     Every recording is read and segmented before the fit: a file too short for one SA
     segment (or unreadable) fails now, not after minutes of fitting.
@@ -149,9 +151,15 @@ def _segments(files, healthy, faulty, kw, holdout=0.0):
         healthy_sa.append(sa[:n_fit])
         held.append((p, sa[n_fit:], n_fit))
     if faulty is None:   # zero-shot
-        return targets, np.vstack(healthy_sa), long, None, None, held, health
+        return targets, healthy_sa, long, None, None, held, health
     faulty_sa = cut(faulty, "faulty")
-    return targets, np.vstack(healthy_sa), long, faulty_sa[0], faulty_sa[1:], held, health
+    return targets, healthy_sa, long, faulty_sa[0], faulty_sa[1:], held, health
+
+
+def recording_labels(per_recording) -> np.ndarray:
+    """The recording index of every SA of per-recording SA arrays, stacked in order (the
+    fit's ``healthy_recordings``: comparability calibrated on whole recordings left out)."""
+    return np.repeat(np.arange(len(per_recording)), [len(sa) for sa in per_recording])
 
 
 def _key(path) -> Path:

@@ -17,6 +17,7 @@ from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
 from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
+from .predict_fit import recording_labels
 from .trust import add_trust_columns
 
 __all__ = ["machine_segments", "predict_from_machine", "fit_machine", "machine_database_path",
@@ -207,8 +208,7 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
                               sensor=sensor, holdout=holdout, example_segment=example_segment)
     cond = _condition(database, machine, seg, speed=speed, load=load,
                       speed_tolerance=speed_tolerance)
-    # every mesh synchronous with the shaft leaves the difference signal (the second stage's
-    # too), on the simulated side as on the recorded one
+    # every mesh synchronous with the shaft leaves the difference signal, on both sides
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
     calibration = {} if faulty is not None else {"calibration": "zero_shot"}
     est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
@@ -218,6 +218,7 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
             None if faulty is None else faulty_size, seg.long,
             selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
             pinion_teeth=machine.mate()[1], holdout=holdout,
+            healthy_recordings=recording_labels(seg.train),
             healthy_holdout=seg.holdout_sas("healthy_holdout"),
             example_record=None if faulty is None else seg.holdout_sas("faulty_rest"))
     return est, seg, cond

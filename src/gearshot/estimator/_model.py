@@ -37,7 +37,13 @@ from ..fault_registry import FAULT_TYPE_NAMES
 from ..features import PAPER_FEATURES, available_features
 from ._database import _database_by_grade, _database_twins, _has_twins, _select_fault_type
 from ._grade_choice import _GradeChoosing
-from ._inputs import STEP_SEEDS, _step_seeds, check_fit_inputs, default_selection_tf
+from ._inputs import (
+    STEP_SEEDS,
+    _step_seeds,
+    check_fit_inputs,
+    default_selection_tf,
+    spread_references,
+)
 from ._joint import _JointCalibration
 from ._pair import as_orders, resolve_mesh_orders
 from ._params import (
@@ -55,12 +61,8 @@ from ._params import (
 )
 from ._prediction import _Prediction
 from ._target import fit_target_side
-from .calibration import (
-    CALIBRATION_STRATEGIES,
-    CalibrationOptions,
-    resolve_calibration,
-)
-from .comparability import fit_comparability
+from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
+from .comparability import MIN_GROUPS, fit_comparability
 from .detection import detection_limit
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
@@ -69,7 +71,6 @@ from .regressors import ESTIMATORS
 __all__ = ["OneFaultShotEstimator", "STEP_SEEDS", "default_selection_tf"]
 
 FloatArray = NDArray[np.float64]
-
 
 
 # scikit-learn ships no type information: its classes are Any to mypy
@@ -105,11 +106,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
           grade × fault gain × fault width × TF mode (× noise scale) on the twin
           differences, weighted by how well it explains the example's whole feature
           vector (:mod:`gearshot.estimator.calibration`); a :class:`CalibrationOptions`
-          (or a mapping of its fields) is ``"joint"`` with that grid. On the rig family's
-          development range (issue #19) "joint" scored 12.0 % (11.6 % matching the
-          selected features only) against 11.3 % for "grade", within the draw-to-draw
-          noise (± 0.8), with more even conditions (worst 13.2 against 15.7 %) but a worse
-          p90; "grade" was kept.
+          (or a mapping of its fields) is ``"joint"`` with that grid (rig family, dev:
+          12.0 % against 11.3 % for "grade", within the draw-to-draw noise of ± 0.8).
         * ``"nominal"``: no tuning, ``nominal_grade``.
         * ``"zero_shot"``: no faulty example: the grades are weighted by how well their
           simulated healthy SAs match the target's healthy statistics
@@ -150,9 +148,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         intervals. There is no upper bound (intervals are clipped to [0, 1]).
     estimator : {"paper", "isotonic", "boosting"}, default "paper"
         Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): the
-        paper's KNN, an isotonic map of a learned linear score, or gradient-boosted trees.
-        Screened on the rig family's development range (issue #30, benchmarks/RESULTS.md
-        "Estimator: information limit and new default").
+        paper's KNN, an isotonic map of a learned linear score, or gradient-boosted trees
+        (screened: benchmarks/RESULTS.md "Estimator: information limit and new default").
     random_state : int >= 0, numpy RandomState or Generator, or None
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
         step 1, the validation split of step 8 and the matched noise) gets its own child
@@ -194,9 +191,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     n_neighbors_, n_points_ : int
     faulty_size_ : float or None
     step_seeds_ : dict step → int
-        The seeds the random steps used.
-    simulated_reference_ : {"first_healthy", "twin"}
-        Step 6's reference (``options.simulated_reference``, "auto" resolved).
+    simulated_reference_ : {"first_healthy", "twin"} (step 6's reference, "auto" resolved)
     calibration_ : dict
         What the example calibrated: ``strategy`` ("grade" or "joint"), ``settings`` (list
         of dicts ``grade, gain, width, tf, noise, weight`` — and ``log_likelihood`` with
@@ -206,12 +201,10 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     setting_models_ : list of KnnModel
         One model per entry of ``calibration_["settings"]``.
     comparability_reference_ : ComparabilityReference
-        The fitted machine's regular-part states (the healthy SAs' features, their local
-        spread, the example's effect) and the leave-one-out calibration that
-        :meth:`comparability` tests segments against
+        What :meth:`comparability` tests segments against
         (:mod:`gearshot.estimator.comparability`).
     mesh_orders_ : tuple of int
-        The gear-mesh orders step 7 removed (``mesh_order`` with ``None`` resolved).
+        The gear-mesh orders step 7 removed (``mesh_order`` resolved).
     fit_check_ : FitCheck
         The fit's hold-outs read back against 0 and ``faulty_size`` and a ``verdict``
         (:mod:`~gearshot.estimator.fit_check`); they calibrate :meth:`predict_interval`.
@@ -284,7 +277,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             healthy_long: ArrayLike | None = None, *, selection_tf: Any = None,
             gear_teeth: int | None = None, pinion_teeth: int | None = None,
             holdout: float = 0.0, healthy_holdout: ArrayLike | None = None,
-            example_record: ArrayLike | None = None) -> Self:
+            example_record: ArrayLike | None = None,
+            healthy_recordings: ArrayLike | None = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters
@@ -321,6 +315,10 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         example_record : array_like (n, n_points), optional
             The example record's other segments (not the example itself): their
             estimates must read near ``faulty_size``.
+        healthy_recordings : array_like (n_healthy,), optional
+            Each ``target_healthy`` SA's recording: from 3 recordings on, step 6's
+            references come from every recording and comparability leaves whole
+            recordings out (run-to-run).
 
         Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``);
         the hold-outs also calibrate :meth:`predict_interval`.
@@ -342,7 +340,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         orders = resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
         self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
         try:
-            self._fit(database, target_healthy, faulty_example, faulty_size,
+            self._fit(database, *spread_references(target_healthy, healthy_recordings,
+                                                   MIN_GROUPS), faulty_example, faulty_size,
                       healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
@@ -350,7 +349,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         self.fit_check_ = check_holdouts(self.predict, holdouts, n_fit, self.faulty_size_)
         return self
 
-    def _fit(self, database: Any, target_healthy: ArrayLike,
+    def _fit(self, database: Any, target_healthy: ArrayLike, recordings: Any,
              faulty_example: ArrayLike | None, faulty_size: float | None,
              healthy_long: ArrayLike | None, selection_tf: Any,
              orders: tuple[int, ...]) -> Self:
@@ -381,7 +380,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                                      grade_choice["calibration_"]["settings"]])
         comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
                                           faulty_example=inputs.faulty_example,
-                                          faulty_size=inputs.faulty_size)
+                                          faulty_size=inputs.faulty_size,
+                                          recordings=recordings)
 
         learned = dict(
             n_points_=inputs.n_points, transfer_function_=target.transfer_function,

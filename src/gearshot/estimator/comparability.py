@@ -34,11 +34,16 @@ in exact proportion). Zero-shot (no example): the distance from the nearest heal
 
 **Calibration.** At fit time every healthy SA is scored by the reference fitted without it
 (leave-one-out); the logarithms of those scores define a normal model of a healthy segment's
-log-score. A segment's **p-value** is the upper tail of that model at its log-score, and it
-is **comparable** when its p-value is at least the stated false-alarm rate,
-:data:`DEFAULT_FALSE_ALARM` = 0.01 (1 % of the fitted machine's own healthy segments are
-expected to be flagged). Fewer than :data:`MIN_HEALTHY` healthy SAs cannot be calibrated:
-then no segment is comparable.
+log-score. When the healthy SAs come from at least :data:`MIN_GROUPS` recordings
+(``recordings``), each is scored by the reference fitted without its whole recording
+(leave-one-recording-out): a new recording differs from the fitted ones by what changes
+from run to run (speed and load within their tolerance, temperature, the path), which the
+SAs of one recording cannot show; the calibration then states the false-alarm rate of a
+*new recording* of the same machine. A segment's **p-value** is the upper tail of that
+model at its log-score, and it is **comparable** when its p-value is at least the stated
+false-alarm rate, :data:`DEFAULT_FALSE_ALARM` = 0.01 (1 % of the fitted machine's own
+healthy segments are expected to be flagged). Fewer than :data:`MIN_HEALTHY` healthy SAs
+cannot be calibrated: then no segment is comparable.
 
 The comparable decision of a *recording* takes all its segments together (the median score):
 another load, speed or build differs for the whole record.
@@ -67,8 +72,8 @@ from .regular_part import (
     regular_features,
 )
 
-__all__ = ["DEFAULT_FALSE_ALARM", "FAULT_SHAPE_UNCERTAINTY", "FEATURE_GROUPS", "MIN_HEALTHY",
-           "MIN_STD",
+__all__ = ["DEFAULT_FALSE_ALARM", "FAULT_SHAPE_UNCERTAINTY", "FEATURE_GROUPS", "MIN_GROUPS",
+           "MIN_HEALTHY", "MIN_STD",
            "Comparability", "ComparabilityReference", "fit_comparability",
            "harmonic_orders", "harmonic_profile", "healthy_spread", "regular_features"]
 
@@ -82,6 +87,12 @@ DEFAULT_FALSE_ALARM = 0.01
 #: unsteady (3 healthy SAs of PHM09 spur3 30 Hz High: a threshold of 16 and 78 on the two
 #: sensors, against 2.7 with the development fits' 9).
 MIN_HEALTHY = 6
+
+#: Fewest healthy recordings whose leave-one-recording-out scores calibrate the test (with
+#: fewer, each SA is left out alone): two recordings give one between-run difference each,
+#: too few to tell a run-to-run spread from one odd run (chosen on the development lives of
+#: ``benchmarks/monitor_lives.py``).
+MIN_GROUPS = 3
 
 #: Smallest standard deviation of a feature (log10 units; kurtosis units for kurtosis):
 #: identical healthy SAs would otherwise make every other segment infinitely far.
@@ -267,21 +278,25 @@ def _states(features: FloatArray, example: FloatArray | None
 
 
 def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
-                          max_step: float, masks: list[NDArray[np.bool_]]) -> FloatArray:
-    """Each healthy row scored by the states fitted on the others."""
+                          max_step: float, masks: list[NDArray[np.bool_]],
+                          recordings: NDArray | None = None) -> FloatArray:
+    """Each healthy row scored by the states fitted on the others (on the other
+    recordings' rows when ``recordings`` labels the rows)."""
+    labels = np.arange(len(features)) if recordings is None else recordings
     scores = np.empty(len(features))
-    for i in range(len(features)):
-        mean, std, anchors, direction = _states(np.delete(features, i, axis=0), example)
-        z = ((features[i] - mean) / std)[None, :]
-        scores[i] = _distance(z, anchors, direction, max_step, masks)[0]
+    for label in dict.fromkeys(labels.tolist()):
+        out = labels == label
+        mean, std, anchors, direction = _states(features[~out], example)
+        scores[out] = _distance((features[out] - mean) / std, anchors, direction,
+                                max_step, masks)
     return scores
 
 
 def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
                       faulty_example: ArrayLike | None = None,
                       faulty_size: float | None = None,
-                      false_alarm_rate: float = DEFAULT_FALSE_ALARM
-                      ) -> ComparabilityReference:
+                      false_alarm_rate: float = DEFAULT_FALSE_ALARM,
+                      recordings: ArrayLike | None = None) -> ComparabilityReference:
     """Learn the fitted machine's states and calibrate the test on its healthy SAs.
 
     Parameters
@@ -295,6 +310,9 @@ def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
     faulty_size : float in (0, 1], optional
         Its size (needed with ``faulty_example``).
     false_alarm_rate : float in (0, 1), default :data:`DEFAULT_FALSE_ALARM`
+    recordings : array_like (n_healthy,), optional
+        The recording each healthy SA comes from: with at least :data:`MIN_GROUPS`
+        recordings the calibration leaves one recording out at a time.
 
     Returns
     -------
@@ -309,7 +327,7 @@ def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
                            low_inclusive=False, high_inclusive=False)
     n_points = healthy.shape[1]
     meshes = check_mesh_orders(mesh_order, n_points)
-    feats, groups = regular_features(healthy, list(meshes))
+    feats, columns = regular_features(healthy, list(meshes))
     example, max_step = None, 0.0
     if faulty_example is not None:
         if faulty_size is None:
@@ -324,9 +342,21 @@ def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
     mean, std, anchors, direction = _states(feats, example)
     log_mean = log_std = float("nan")
     if len(feats) >= MIN_HEALTHY:
-        loo = _leave_one_out_scores(feats, example, max_step, _group_masks(groups))
+        loo = _leave_one_out_scores(feats, example, max_step, _group_masks(columns),
+                                    _recording_labels(recordings, len(feats)))
         logs = np.log(np.maximum(loo, _TINY))
         log_mean = float(logs.mean())
         log_std = max(float(logs.std(ddof=1)), MIN_LOG_SPREAD)
-    return ComparabilityReference(tuple(meshes), n_points, groups, mean, std, anchors,
+    return ComparabilityReference(tuple(meshes), n_points, columns, mean, std, anchors,
                                   direction, max_step, log_mean, log_std, float(alpha))
+
+
+def _recording_labels(recordings: ArrayLike | None, n: int) -> NDArray | None:
+    """The recording labels of ``n`` healthy SAs when they name at least
+    :data:`MIN_GROUPS` recordings (else None: leave one SA out)."""
+    if recordings is None:
+        return None
+    labels = np.asarray(recordings).reshape(-1)
+    if labels.size != n:
+        raise GearshotError(f"recordings has {labels.size} labels for {n} healthy SAs")
+    return labels if len(set(labels.tolist())) >= MIN_GROUPS else None

@@ -264,13 +264,17 @@ class VirtualRig:
     def campaign(self, folder: str | os.PathLike, *, speed: float, load: float,
                  duration: float = 60.0, healthy: int = 6,
                  sizes: Sequence[float] = TABLE1_SIZES, repetitions: int = 6,
-                 dtype: str = "float32", progress: bool = True) -> pd.DataFrame:
+                 variation: float = 0.0, dtype: str = "float32",
+                 progress: bool = True) -> pd.DataFrame:
         """Record one condition as in the paper's Table 1 and write it to ``folder``.
 
         ``healthy`` healthy recordings and ``repetitions`` recordings per fault size, each
         ``duration`` s, written as native HDF5 recordings (``dtype`` samples) plus an index
         ``index.csv`` (rows of other conditions already in the folder are kept; rows of
-        this condition are replaced).
+        this condition are replaced). ``variation`` > 0 records each at its own speed and
+        load, the set-points times ``1 + variation · N(0, 1)`` (seeded by the rig, the size
+        and the repetition; the run-to-run spread of :meth:`history`); the index keeps the
+        set-points.
 
         Everything is first written to a hidden staging folder inside ``folder``
         (:func:`gearshot._atomic.staging_dir`); only when all recordings succeeded are they
@@ -289,13 +293,15 @@ class VirtualRig:
         load = check_load(load)
         jobs = _campaign_jobs(healthy, sizes, repetitions)
         check_positive(duration, "duration")
+        variation = check_in_range(variation, "variation", 0.0, 0.1)
         self._build()
         if not jobs:
             raise GearshotError("the campaign holds no recording (healthy=0 and no sizes)")
         check_writable(folder, "folder", folder=True)
         with staging_dir(folder) as staging:
             new = self._record_jobs(staging, folder, jobs, speed=speed, load=load,
-                                    duration=duration, dtype=dtype, progress=progress)
+                                    duration=duration, dtype=dtype, progress=progress,
+                                    variation=variation)
             new_index = _merged_index(folder / INDEX_NAME, new, speed, load)
             with atomic_path(staging / INDEX_NAME) as tmp:
                 new_index.to_csv(tmp, index=False)
@@ -315,14 +321,16 @@ class VirtualRig:
 
     def _record_jobs(self, staging: Path, folder: Path, jobs: list[tuple[float, int]], *,
                      speed: float, load: float, duration: float, dtype: str,
-                     progress: bool) -> pd.DataFrame:
+                     progress: bool, variation: float = 0.0) -> pd.DataFrame:
         """Record every (size, repetition) job into ``staging``; their index rows."""
         from .._progress import track
 
         rows = []
         for y, r in track(jobs, f"rig {speed:g} rev/s {load:g} N m", enabled=progress):
-            rec = self.record(speed=speed, load=load, fault_size=y, duration=duration,
-                              repetition=r)
+            z = (np.random.default_rng([self.seed, 43, r, int(round(y * 1e6))])
+                 .standard_normal(2) * variation if variation else np.zeros(2))
+            rec = self.record(speed=speed * (1 + z[0]), load=load * (1 + z[1]),
+                              fault_size=y, duration=duration, repetition=r)
             name = self.file_name(speed, load, y, r)
             try:
                 rec.write(staging / name, dtype=dtype)
