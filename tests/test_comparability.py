@@ -106,8 +106,8 @@ def test_another_speed_is_flagged_without_any_speed_gate(phm):
 def test_helical_records_under_the_spur_machine_are_flagged(phm):
     ref = _reference(phm)
     for name in ("helical1_30hz_High_1", "helical2_30hz_High_1", "helical5_30hz_High_1"):
-        res = ref.evaluate(phm(name))
-        assert not res.comparable.any() and not res.record_comparable, name
+        res = ref.evaluate(phm(name))   # the target: >= 90 % of segments flagged
+        assert (~res.comparable).mean() >= 0.9 and not res.record_comparable, name
 
 
 def test_the_other_load_is_flagged(phm):

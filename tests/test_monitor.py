@@ -63,8 +63,12 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     import hashlib
 
     assert back.database["manifest_sha256"] == hashlib.sha256(manifest).hexdigest()
-    # the baseline: the last healthy recording (a quarter of 4), kept out of the fit
-    assert len(back.baseline) == 2 and back.threshold == pytest.approx(m.threshold)
+    # the baseline: the last healthy recording (a quarter of 4) kept out of the fit, and
+    # each of the 3 fit recordings estimated by a fit on the other two: 4 x 2 segments
+    assert len(back.baseline) == 8 and back.threshold == pytest.approx(m.threshold)
+    from gearshot.monitor import alarm_threshold
+
+    assert back.threshold == pytest.approx(alarm_threshold(back.baseline))
     assert back.machine_toml is None and isinstance(back.fit_check["verdict"], str)
     sa = np.zeros((1, 2048))
     assert np.allclose(back.estimator.predict(sa), m.estimator.predict(sa))
@@ -257,3 +261,29 @@ def test_fit_and_monitor_with_a_machine_file_on_phm09(tmp_path):
     assert [Path(r["recording"]).name for r in payload["records"]] == [r[0] for r in rows]
     assert not payload["records"][2]["trusted"] and not payload["records"][2]["alarm"]
     assert payload["forecast"]["time"] is None and "too few" in payload["forecast"]["reason"]
+
+
+def test_a_gain_other_than_the_fits_is_not_comparable_a_new_run_is(machine, tmp_path):
+    """Fitted on three healthy runs (comparability left one recording out at a time),
+    a fourth run of the same machine stays comparable; the same run through a gain of
+    x100 or x0.01 (a physical level, so the input check passes) is not: the estimate it
+    moves is never trusted."""
+    from gearshot.app.predict_fit import estimate_segments, fit_from_files
+    from gearshot.io import Recording, recording_segments
+
+    healthy = machine["healthy"]
+    est, _ = fit_from_files(machine["db"], healthy[:3], machine["faulty"], 0.5, speed=15,
+                            load=10)
+    ref = est.comparability_reference_
+    assert ref.calibrated
+    new = recording_segments(healthy[3])
+    same = estimate_segments(est, new)
+    assert same["input_check"].eq("ok").all() and same["comparable"].mean() > 0.5
+    rec = Recording.read(healthy[3])
+    for gain in (100.0, 0.01):
+        path = Recording(rec.acceleration * gain, rec.tacho, rec.fs, speed=rec.speed,
+                         load=rec.load).write(tmp_path / f"x{gain:g}.h5")
+        scaled = recording_segments(path)
+        rows = estimate_segments(est, scaled)
+        assert rows["input_check"].eq("ok").all(), gain
+        assert not rows["comparable"].any() and not rows["trusted"].any(), gain

@@ -30,7 +30,10 @@ root-mean-square over features of the residual, each squared residual divided by
 variance at that state, ``1 + t_g**2 (1 + (k v_j)**2)``: the example is one noisy SA (the
 ``t_g**2``), and its effect on each feature is known only to a fraction
 ``k =`` :data:`FAULT_SHAPE_UNCERTAINTY` (a fault of another size does not move every feature
-in exact proportion). Zero-shot (no example): the distance from the nearest healthy SA.
+in exact proportion). The level may move along the fault at most
+:data:`LEVEL_STEP_RATIO` times as far as the farthest-moved other group: a fault that
+raises the level changes the signal's shape too, another gain or a louder path moves the
+level alone. Zero-shot (no example): the distance from the nearest healthy SA.
 
 **Calibration.** At fit time every healthy SA is scored by the reference fitted without it
 (leave-one-out); the logarithms of those scores define a normal model of a healthy segment's
@@ -39,8 +42,13 @@ log-score. When the healthy SAs come from at least :data:`MIN_GROUPS` recordings
 (leave-one-recording-out): a new recording differs from the fitted ones by what changes
 from run to run (speed and load within their tolerance, temperature, the path), which the
 SAs of one recording cannot show; the calibration then states the false-alarm rate of a
-*new recording* of the same machine. A segment's **p-value** is the upper tail of that
-model at its log-score, and it is **comparable** when its p-value is at least the stated
+*new recording* of the same machine. The **level** is tested on its own as well (one
+feature of many, its change would be diluted in the score): its residual at the nearest
+state, in its standard deviations, against the spread of the same left-out residuals (a
+normal law, two-sided). The two tests share the false-alarm rate (weighted Bonferroni:
+:data:`LEVEL_SHARE` of it to the level, whose departures under a wrong gain are gross):
+a segment's **p-value** is the smaller of ``p_score / (1 - LEVEL_SHARE)`` and
+``p_level / LEVEL_SHARE``, and it is **comparable** when its p-value is at least the stated
 false-alarm rate, :data:`DEFAULT_FALSE_ALARM` = 0.01 (1 % of the fitted machine's own
 healthy segments are expected to be flagged). Fewer than :data:`MIN_HEALTHY` healthy SAs
 cannot be calibrated: then no segment is comparable.
@@ -64,6 +72,17 @@ from numpy.typing import ArrayLike, NDArray
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range
 from ..signal.orders import check_mesh_orders
+from .comparability_states import (
+    FAULT_SHAPE_UNCERTAINTY,
+    LEVEL_STEP_RATIO,
+    MIN_GROUPS,
+    MIN_STD,
+    _distance,
+    _group_masks,
+    _leave_one_out_scores,
+    _recording_labels,
+    _states,
+)
 from .regular_part import (
     FEATURE_GROUPS,
     harmonic_orders,
@@ -72,8 +91,8 @@ from .regular_part import (
     regular_features,
 )
 
-__all__ = ["DEFAULT_FALSE_ALARM", "FAULT_SHAPE_UNCERTAINTY", "FEATURE_GROUPS", "MIN_GROUPS",
-           "MIN_HEALTHY", "MIN_STD",
+__all__ = ["DEFAULT_FALSE_ALARM", "FAULT_SHAPE_UNCERTAINTY", "FEATURE_GROUPS",
+           "LEVEL_SHARE", "LEVEL_STEP_RATIO", "MIN_GROUPS", "MIN_HEALTHY", "MIN_STD",
            "Comparability", "ComparabilityReference", "fit_comparability",
            "harmonic_orders", "harmonic_profile", "healthy_spread", "regular_features"]
 
@@ -88,23 +107,11 @@ DEFAULT_FALSE_ALARM = 0.01
 #: sensors, against 2.7 with the development fits' 9).
 MIN_HEALTHY = 6
 
-#: Fewest healthy recordings whose leave-one-recording-out scores calibrate the test (with
-#: fewer, each SA is left out alone): two recordings give one between-run difference each,
-#: too few to tell a run-to-run spread from one odd run (chosen on the development lives of
-#: ``benchmarks/monitor_lives.py``).
-MIN_GROUPS = 3
-
-#: Smallest standard deviation of a feature (log10 units; kurtosis units for kurtosis):
-#: identical healthy SAs would otherwise make every other segment infinitely far.
-MIN_STD = 1e-3
-
-#: Relative uncertainty of the example's effect on each feature: a fault of another size
-#: moves every feature toward the example's value, but not in exact proportion (measured
-#: on virtual rigs: a size-0.3 fault moves the level 18 % and the background 43 % of the
-#: way to a size-0.6 example). Chosen on the development part of the matrix (0, 0.05,
-#: 0.1, 0.25, 0.5, 1 tried: the smallest value that keeps a smaller fault of the
-#: development rig comparable).
-FAULT_SHAPE_UNCERTAINTY = 0.25
+#: Share of the false-alarm rate given to the level test (the rest to the score): a wrong
+#: gain or a louder path departs by tens of standard deviations, so a small share keeps
+#: the score's own threshold (chosen on the development part of the matrix: with half,
+#: the helical records and spur1 at 30 Hz High passed the score test more often).
+LEVEL_SHARE = 0.1
 
 #: Smallest spread of the leave-one-out log-scores (natural-log units).
 MIN_LOG_SPREAD = 0.05
@@ -124,14 +131,15 @@ class Comparability:
         fitted machine).
     p_value : ndarray (n_signals,)
         Probability that a healthy segment of the fitted machine scores at least as high
-        (the calibrated model of the leave-one-out healthy scores); NaN when the
+        (the calibrated model of the leave-one-out healthy scores), or departs as far in
+        level, Bonferroni-combined (:meth:`ComparabilityReference.p_value`); NaN when the
         reference is not calibrated.
     comparable : ndarray of bool (n_signals,)
-        ``p_value >= false_alarm_rate`` (equivalently ``score <= threshold``).
+        ``p_value >= false_alarm_rate``.
     false_alarm_rate : float
     threshold : float
-        The score at which the p-value equals the false-alarm rate (0 when the reference
-        is not calibrated: no segment is then comparable).
+        The score above which a segment is flagged whatever its level (0 when the
+        reference is not calibrated: no segment is then comparable).
     record_p_value : float
         The p-value of the segments' median score: all segments judged together as one
         recording (another load, speed or build differs for the whole record).
@@ -171,6 +179,10 @@ class ComparabilityReference:
         Normal model of a healthy segment's ``log(score)``, from the leave-one-out scores
         of the healthy SAs (NaN when fewer than :data:`MIN_HEALTHY` SAs: not calibrated).
     false_alarm_rate : float
+    level_spread : float
+        Standard deviation of a healthy segment's level residual (its level's distance
+        from the nearest state, in its own standard deviations), from the same
+        leave-one-out; NaN: no level test (a reference saved before it existed).
     """
 
     mesh_order: tuple[int, ...]
@@ -184,6 +196,7 @@ class ComparabilityReference:
     log_score_mean: float
     log_score_std: float
     false_alarm_rate: float
+    level_spread: float = float("nan")
 
     @property
     def calibrated(self) -> bool:
@@ -192,24 +205,41 @@ class ComparabilityReference:
 
     def distance(self, features: ArrayLike) -> FloatArray:
         """Score of :func:`regular_features` rows (see the module docstring)."""
+        return self.scores(features)[0]
+
+    def scores(self, features: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """Score and level residual of :func:`regular_features` rows."""
         z = (np.atleast_2d(np.asarray(features, dtype=float)) - self.mean) / self.std
         return _distance(z, self.anchors, self.fault_direction, self.max_step,
                          _group_masks(self.groups))
 
-    def p_value(self, score: ArrayLike) -> FloatArray:
-        """Upper-tail probability of scores under the healthy log-score model."""
+    @property
+    def _score_share(self) -> float:
+        return 1.0 - LEVEL_SHARE if np.isfinite(self.level_spread) else 1.0
+
+    def p_value(self, score: ArrayLike, level: ArrayLike | None = None) -> FloatArray:
+        """Probability of a healthy segment scoring as high (upper tail of the healthy
+        log-score model) or, with ``level``, departing as far in level (two-sided normal
+        with :attr:`level_spread`), weighted Bonferroni (:data:`LEVEL_SHARE`)."""
         s = np.asarray(score, dtype=float)
         if not self.calibrated:
             return np.full(s.shape, np.nan)
         z = (np.log(np.maximum(s, _TINY)) - self.log_score_mean) / self.log_score_std
-        return np.asarray(scipy.special.ndtr(-z), dtype=float)
+        p = np.asarray(scipy.special.ndtr(-z), dtype=float)
+        if level is None or self._score_share == 1.0:
+            return p
+        p_level = 2.0 * scipy.special.ndtr(-np.abs(np.asarray(level, float))
+                                           / self.level_spread)
+        return np.asarray(np.minimum(1.0, np.minimum(p / self._score_share,
+                                                     p_level / LEVEL_SHARE)), dtype=float)
 
     def threshold(self, false_alarm_rate: float) -> float:
-        """The score whose p-value is ``false_alarm_rate`` (0 when not calibrated)."""
+        """The score flagged at ``false_alarm_rate`` whatever the level (0 when not
+        calibrated)."""
         if not self.calibrated:
             return 0.0
-        return float(np.exp(self.log_score_mean
-                            + self.log_score_std * scipy.special.ndtri(1 - false_alarm_rate)))
+        q = scipy.special.ndtri(1 - false_alarm_rate * self._score_share)
+        return float(np.exp(self.log_score_mean + self.log_score_std * q))
 
     def evaluate(self, sa: ArrayLike, false_alarm_rate: float | None = None
                  ) -> Comparability:
@@ -222,74 +252,12 @@ class ComparabilityReference:
         alpha = (self.false_alarm_rate if false_alarm_rate is None else
                  check_in_range(false_alarm_rate, "false_alarm_rate", 0.0, 1.0,
                                 low_inclusive=False, high_inclusive=False))
-        score = self.distance(regular_features(arr, list(self.mesh_order))[0])
-        p = self.p_value(score)
-        record_p = float(self.p_value(np.median(score)))
+        score, level = self.scores(regular_features(arr, list(self.mesh_order))[0])
+        p = self.p_value(score, level)
+        record_p = float(self.p_value(np.median(score), np.median(level)))
         comparable = np.asarray(p >= alpha, dtype=bool)  # NaN (not calibrated): False
         return Comparability(score, p, comparable, float(alpha), self.threshold(alpha),
                              record_p, bool(record_p >= alpha))
-
-
-def _group_masks(groups: tuple[str, ...]) -> list[NDArray[np.bool_]]:
-    labels = np.asarray(groups)
-    return [labels == g for g in dict.fromkeys(groups)]
-
-
-def _local_spread(features: FloatArray) -> FloatArray:
-    """RMS difference of each row from its nearest other row (in pooled standard
-    deviations) over ``sqrt(2)``, per column, at least :data:`MIN_STD`."""
-    pooled = np.sqrt(features.var(axis=0, ddof=1) + MIN_STD ** 2)
-    z = features / pooled
-    gap = np.sum((z[:, None, :] - z[None, :, :]) ** 2, axis=-1)
-    np.fill_diagonal(gap, np.inf)
-    nearest = features[np.argmin(gap, axis=1)]
-    return np.asarray(np.sqrt(np.mean((features - nearest) ** 2, axis=0) / 2
-                              + MIN_STD ** 2), dtype=float)
-
-
-def _distance(z: FloatArray, anchors: FloatArray, direction: FloatArray,
-              max_step: float, masks: list[NDArray[np.bool_]]) -> FloatArray:
-    """Distance of standardised rows ``z`` from the nearest state ``anchor + t_g v_g``."""
-    offset = z[:, None, :] - anchors[None, :, :]        # (m, n_anchors, d)
-    total = np.zeros(offset.shape[:2])
-    for mask in masks:
-        v = direction[mask]
-        part = offset[..., mask]
-        vv = float(v @ v)
-        t = np.clip(part @ v / vv, 0.0, max_step) if vv > 0 else np.zeros(total.shape)
-        resid = part - t[..., None] * v
-        var = 1.0 + t[..., None] ** 2 * (1.0 + (FAULT_SHAPE_UNCERTAINTY * v) ** 2)
-        total += np.sum(resid ** 2 / var, axis=-1)
-    return np.asarray(np.sqrt(total.min(axis=1) / z.shape[1]), dtype=float)
-
-
-def _states(features: FloatArray, example: FloatArray | None
-            ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Mean, local spread, anchors and fault direction of healthy feature rows."""
-    mean = features.mean(axis=0)
-    std = _local_spread(features)
-    anchors = (features - mean) / std
-    direction = np.zeros_like(mean)
-    if example is not None:
-        ez = (example - mean) / std
-        gap = np.sum((anchors - ez) ** 2, axis=1)
-        direction = ez - anchors[gap <= np.median(gap)].mean(axis=0)
-    return mean, std, anchors, direction
-
-
-def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
-                          max_step: float, masks: list[NDArray[np.bool_]],
-                          recordings: NDArray | None = None) -> FloatArray:
-    """Each healthy row scored by the states fitted on the others (on the other
-    recordings' rows when ``recordings`` labels the rows)."""
-    labels = np.arange(len(features)) if recordings is None else recordings
-    scores = np.empty(len(features))
-    for label in dict.fromkeys(labels.tolist()):
-        out = labels == label
-        mean, std, anchors, direction = _states(features[~out], example)
-        scores[out] = _distance((features[out] - mean) / std, anchors, direction,
-                                max_step, masks)
-    return scores
 
 
 def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
@@ -340,23 +308,16 @@ def fit_comparability(healthy_sa: ArrayLike, mesh_order: int | Sequence[int], *,
         example = regular_features(ex, list(meshes))[0][0]
         max_step = 1.0 / size
     mean, std, anchors, direction = _states(feats, example)
-    log_mean = log_std = float("nan")
+    log_mean = log_std = level_spread = float("nan")
     if len(feats) >= MIN_HEALTHY:
-        loo = _leave_one_out_scores(feats, example, max_step, _group_masks(columns),
-                                    _recording_labels(recordings, len(feats)))
+        labels = _recording_labels(recordings, len(feats))
+        loo, level = _leave_one_out_scores(feats, example, max_step, _group_masks(columns),
+                                           labels)
         logs = np.log(np.maximum(loo, _TINY))
         log_mean = float(logs.mean())
         log_std = max(float(logs.std(ddof=1)), MIN_LOG_SPREAD)
+        if labels is not None:   # whole recordings left out: the level tested too
+            level_spread = max(float(np.sqrt(np.mean(level ** 2))), 1.0)
     return ComparabilityReference(tuple(meshes), n_points, columns, mean, std, anchors,
-                                  direction, max_step, log_mean, log_std, float(alpha))
-
-
-def _recording_labels(recordings: ArrayLike | None, n: int) -> NDArray | None:
-    """The recording labels of ``n`` healthy SAs when they name at least
-    :data:`MIN_GROUPS` recordings (else None: leave one SA out)."""
-    if recordings is None:
-        return None
-    labels = np.asarray(recordings).reshape(-1)
-    if labels.size != n:
-        raise GearshotError(f"recordings has {labels.size} labels for {n} healthy SAs")
-    return labels if len(set(labels.tolist())) >= MIN_GROUPS else None
+                                  direction, max_step, log_mean, log_std, float(alpha),
+                                  level_spread)
