@@ -14,9 +14,9 @@ def combine_segments(frame: pd.DataFrame) -> dict:
     """The combined estimate of one recording's segments.
 
     The estimate is the median of the trusted segments' estimates (of all segments when
-    the recording is not trusted: half of its segments or fewer are); the interval is the median of their interval bounds —
-    the segments of one run share its bias, so the interval is not narrowed by their
-    number.
+    the recording is not trusted: half of its segments or fewer are); the interval is the
+    median of their interval bounds — the segments of one run share its bias, so the
+    interval is not narrowed by their number.
 
     Parameters
     ----------
