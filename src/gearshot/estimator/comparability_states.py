@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -100,7 +102,7 @@ def _states(features: FloatArray, example: FloatArray | None
 
 def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
                           max_step: float, masks: list[NDArray[np.bool_]],
-                          recordings: NDArray | None = None
+                          recordings: NDArray[Any] | None = None
                           ) -> tuple[FloatArray, FloatArray]:
     """Each healthy row scored by the states fitted on the others (on the other
     recordings' rows when ``recordings`` labels the rows): scores and level residuals."""
@@ -114,7 +116,7 @@ def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
     return scores, levels
 
 
-def _recording_labels(recordings: ArrayLike | None, n: int) -> NDArray | None:
+def _recording_labels(recordings: ArrayLike | None, n: int) -> NDArray[Any] | None:
     """The recording labels of ``n`` healthy SAs when they name at least
     :data:`MIN_GROUPS` recordings (else None: leave one SA out)."""
     if recordings is None:
