@@ -124,7 +124,7 @@ def _segments(files, healthy, faulty, kw, holdout=0.0):
     Every recording is read and segmented before the fit: a file too short for one SA
     segment (or unreadable) fails now, not after minutes of fitting.
     """
-    from ..estimator.fit_check import holdout_count
+    from ..estimator.fit_check import holdout_count, typical_segment
     from ..io import recording_segments
 
     health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)
@@ -153,7 +153,9 @@ def _segments(files, healthy, faulty, kw, holdout=0.0):
     if faulty is None:   # zero-shot
         return targets, healthy_sa, long, None, None, held, health
     faulty_sa = cut(faulty, "faulty")
-    return targets, healthy_sa, long, faulty_sa[0], faulty_sa[1:], held, health
+    k = typical_segment(faulty_sa)
+    rest = np.delete(faulty_sa, k, axis=0)
+    return targets, healthy_sa, long, faulty_sa[k], rest, held, health
 
 
 def recording_labels(per_recording) -> np.ndarray:

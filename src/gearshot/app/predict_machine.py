@@ -12,6 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
+from ..estimator.fit_check import typical_segment
 from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from ..machine.signal_check import speed_check, verify_machine
 from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
@@ -44,11 +45,8 @@ def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
     (:func:`gearshot.machine.signal_check.speed_check`) and the sensor's input checks
     ``recording`` and ``segments``.
 
-    Returns
-    -------
-    sa : ndarray, shape (n_segments, samples_per_cycle)
-    x : ndarray (n_cycles * samples_per_cycle,): the whole angle-domain signal
-    speed : float: the tacho shaft's speed, rev/s
+    Returns ``sa`` (n_segments, samples_per_cycle), ``x`` (the whole angle-domain signal,
+    n_cycles * samples_per_cycle) and ``speed`` (the tacho shaft's, rev/s).
     """
     from ..io import Recording
 
@@ -97,7 +95,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                          recordings: Sequence[str | Path] = (), *,
                          speed: float | None = None, load: float | None = None,
                          cycles_per_segment: int | None = None, sensor: str | None = None,
-                         holdout: float = 0.25, example_segment: int = 0,
+                         holdout: float = 0.25, example_segment: int | None = None,
                          coverage: float = 0.9, seed: int = 0,
                          params: dict | None = None,
                          speed_tolerance: float = SPEED_TOLERANCE) -> pd.DataFrame:
@@ -114,7 +112,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     healthy : sequence of path
         Healthy recordings.
     faulty : path
-        The faulty recording; its segment ``example_segment`` is the one example.
+        The faulty recording; its segment ``example_segment`` is the one example (None:
+        its most typical, :func:`~gearshot.estimator.fit_check.typical_segment`).
     faulty_size : float
         The example's declared size in (0, 1].
     recordings : sequence of path
@@ -181,7 +180,7 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
                 faulty_size: float | None, recordings: Sequence[str | Path] = (), *,
                 speed: float | None = None, load: float | None = None,
                 cycles_per_segment: int | None = None, sensor: str | None = None,
-                holdout: float = 0.25, example_segment: int = 0, seed: int = 0,
+                holdout: float = 0.25, example_segment: int | None = None, seed: int = 0,
                 params: dict | None = None, speed_tolerance: float = SPEED_TOLERANCE):
     """The fit of :func:`predict_from_machine` (same parameters); ``faulty`` None fits
     zero-shot (``calibration="zero_shot"``).
@@ -318,8 +317,8 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
     if faulty is not None:
         fsa, _, fsp = cut(faulty)
         _require_fit_input(seg.sources[str(faulty)], faulty, "faulty")
-        example_segment = check_int(example_segment, "example_segment", minimum=0,
-                                    maximum=fsa.shape[0] - 1)
+        example_segment = typical_segment(fsa) if example_segment is None else check_int(
+            example_segment, "example_segment", minimum=0, maximum=fsa.shape[0] - 1)
         seg.example = fsa[example_segment]
         seg.rows.extend((str(faulty), "faulty_rest", k, fsp, fsa[k])
                         for k in range(fsa.shape[0]) if k != example_segment)

@@ -125,6 +125,15 @@ def holdout_count(n_segments: int, holdout: float) -> int:
     return int(np.floor(holdout * int(n_segments)))
 
 
+def typical_segment(sa: ArrayLike) -> int:
+    """Index of the segment of one record nearest (Euclidean) to the record's mean SA: the
+    example a fit calibrates on. One segment carries its own noise into the calibration,
+    and the record's other segments check it; the record's most typical segment is the
+    one the others agree with best."""
+    arr = np.atleast_2d(np.asarray(sa, dtype=float))
+    return int(np.argmin(np.sum((arr - arr.mean(axis=0)) ** 2, axis=1)))
+
+
 @dataclass(frozen=True)
 class Holdouts:
     """The SAs a fit keeps out to check itself.
