@@ -285,3 +285,17 @@ def test_predict_without_machine_holds_out_and_checks(tmp_path, duration, n_held
             "unchecked: 6 healthy segments give 0 hold-out(s) at holdout 0.25, 2 needed")
         assert not frame["trusted"].any()
     assert (frame["fit_check"] == frame.attrs["fit_check"]["verdict"]).all()
+
+
+def test_typical_segment_is_the_one_nearest_the_record_mean():
+    """The example of a faulty record: not an odd first segment, but the segment the
+    others agree with best."""
+    from gearshot.estimator.fit_check import typical_segment
+
+    rng = np.random.default_rng(5)
+    base = np.sin(2 * np.pi * 7 * np.arange(256) / 256)
+    record = base + 0.05 * rng.standard_normal((6, 256))
+    record[0] += 0.8 * np.cos(2 * np.pi * 3 * np.arange(256) / 256)   # an odd segment
+    record[4] = base                                                   # the typical one
+    assert typical_segment(record) == 4
+    assert typical_segment(base) == 0
