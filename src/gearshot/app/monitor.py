@@ -132,7 +132,7 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
     :data:`~gearshot.estimator.comparability.MIN_GROUPS` fit recordings on; else none):
     the healthy baseline then holds every healthy recording's run, not one kept out.
     Chosen on the development lives (``benchmarks/monitor_lives.py``, seeds 1-10): with
-    the one kept-out recording alone the threshold reached 0.29-0.31 in three lives and
+    the kept-out recordings alone the threshold reached 0.29-0.31 in three lives and
     one alarm came 6 recordings late; cross-fitted, every alarm came in time, none false."""
     from ..estimator.comparability import MIN_GROUPS
     from .predict import estimate_segments, fit_from_files
