@@ -40,6 +40,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
 sys.path.insert(0, str(SRC))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from phm09_records import crop as _crop  # noqa: E402  (the tests' cropped PHM09 records)
 
 from gearshot import GearshotError  # noqa: E402
 
@@ -56,19 +59,6 @@ def fsize(limit):
 
 def leftovers(folder: Path) -> list[Path]:
     return [p for p in folder.rglob("*") if p.name.startswith(".") and "tmp" in p.name]
-
-
-def _crop(name: str, folder: Path, rows: int) -> Path:
-    """A zipped copy of a PHM09 record holding its first ``rows`` rows."""
-    import zipfile
-
-    with zipfile.ZipFile(ROOT.parent / "shared" / "data" / "phm09" / name) as zf:
-        member = zf.namelist()[0]
-        lines = zf.read(member).splitlines(keepends=True)[:rows]
-    out = folder / name
-    with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(member, b"".join(lines))
-    return out
 
 
 def contract() -> dict[str, int]:
