@@ -142,18 +142,9 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
     return rows
 
 
-RIG_SPEED, RIG_LOAD = 15.0, 10.0
-
-
-def _rig_sa(rig, *, speed=RIG_SPEED, load=RIG_LOAD, size=0.0, rep=0, segments=4):
-    duration = 1.02 * (segments * 50 + 1) / (speed * 17 / 38)
-    rec = rig.record(speed=speed, load=load, fault_size=size, duration=duration,
-                     repetition=rep)
-    return rec.to_sa_segments(gear_teeth=38, pinion_teeth=17, cycles_per_segment=50,
-                              samples_per_cycle=2048)
-
-
 def rig_rows(seed: int) -> list[dict]:
+    from rig_comparability import _sa as _rig_sa  # the rig records of the first matrix
+
     from gearshot.rig import VirtualRig
 
     rig = VirtualRig(seed=seed)
