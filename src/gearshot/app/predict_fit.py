@@ -38,7 +38,8 @@ class FittedFiles:
 
 def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
                    coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                   selection_tf=None, recordings=(), holdout=0.25, holdout_files=()):
+                   selection_tf=None, recordings=(), holdout=0.25, holdout_files=(),
+                   segmented=None):
     """Fit the estimator from recording files (the fit of ``gearshot predict`` and
     ``gearshot fit`` without ``--machine``), its hold-outs checking it.
 
@@ -49,6 +50,8 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     Every recording (``recordings`` too, segmented into ``FittedFiles.targets``) is read,
     checked (:mod:`gearshot.io.input_health`: a fit recording that fails is refused) and
     segmented before the fit: a bad file fails now, not after minutes of fitting.
+    ``segmented``, a dict kept by the caller across fits on the same files, holds what was
+    read and segmented, so that each file is read once (``gearshot fit``'s cross-fits).
 
     Returns
     -------
@@ -72,7 +75,7 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
     targets, healthy_sa, long, example, rest, held, health = _segments(
-        recordings, healthy, faulty, kw, holdout)
+        recordings, healthy, faulty, kw, holdout, segmented)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     whole = {_key(p) for p in holdout_files}
@@ -114,7 +117,7 @@ def estimate_segments(est, sa, *, coverage=0.9, input_check=None) -> pd.DataFram
     return frame
 
 
-def _segments(files, healthy, faulty, kw, holdout=0.0):
+def _segments(files, healthy, faulty, kw, holdout=0.0, segmented=None):
     """SA segments of the targets; the healthy recordings' fitted segments (one array per
     recording; the first one's long angle-domain signal too, without its hold-outs); the
     faulty example (the faulty recording's first segment) and its record's other segments;
@@ -122,7 +125,8 @@ def _segments(files, healthy, faulty, kw, holdout=0.0):
     (path, SAs).
 
     Every recording is read and segmented before the fit: a file too short for one SA
-    segment (or unreadable) fails now, not after minutes of fitting.
+    segment (or unreadable) fails now, not after minutes of fitting; ``segmented`` (a dict,
+    optional) keeps each file's segments and checks for the next fit on the same files.
     """
     from ..estimator.fit_check import holdout_count, typical_segment
     from ..io import recording_segments
@@ -130,8 +134,14 @@ def _segments(files, healthy, faulty, kw, holdout=0.0):
     health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)
 
     def cut(path, role=None, **more):
-        found: dict = {}
-        out = recording_segments(path, health=found, **more, **kw)
+        key = (_key(path), bool(more.get("long")), tuple(sorted(kw.items())))
+        if segmented is not None and key in segmented:
+            out, found = segmented[key]
+        else:
+            found = {}
+            out = recording_segments(path, health=found, **more, **kw)
+            if segmented is not None:
+                segmented[key] = (out, found)
         health[_key(path)] = found
         if role is not None:   # a recording the fit uses: refused unless every check passes
             for check in (found["recording"], *found["segments"]):
