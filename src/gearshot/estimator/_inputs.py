@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._errors import GearshotError
 from .._validation import as_signal_array
 from ..transfer import resample_transfer_function
+from .comparability_states import _recording_labels
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -115,34 +116,42 @@ def check_fit_inputs(est: Any, target_healthy: ArrayLike, faulty_example: ArrayL
     return _FitInputs(healthy, example, size, long, sel_tf, n_points)
 
 
-def spread_references(target_healthy: FloatArray, recordings: ArrayLike | None,
-                      min_recordings: int, ref_fraction: float = 0.2
+#: Share of the target's healthy SAs that are step 6's references (the last ones).
+REFERENCE_FRACTION = 0.2
+
+
+def reference_count(n_healthy: int, ref_fraction: float = REFERENCE_FRACTION) -> int:
+    """How many of ``n_healthy`` target healthy SAs are step 6's references (at least one;
+    :func:`gearshot.estimator.steps.split_target_healthy`)."""
+    return max(1, int(round(n_healthy * ref_fraction)))
+
+
+def spread_references(target_healthy: FloatArray, recordings: ArrayLike | None
                       ) -> tuple[FloatArray, NDArray[Any] | None]:
     """The fit's healthy SAs ordered so that the references of step 6 (the last
-    ``ref_fraction``) come from as many recordings as possible, and their recording labels.
+    :func:`reference_count`) come from as many recordings as possible, and their recording
+    labels (None below :data:`~gearshot.estimator.comparability.MIN_GROUPS` recordings).
 
     ``recordings`` labels the SAs (it may be longer: the hold-outs cut from the end are not
-    labelled here); with fewer than ``min_recordings`` recordings (or None) the order is
-    kept (the references are the last SAs). Otherwise the references are taken round-robin,
+    labelled here); with fewer than ``MIN_GROUPS`` recordings (or None) the order is kept
+    (the references are the last SAs). Otherwise the references are taken round-robin,
     the last SA of each recording first: the target side subtracts the reference that
     leaves the least, and a reference of every run lets a segment of a later run (another
     speed within tolerance, another day) find the run it resembles most.
     """
-    if recordings is None:
+    n = len(target_healthy)
+    labels = _recording_labels(None if recordings is None else
+                               np.asarray(recordings).reshape(-1)[:n], n, "healthy_recordings")
+    if labels is None:
         return target_healthy, None
-    labels = np.asarray(recordings).reshape(-1)[:len(target_healthy)]
-    if labels.size != len(target_healthy):
-        raise GearshotError(f"healthy_recordings has {labels.size} labels for "
-                            f"{len(target_healthy)} healthy SAs")
     names = list(dict.fromkeys(labels.tolist()))
-    if len(names) < min_recordings:
-        return target_healthy, labels
-    n_ref = max(1, int(round(len(labels) * ref_fraction)))
+    n_ref = reference_count(len(labels))
     queues = [list(np.nonzero(labels == g)[0][::-1]) for g in names]
     refs: list[int] = []
     while len(refs) < n_ref:
         for q in queues:
             if q and len(refs) < n_ref:
                 refs.append(int(q.pop(0)))
-    order = np.array([i for i in range(len(labels)) if i not in set(refs)] + refs[::-1])
+    chosen = set(refs)
+    order = np.array([i for i in range(len(labels)) if i not in chosen] + refs[::-1])
     return target_healthy[order], labels[order]

@@ -62,7 +62,7 @@ from ._params import (
 from ._prediction import _Prediction
 from ._target import fit_target_side
 from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
-from .comparability import MIN_GROUPS, fit_comparability
+from .comparability import fit_comparability
 from .detection import detection_limit
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
@@ -340,9 +340,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         orders = resolve_mesh_orders(self.mesh_order, database, gear_teeth, pinion_teeth)
         self._fitting_orders = orders   # what _mesh_orders() gives until fit returns
         try:
-            self._fit(database, *spread_references(target_healthy, healthy_recordings,
-                                                   MIN_GROUPS), faulty_example, faulty_size,
-                      healthy_long, selection_tf, orders)
+            self._fit(database, *spread_references(target_healthy, healthy_recordings),
+                      faulty_example, faulty_size, healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
         n_fit = len(self.target_healthy_features_) + len(self.references_)

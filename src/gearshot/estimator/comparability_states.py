@@ -116,12 +116,14 @@ def _leave_one_out_scores(features: FloatArray, example: FloatArray | None,
     return scores, levels
 
 
-def _recording_labels(recordings: ArrayLike | None, n: int) -> NDArray[Any] | None:
-    """The recording labels of ``n`` healthy SAs when they name at least
-    :data:`MIN_GROUPS` recordings (else None: leave one SA out)."""
+def _recording_labels(recordings: ArrayLike | None, n: int, name: str = "recordings"
+                      ) -> NDArray[Any] | None:
+    """The recording labels (argument ``name``) of ``n`` healthy SAs when they name at
+    least :data:`MIN_GROUPS` recordings (else None: leave one SA out; the references of
+    step 6 are the last SAs)."""
     if recordings is None:
         return None
     labels = np.asarray(recordings).reshape(-1)
     if labels.size != n:
-        raise GearshotError(f"recordings has {labels.size} labels for {n} healthy SAs")
+        raise GearshotError(f"{name} has {labels.size} labels for {n} healthy SAs")
     return labels if len(set(labels.tolist())) >= MIN_GROUPS else None

@@ -31,6 +31,7 @@ from .._errors import GearshotError
 from ..features import extract_features
 from ..signal import mean_rms, subtract_healthy
 from ..transfer import estimate_transfer_function, propagate
+from ._inputs import REFERENCE_FRACTION, reference_count
 from ._simulated import difference_features, residue_noise_spectrum, twin_difference_features
 from .knn import KnnModel, fit_knn
 
@@ -286,15 +287,14 @@ def residue_noise(power: ArrayLike, n_signals: int, n_points: int,
     return np.asarray(np.fft.irfft(shaped, n=n_points, axis=-1), dtype=np.float64)
 
 
-def split_target_healthy(target_healthy: FloatArray, *, ref_fraction: float = 0.2,
+def split_target_healthy(target_healthy: FloatArray, *, ref_fraction: float = REFERENCE_FRACTION
                          ) -> tuple[FloatArray, FloatArray]:
     """Split target healthy SAs into (training part, references): the last fifth are references."""
     n = target_healthy.shape[0]
-    n_ref = max(1, int(round(n * ref_fraction)))
+    n_ref = reference_count(n, ref_fraction)
     if n - n_ref < 1:
-        raise GearshotError(
-            f"target_healthy holds {n} SAs; at least 2 are needed to keep references apart "
-            f"from training (5 or more recommended)")
+        raise GearshotError(f"target_healthy holds {n} SAs; at least 2 are needed to keep "
+                            f"references apart from training (5 or more recommended)")
     return target_healthy[: n - n_ref], target_healthy[n - n_ref:]
 
 
