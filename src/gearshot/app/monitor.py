@@ -92,18 +92,18 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         from .predict import fit_from_files
 
         fit_files, base_files = _holdout_split(healthy, holdout)
-        segmented: dict = {}   # each file read once, for the fit and the cross-fits
+        reads: dict = {}   # each file and the database read once, for the fit and cross-fits
         est, fitted = fit_from_files(database, fit_files, faulty, faulty_size, speed=speed,
                                      load=load, coverage=coverage, gear_teeth=gear_teeth,
                                      pinion_teeth=pinion_teeth, seed=seed,
                                      recordings=base_files, holdout=0.0,
-                                     holdout_files=base_files, segmented=segmented)
+                                     holdout_files=base_files, reads=reads)
         baseline = np.concatenate([estimate_segments(est, sa, coverage=coverage)["predicted"]
                                    for _, sa in fitted.targets]
                                   + _cross_fitted(database, fit_files, faulty, faulty_size,
                                                   speed=speed, load=load, coverage=coverage,
                                                   seed=seed, teeth=fitted.teeth,
-                                                  segmented=segmented))
+                                                  reads=reads))
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
@@ -129,7 +129,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
 
 
 def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, coverage, seed,
-                  teeth, segmented=None) -> list:
+                  teeth, reads=None) -> list:
     """Estimates of each fit recording by a fit on the other healthy recordings (from
     :data:`~gearshot.estimator.comparability.MIN_GROUPS` fit recordings on; else none):
     the healthy baseline then holds every healthy recording's run, not one kept out.
@@ -147,7 +147,7 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
         est, fitted = fit_from_files(database, others, faulty, faulty_size, speed=speed,
                                      load=load, coverage=coverage, seed=seed,
                                      recordings=[path], holdout=0.0, holdout_files=[path],
-                                     segmented=segmented, **teeth)
+                                     reads=reads, **teeth)
         out.append(estimate_segments(est, fitted.targets[0][1],
                                      coverage=coverage)["predicted"].to_numpy())
     return out

@@ -39,7 +39,7 @@ class FittedFiles:
 def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
                    coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
                    selection_tf=None, recordings=(), holdout=0.25, holdout_files=(),
-                   segmented=None):
+                   reads=None):
     """Fit the estimator from recording files (the fit of ``gearshot predict`` and
     ``gearshot fit`` without ``--machine``), its hold-outs checking it.
 
@@ -50,8 +50,9 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     Every recording (``recordings`` too, segmented into ``FittedFiles.targets``) is read,
     checked (:mod:`gearshot.io.input_health`: a fit recording that fails is refused) and
     segmented before the fit: a bad file fails now, not after minutes of fitting.
-    ``segmented``, a dict kept by the caller across fits on the same files, holds what was
-    read and segmented, so that each file is read once (``gearshot fit``'s cross-fits).
+    ``reads``, a dict kept by the caller across fits on the same files, holds the database
+    slice and every file's segments, so that each is read once (``gearshot fit``'s
+    cross-fits).
 
     Returns
     -------
@@ -69,13 +70,18 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     check_in_range(coverage, "coverage (--coverage)", 0.0, 1.0, low_inclusive=False,
                    high_inclusive=False)
     speed, load = choose_condition(database, None, speed=speed, load=load, measured=[])
-    db = load_database(database, speed=speed, load=load)
+    key = ("database", str(database), speed, load)
+    db = (reads or {}).get(key)
+    if db is None:
+        db = load_database(database, speed=speed, load=load)
+        if reads is not None:
+            reads[key] = db
     # the pair is the database's unless declared (a declared other pair is refused by fit)
     teeth = dict(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth)
     kw = {k: db.attrs.get(k, default) if teeth[k] is None else teeth[k]
           for k, default in (("gear_teeth", GEAR_TEETH), ("pinion_teeth", PINION_TEETH))}
     targets, healthy_sa, long, example, rest, held, health = _segments(
-        recordings, healthy, faulty, kw, holdout, segmented)
+        recordings, healthy, faulty, kw, holdout, reads)
     if selection_tf is None:
         selection_tf = default_selection_tf(seed)
     whole = {_key(p) for p in holdout_files}
@@ -117,15 +123,16 @@ def estimate_segments(est, sa, *, coverage=0.9, input_check=None) -> pd.DataFram
     return frame
 
 
-def _segments(files, healthy, faulty, kw, holdout=0.0, segmented=None):
+def _segments(files, healthy, faulty, kw, holdout=0.0, reads=None):
     """SA segments of the targets; the healthy recordings' fitted segments (one array per
     recording; the first one's long angle-domain signal too, without its hold-outs); the
-    faulty example (the faulty recording's first segment) and its record's other segments;
+    faulty example (the faulty recording's most typical segment,
+    :func:`~gearshot.estimator.fit_check.typical_segment`) and its record's other segments;
     each healthy recording's hold-outs (its last ``floor(holdout · n)`` segments) as
     (path, SAs).
 
     Every recording is read and segmented before the fit: a file too short for one SA
-    segment (or unreadable) fails now, not after minutes of fitting; ``segmented`` (a dict,
+    segment (or unreadable) fails now, not after minutes of fitting; ``reads`` (a dict,
     optional) keeps each file's segments and checks for the next fit on the same files.
     """
     from ..estimator.fit_check import holdout_count, typical_segment
@@ -135,13 +142,13 @@ def _segments(files, healthy, faulty, kw, holdout=0.0, segmented=None):
 
     def cut(path, role=None, **more):
         key = (_key(path), bool(more.get("long")), tuple(sorted(kw.items())))
-        if segmented is not None and key in segmented:
-            out, found = segmented[key]
+        if reads is not None and key in reads:
+            out, found = reads[key]
         else:
             found = {}
             out = recording_segments(path, health=found, **more, **kw)
-            if segmented is not None:
-                segmented[key] = (out, found)
+            if reads is not None:
+                reads[key] = (out, found)
         health[_key(path)] = found
         if role is not None:   # a recording the fit uses: refused unless every check passes
             for check in (found["recording"], *found["segments"]):
