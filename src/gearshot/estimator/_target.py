@@ -56,8 +56,13 @@ class _TargetSide:
     residue_ms: float
 
 
-def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _TargetSide:
-    """Steps 3 and 5–7 on the target: TF, scale, references, healthy features."""
+def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
+                    recordings: NDArray[Any] | None = None) -> _TargetSide:
+    """Steps 3 and 5–7 on the target: TF, scale, references, healthy features.
+
+    ``recordings`` (the healthy SAs' recording labels, or None): each training SA's
+    step-6 reference is then taken from the *other* recordings only (:func:`cross_run`).
+    """
     tf = target_tf(est, inputs.healthy_long, inputs.n_points)
     scale = steps.rms_scale(inputs.target_healthy, name="target_healthy")
     scaled = steps.normalize_rms(inputs.target_healthy, scale=scale) \
@@ -67,13 +72,41 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...]) -> _Ta
     if est.rms_normalization:  # the unscaled arrays' lags serve (shared_target_work)
         unscaled = steps.split_target_healthy(inputs.target_healthy)
         keep("unscaled references", (references, float(scale)), unscaled[1])
-    sub_h = suppressed_target(train_h, references, est._options().upsample, unscaled)
+    upsample = est._options().upsample
+    if recordings is None:
+        sub_h = suppressed_target(train_h, references, upsample, unscaled)
+    else:
+        sub_h = cross_run(train_h, references, recordings, upsample, unscaled)
     feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
     return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
                        steps.residue_power(sub_h),
                        residue_mean_square(sub_h, est._mesh_orders()))
+
+
+def cross_run(train: FloatArray, references: FloatArray, recordings: NDArray[Any],
+              upsample: int, unscaled: tuple[FloatArray, FloatArray] | None = None
+              ) -> FloatArray:
+    """Step 6 on the training SAs with references of other recordings only.
+
+    A recording estimated later is another run: none of step 6's references comes from
+    it. The target's healthy differences that centre the features and set the noise
+    matched on the simulated side are formed the same way, so that they carry the
+    run-to-run change a new recording brings (a training SA whose recording holds every
+    reference keeps them all). ``recordings`` labels ``train`` then ``references``.
+    """
+    labels = np.asarray(recordings)
+    own, ref_labels = labels[: len(train)], labels[len(train):]
+    out = np.empty_like(train)
+    for group in dict.fromkeys(own.tolist()):
+        rows = np.nonzero(own == group)[0]
+        other = ref_labels != group
+        if not other.any():
+            other = np.ones(len(references), bool)
+        part = None if unscaled is None else (unscaled[0][rows], unscaled[1][other])
+        out[rows] = suppressed_target(train[rows], references[other], upsample, part)
+    return out
 
 
 def target_tf(est: Any, healthy_long: FloatArray | None,

@@ -1,0 +1,81 @@
+"""Healthy recordings of several runs: step 6's target-side differences of the fit are
+formed with references of *other* runs (``gearshot.estimator._target.cross_run``), as a
+new recording's are. Analytic SAs: one gear, each run off by its own synchronous change
+(what a remount, another day's temperature or a slightly other load leaves)."""
+
+from __future__ import annotations
+
+import numpy as np
+from estimator_data import N, paired_synthetic_database, synthetic_sa, tf_pair
+
+from gearshot.estimator import OneFaultShotEstimator
+from gearshot.estimator._target import cross_run
+from gearshot.signal.alignment import subtract_healthy
+from gearshot.transfer import propagate
+
+
+def _run_change(rng: np.random.Generator, size: float) -> np.ndarray:
+    """A run's own synchronous change: random content at orders 1–300, RMS ``size``."""
+    spec = np.zeros(N // 2 + 1, complex)
+    orders = np.arange(1, 301)
+    spec[orders] = rng.normal(size=orders.size) + 1j * rng.normal(size=orders.size)
+    x = np.fft.irfft(spec, n=N)
+    return np.asarray(size * x / x.std())
+
+
+def _runs(n_runs: int, per_run: int, *, seed: int, fault: float = 0.0,
+          run_size: float = 6.0, noise: float = 0.5) -> np.ndarray:
+    """``n_runs`` runs of ``per_run`` SAs of one grade-6 gear (size ``fault``)."""
+    rng = np.random.default_rng(seed)
+    gear = synthetic_sa([fault], 6, np.random.default_rng(7), same_gear=True)[0]
+    return np.array([[gear + change + noise * rng.normal(size=N) for _ in range(per_run)]
+                     for change in (_run_change(rng, run_size) for _ in range(n_runs))])
+
+
+def test_cross_run_subtracts_references_of_other_recordings_only():
+    runs = _runs(3, 3, seed=1)
+    train, refs = runs[:, :2].reshape(-1, N), runs[:, 2]
+    labels = np.r_[np.repeat([0, 1, 2], 2), [0, 1, 2]]
+    out = cross_run(train, refs, labels, upsample=4)
+    for run in range(3):
+        rows = np.nonzero(labels[:6] == run)[0]
+        others = refs[np.arange(3) != run]
+        np.testing.assert_allclose(out[rows], subtract_healthy(train[rows], others,
+                                                               upsample=4))
+    # with its own run's reference allowed, step 6 picks it and hides the run change
+    same_run = subtract_healthy(train, refs, upsample=4)
+    assert (out ** 2).mean() > 10 * (same_run ** 2).mean()
+    # a recording that holds every reference keeps them all
+    solo = cross_run(train[:2], refs[:1], np.r_[0, 0, 0], upsample=4)
+    np.testing.assert_allclose(solo, subtract_healthy(train[:2], refs[:1], upsample=4))
+
+
+def test_new_runs_read_healthy_when_the_fit_differences_cross_runs(monkeypatch):
+    """Fitted on 4 labelled runs, healthy SAs of 6 new runs read near 0 and new runs of
+    the faulty gear near the example's size; with each training SA's own run among its
+    references (the differences then hold the within-run noise only, what
+    :func:`cross_run` replaces) the same new healthy runs read as a half-size fault."""
+    import gearshot.estimator._target as target
+
+    path, held_out = tf_pair()
+    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
+    fit_runs = propagate(_runs(4, 6, seed=2).reshape(-1, N), path)
+    labels = np.repeat(np.arange(4), 6)
+    long = propagate(_runs(1, 40, seed=3).reshape(-1, N), path).ravel()
+    example = propagate(_runs(1, 1, seed=4, fault=0.5)[0, 0], path)
+    new_healthy = propagate(_runs(6, 2, seed=5).reshape(-1, N), path)
+    new_faulty = propagate(_runs(6, 1, seed=6, fault=0.5).reshape(-1, N), path)
+
+    def fit():
+        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0)
+        return est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
+                       healthy_recordings=labels)
+
+    by_run = fit()
+    assert by_run.predict(new_healthy).mean() <= 0.15
+    assert abs(np.median(by_run.predict(new_faulty)) - 0.5) <= 0.2
+    monkeypatch.setattr(target, "cross_run", lambda train, refs, rec, up, unscaled=None:
+                        target.suppressed_target(train, refs, up, unscaled))
+    within_run = fit()
+    assert by_run.target_residue_power_.sum() > 50 * within_run.target_residue_power_.sum()
+    assert within_run.predict(new_healthy).mean() >= 0.3
