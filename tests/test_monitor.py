@@ -64,9 +64,8 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
 
     assert back.database["manifest_sha256"] == hashlib.sha256(manifest).hexdigest()
     # the baseline: the last healthy recording (a quarter of 4) kept out of the fit, and
-    # each of the 3 fit recordings estimated by a fit on the other two: of their 4 x 2
-    # segments, those comparable (baseline_values; at least 2)
-    assert 2 <= len(back.baseline) <= 8 and back.threshold == pytest.approx(m.threshold)
+    # each of the 3 fit recordings estimated by a fit on the other two: 4 x 2 segments
+    assert len(back.baseline) == 8 and back.threshold == pytest.approx(m.threshold)
     from gearshot.monitor import alarm_threshold
 
     assert back.threshold == pytest.approx(alarm_threshold(back.baseline))

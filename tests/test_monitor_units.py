@@ -78,20 +78,6 @@ def test_no_forecast_from_a_flat_trend_or_too_few_points():
         forecast_crossing(DAYS, DAYS / 40, 1.5)
 
 
-def test_baseline_keeps_the_segments_that_could_alarm():
-    """Healthy baseline segments that would be untrusted (not comparable, bad input) do not
-    set the threshold; with fewer than two left, every segment does."""
-    from gearshot.app.monitor import baseline_values
-
-    a = pd.DataFrame({"predicted": [0.02, 0.37, 0.05], "comparable": [True, False, True],
-                      "input_check": ["ok", "ok", "ok"]})
-    b = pd.DataFrame({"predicted": [0.04, 0.30], "comparable": [True, True],
-                      "input_check": ["ok", "constant"]})
-    np.testing.assert_array_equal(baseline_values([a, b]), [0.02, 0.05, 0.04])
-    lone = pd.DataFrame({"predicted": [0.1, 0.3], "comparable": [True, False]})
-    np.testing.assert_array_equal(baseline_values([lone]), [0.1, 0.3])
-
-
 def test_threshold_is_the_normal_quantile_of_the_baseline():
     base = np.array([0.05, 0.10, 0.15, 0.20, 0.10])
     expected = base.mean() + stats.norm.isf(0.01) * base.std(ddof=1)

@@ -98,12 +98,12 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                                      pinion_teeth=pinion_teeth, seed=seed,
                                      recordings=base_files, holdout=0.0,
                                      holdout_files=base_files, reads=reads)
-        baseline = baseline_values([estimate_segments(est, sa, coverage=coverage)
-                                    for _, sa in fitted.targets]
-                                   + _cross_fitted(database, fit_files, faulty, faulty_size,
-                                                   speed=speed, load=load, coverage=coverage,
-                                                   seed=seed, teeth=fitted.teeth,
-                                                   reads=reads))
+        baseline = np.concatenate([estimate_segments(est, sa, coverage=coverage)["predicted"]
+                                   for _, sa in fitted.targets]
+                                  + _cross_fitted(database, fit_files, faulty, faulty_size,
+                                                  speed=speed, load=load, coverage=coverage,
+                                                  seed=seed, teeth=fitted.teeth,
+                                                  reads=reads))
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
@@ -148,23 +148,9 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
                                      load=load, coverage=coverage, seed=seed,
                                      recordings=[path], holdout=0.0, holdout_files=[path],
                                      reads=reads, **teeth)
-        out.append(estimate_segments(est, fitted.targets[0][1], coverage=coverage))
+        out.append(estimate_segments(est, fitted.targets[0][1],
+                                     coverage=coverage)["predicted"].to_numpy())
     return out
-
-
-def baseline_values(frames: Sequence[pd.DataFrame]) -> np.ndarray:
-    """The healthy baseline from the baseline recordings' segment tables: the estimates of
-    the segments a monitored recording could alarm with, i.e. comparable and with sound
-    input (the fit's own check is not asked: a cross-fit's is not the model's); all of
-    them when fewer than 2 are. Untrusted recordings never raise an alarm, so healthy
-    segments that would be untrusted must not raise the threshold either (development
-    lives: such segments read up to 0.37 where the comparable ones stayed below 0.1)."""
-    frame = pd.concat(list(frames), ignore_index=True)
-    ok = frame["comparable"].to_numpy(bool, copy=True)
-    if "input_check" in frame:
-        ok &= frame["input_check"].astype(str).eq("ok").to_numpy(bool)
-    values = frame["predicted"].to_numpy(float)
-    return values[ok] if ok.sum() >= 2 else values
 
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
@@ -184,7 +170,7 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
     if not held:
         raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
                             f"fit; the alarm baseline needs some (raise --holdout)")
-    baseline = baseline_values([estimate_segments(est, np.stack(held), coverage=coverage)])
+    baseline = estimate_segments(est, np.stack(held), coverage=coverage)["predicted"]
     cps = mach.cycles_per_segment if cycles_per_segment is None else cycles_per_segment
     assert cps is not None   # fit_machine refused a machine without one
     condition = {"speed": float(cond.speed), "load": float(cond.load),
