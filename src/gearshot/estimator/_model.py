@@ -317,8 +317,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             estimates must read near ``faulty_size``.
         healthy_recordings : array_like (n_healthy,), optional
             Each ``target_healthy`` SA's recording: from 3 recordings on, step 6's
-            references come from every recording and comparability leaves whole
-            recordings out (run-to-run).
+            references come from every recording, each training SA's difference is
+            taken against the references of the other recordings (as a new recording's
+            is) and comparability leaves whole recordings out (run-to-run).
 
         Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``);
         the hold-outs also calibrate :meth:`predict_interval`.
