@@ -120,6 +120,8 @@ def test_rerun_adds_only_the_new_recordings_and_untrusts_the_load_change(machine
     changed = [r for r, e in zip(second["records"], events, strict=True) if e == "load_change"]
     assert len(changed) == 1 and not changed[0]["trusted"] and not changed[0]["alarm"]
     assert "outside the fitted 10 N m" in again["note"].iloc[events.index("load_change")]
+    # every untrusted recording says why, no trusted one carries a note
+    assert (again["note"].astype(bool) == ~again["trusted"]).all()
 
 
 def test_an_unreadable_recording_is_kept_untrusted_with_its_reason(machine, tmp_path):
@@ -287,3 +289,8 @@ def test_a_gain_other_than_the_fits_is_not_comparable_a_new_run_is(machine, tmp_
         rows = estimate_segments(est, scaled)
         assert rows["input_check"].eq("ok").all(), gain
         assert not rows["comparable"].any() and not rows["trusted"].any(), gain
+        from gearshot.monitor.trust import untrusted_reason
+
+        assert "not comparable with the fitted machine" in untrusted_reason(rows), gain
+    # this fit keeps no hold-out: every estimate says its fit is unchecked
+    assert untrusted_reason(same).startswith("fit check: unchecked")

@@ -177,3 +177,24 @@ def test_rig_growth_laws_start_at_the_onset_and_end_at_the_end_size(law):
     assert np.all(np.diff(y[life >= 0.3]) > 0)
     with pytest.raises(GearshotError, match="law"):
         growth_size(life, onset=0.3, end_size=0.8, law="cubic")
+
+
+def test_untrusted_reason_names_every_failed_check():
+    from gearshot.monitor.trust import untrusted_reason
+
+    ok = pd.DataFrame({"input_check": ["ok"] * 3, "comparable": [True] * 3,
+                       "fit_check": ["passed"] * 3, "trusted": [True] * 3})
+    assert untrusted_reason(ok) == ""
+    failed = ok.assign(fit_check="healthy hold-outs read 0.23 on average (limit 0.15)",
+                       trusted=False)
+    assert untrusted_reason(failed) == ("fit check: healthy hold-outs read 0.23 on average "
+                                        "(limit 0.15)")
+    dead = ok.assign(input_check=["ok", "constant", "constant"], trusted=[True, False, False])
+    assert untrusted_reason(dead) == "input check: 2 of 3 segments (constant)"
+    both = dead.assign(comparable=[True, False, False], fit_check=failed["fit_check"])
+    assert untrusted_reason(both).split("; ")[0].startswith("fit check: healthy hold-outs")
+    assert "2 of 3 segments not comparable" in untrusted_reason(both).split("; ")[2]
+    other = ok.assign(comparable=[False, False, True], trusted=[False, False, True])
+    assert untrusted_reason(other).startswith("2 of 3 segments not comparable")
+    half = ok.iloc[:2].assign(comparable=[True, False], trusted=[True, False])
+    assert untrusted_reason(half).startswith("1 of 2 segments not comparable")

@@ -219,6 +219,7 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
         condition, is kept, untrusted, with the reason in ``note``.
     """
     from ..monitor import combine_segments
+    from ..monitor.trust import untrusted_reason
     from .predict import estimate_segments
 
     machine = model.machine
@@ -232,6 +233,7 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
             sa, note = _segments_of(model, Path(rec.recording), machine)
             frame = estimate_segments(model.estimator, sa, coverage=model.coverage)
             row.update(combine_segments(frame))
+            note = note or _condition_note(model, rec) or untrusted_reason(frame)
         except GearshotError as exc:
             row.update(predicted=np.nan, low=np.nan, high=np.nan, segments=0,
                        trusted_segments=0, trusted=False)
@@ -361,7 +363,8 @@ def format_monitor(payload: dict) -> str:
         else:
             lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
                          f"[{last['low']:.3f}, {last['high']:.3f}]"
-                         + ("" if last["trusted"] else " (untrusted)"))
+                         + ("" if last["trusted"] else
+                            f" (untrusted: {last.get('note') or 'see the history'})"))
     lines.append(f"alarm (threshold {al['threshold']:.3f}): "
                  + (f"raised {al['first_time']}" + (", active" if al["active"] else
                                                       ", cleared since")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = ["row_trust", "recording_trust", "MIN_TRUSTED_SHARE"]
+__all__ = ["untrusted_reason", "row_trust", "recording_trust", "MIN_TRUSTED_SHARE"]
 
 #: Share of a recording's segments that must be trusted for the recording to be: more
 #: than this (a strict majority; a 2-segment recording needs both). Chosen on the
@@ -46,6 +46,35 @@ def row_trust(frame: pd.DataFrame) -> np.ndarray:
     if "input_check" in frame:
         ok &= np.asarray(frame["input_check"].astype(str) == "ok", dtype=bool)
     return ok
+
+
+def untrusted_reason(frame: pd.DataFrame) -> str:
+    """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
+    is): each check that fails, joined by "; " -- the fit's own check, the input and
+    speed checks, the segments not comparable with the fitted machine."""
+    if recording_trust(frame):
+        return ""
+    n, parts = len(frame), []
+    verdict = frame["fit_check"].astype(str) if "fit_check" in frame else None
+    if verdict is not None and n and (verdict != "passed").all():
+        parts.append(f"fit check: {verdict.iloc[0]}")
+    for check in ("input_check", "speed_check"):
+        if check in frame:
+            bad = frame[check].astype(str)
+            bad = bad[bad != "ok"]
+            if len(bad):
+                parts.append(f"{check.replace('_', ' ')}: {len(bad)} of {n} segments "
+                             f"({bad.iloc[0]})")
+    if "comparable" in frame:
+        off = int((~frame["comparable"].astype(bool)).sum())
+        if off:
+            parts.append(f"{off} of {n} segments not comparable with the fitted machine "
+                         f"(another load, speed, sensor or path, or a fault beyond the "
+                         f"example's)")
+    if not parts:
+        parts.append(f"{int(row_trust(frame).sum())} of {n} segments trusted (more than "
+                     f"half needed)")
+    return "; ".join(parts)
 
 
 def recording_trust(frame: pd.DataFrame) -> bool:
