@@ -32,6 +32,7 @@ def test_version():
         (["report", "/nonexistent/results.json"], ["results.json", "does not exist"]),
         (["rig", "/tmp/x", "--frf-folder", "/nonexistent/frfs"], ["--frf-folder"]),
         (["rig", "/tmp/x", "--rig-grade", "13"], ["--rig-grade", "13"]),
+        (["rig", "/tmp/x", "--variation", "0.5"], ["--variation", "0.5"]),
         (["experiment", "simulated", "--frf-folder", "/nonexistent"], ["--frf-folder"]),
         (["predict", "--database", "/nonexistent/db", "--healthy", "/nonexistent/h.h5",
           "--faulty", "/nonexistent/f.h5", "--faulty-size", "0.5", "--recordings", "/tmp",

@@ -165,6 +165,10 @@ def rig(
     frf_folder: Path | None = typer.Option(None, "--frf-folder", help="Measured FRFs "
                                               "for the transfer path (default synthetic)."),
     rig_grade: RigGrade = None,
+    variation: float = typer.Option(0.0, "--variation", help="Run-to-run spread of speed and "
+                                    "load (relative, 0 … 0.1): each recording on its own "
+                                    "run, as a monitored machine's days are (0.01 in "
+                                    "VirtualRig.history); 0: one run, as in the paper."),
 ) -> None:
     """Record a virtual-rig campaign (Table 1 of the paper) into a folder."""
     from ..campaigns import check_rig_grade, make_rig
@@ -176,8 +180,10 @@ def rig(
     check_count(healthy, "--healthy")
     check_count(repetitions, "--repetitions")
     check_seed(seed)
+    if not 0.0 <= variation <= 0.1:
+        raise GearshotError(f"--variation must lie in 0 … 0.1; got {variation}")
     early(folder, "FOLDER", folder=True)
     index = make_rig(seed, frf_folder, rig_grade).campaign(
         folder, speed=speed, load=load, duration=duration, healthy=healthy,
-        sizes=tuple(size), repetitions=repetitions)
+        sizes=tuple(size), repetitions=repetitions, variation=variation)
     typer.echo(f"{len(index)} recordings written to {folder}")
