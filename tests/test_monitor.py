@@ -183,7 +183,9 @@ def test_monitor_adds_only_the_new_then_reestimates_after_a_refit(machine, tmp_p
     assert cli(*watch).stdout.count("0 new recording(s)") == 1
     rep = cli("report", tmp_path / "out.json", "--out", tmp_path / "rep")
     assert rep.returncode == 0, rep.stderr
-    assert "Alarm threshold" in (tmp_path / "rep" / "report.md").read_text()
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert "Alarm threshold" in report
+    assert "outside the fitted 10 N m" in report   # an untrusted recording's reason
     assert (tmp_path / "rep" / "trend.png").stat().st_size > 0
 
 

@@ -198,3 +198,25 @@ def test_untrusted_reason_names_every_failed_check():
     assert untrusted_reason(other).startswith("2 of 3 segments not comparable")
     half = ok.iloc[:2].assign(comparable=[True, False], trusted=[True, False])
     assert untrusted_reason(half).startswith("1 of 2 segments not comparable")
+
+
+def test_monitor_report_lists_why_recordings_are_untrusted(tmp_path):
+    from gearshot.app.monitor_report import monitor_report
+
+    t0 = pd.Timestamp("2026-01-01")
+    records = [{"recording": f"/x/life_{i:03d}.h5",
+                "time": (t0 + pd.Timedelta(days=i)).isoformat(),
+                "predicted": 0.02 * i, "low": 0.0, "high": 0.02 * i + 0.2, "trusted": i != 3,
+                "alarm": False, "model": "abc", "calibration": "one_fault_shot",
+                "segments": 2, "trusted_segments": 2 if i != 3 else 0,
+                "note": "" if i != 3 else "2 of 2 segments not comparable with the fitted "
+                                          "machine"} for i in range(6)]
+    payload = {"kind": "monitor", "model": {"description": "a model"},
+               "calibration": "one_fault_shot", "records": records,
+               "alarm": {"threshold": 0.3, "first_time": None, "active": False},
+               "forecast": {"limit": 0.6, "time": None, "low": None, "high": None,
+                            "law": None, "reason": "flat trend"}}
+    text = monitor_report(payload, tmp_path / "rep", tmp_path / "life.json").read_text()
+    header = text.splitlines()[text.splitlines().index("## Latest recordings") + 2]
+    assert header.rstrip().endswith("| alarm | note |")
+    assert "2 of 2 segments not comparable with the fitted machine" in text

@@ -78,5 +78,7 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
         last = recs.tail(20).copy()
         last["recording"] = [Path(r).name for r in last["recording"]]
         cols = ["recording", "time", "predicted", "low", "high", "trusted", "alarm"]
+        if "note" in last:   # why an untrusted recording is untrusted
+            cols.append("note")
         lines += ["## Latest recordings", "", *md_table(last[cols])]
     return write_markdown(out, lines)
