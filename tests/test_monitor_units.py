@@ -220,3 +220,28 @@ def test_monitor_report_lists_why_recordings_are_untrusted(tmp_path):
     header = text.splitlines()[text.splitlines().index("## Latest recordings") + 2]
     assert header.rstrip().endswith("| alarm | note |")
     assert "2 of 2 segments not comparable with the fitted machine" in text
+
+
+def test_untrusted_counts_group_the_reasons_and_monitor_prints_them():
+    from gearshot.app.monitor import format_monitor
+    from gearshot.monitor.trust import untrusted_counts
+
+    notes = ["2 of 2 segments not comparable with the fitted machine (another load ...)",
+             "index load 5 N m is outside the fitted 10 N m", "",
+             "fit check: healthy hold-outs read 0.23 on average (limit 0.15); 1 of 2 "
+             "segments not comparable with the fitted machine (...)",
+             "not estimated: 'x.h5' holds 3 revolution(s)"]
+    assert untrusted_counts(notes) == {
+        "not comparable with the fitted machine": 2,
+        "outside the fitted condition (index speed or load)": 1, "fit check failed": 1,
+        "not estimated (unreadable or too short)": 1}
+    records = [{"recording": "a.h5", "time": "2026-01-01T00:00:00", "predicted": 0.1,
+                "low": 0.0, "high": 0.3, "trusted": False, "alarm": False, "note": n}
+               for n in notes[:2]]
+    payload = {"model": {"description": "a model"}, "records": records, "new": 2,
+               "calibration": "one_fault_shot",
+               "alarm": {"threshold": 0.2, "first_time": None, "active": False},
+               "forecast": {"limit": 0.6, "time": None, "reason": "too few trusted recordings"}}
+    text = format_monitor(payload)
+    assert ("untrusted: 1 not comparable with the fitted machine; 1 outside the fitted "
+            "condition (index speed or load)") in text

@@ -349,13 +349,19 @@ def write_monitor_outputs(payload: dict, *, json_out: Path | None = None,
 
 
 def format_monitor(payload: dict) -> str:
-    """What ``gearshot monitor`` prints: the model, the counts, the alarm, the forecast."""
+    """What ``gearshot monitor`` prints: the model, the counts (and why recordings are
+    untrusted), the alarm, the forecast."""
+    from ..monitor.trust import untrusted_counts
+
     recs = payload["records"]
     n_ok = sum(r["trusted"] for r in recs)
     al, fc = payload["alarm"], payload["forecast"]
     lines = [payload["model"]["description"],
              f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
              f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
+    why = untrusted_counts(r.get("note") for r in recs if not r["trusted"])
+    if why:
+        lines.append("untrusted: " + "; ".join(f"{n} {k}" for k, n in why.items()))
     if recs:
         last = recs[-1]
         if last["predicted"] is None:

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = ["untrusted_reason", "row_trust", "recording_trust", "MIN_TRUSTED_SHARE"]
+__all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
+           "MIN_TRUSTED_SHARE"]
 
 #: Share of a recording's segments that must be trusted for the recording to be: more
 #: than this (a strict majority; a 2-segment recording needs both). Chosen on the
@@ -82,3 +83,23 @@ def recording_trust(frame: pd.DataFrame) -> bool:
     :data:`MIN_TRUSTED_SHARE` of its segments are (:func:`row_trust`)."""
     trust = row_trust(frame)
     return bool(trust.size and trust.mean() > MIN_TRUSTED_SHARE)
+
+
+def untrusted_counts(notes) -> dict[str, int]:
+    """How many untrusted recordings fail each kind of check, from their notes (the
+    ``note`` of :func:`untrusted_reason` or of the monitor's condition and read checks),
+    most frequent first; a recording failing several counts under each."""
+    kinds = {"fit check": "fit check failed", "input check": "input check failed",
+             "speed check": "speed check failed",
+             "not comparable": "not comparable with the fitted machine",
+             "outside the fitted": "outside the fitted condition (index speed or load)",
+             "not estimated": "not estimated (unreadable or too short)"}
+    counts: dict[str, int] = {}
+    for note in notes:
+        text = str(note or "")
+        if not text:
+            continue
+        found = [label for key, label in kinds.items() if key in text] or ["other"]
+        for label in found:
+            counts[label] = counts.get(label, 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
