@@ -8,6 +8,7 @@ from typing import Any
 import typer
 
 from ..._errors import GearshotError
+from ..._validation import check_in_range
 from ...fault_registry import FAULT_TYPE_NAMES
 from ...paper import (
     RIG_DURATION,
@@ -180,8 +181,7 @@ def rig(
     check_count(healthy, "--healthy")
     check_count(repetitions, "--repetitions")
     check_seed(seed)
-    if not 0.0 <= variation <= 0.1:
-        raise GearshotError(f"--variation must lie in 0 … 0.1; got {variation}")
+    check_in_range(variation, "--variation", 0.0, 0.1)
     early(folder, "FOLDER", folder=True)
     index = make_rig(seed, frf_folder, rig_grade).campaign(
         folder, speed=speed, load=load, duration=duration, healthy=healthy,
