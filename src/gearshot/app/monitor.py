@@ -238,7 +238,6 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
             row.update(predicted=np.nan, low=np.nan, high=np.nan, segments=0,
                        trusted_segments=0, trusted=False)
             note = f"not estimated: {exc}"
-        note = note or _condition_note(model, rec)
         if note:
             row["trusted"] = False
         row["note"] = note
