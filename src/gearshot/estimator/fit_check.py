@@ -39,7 +39,7 @@ from .._validation import as_signal_array, check_in_range
 __all__ = ["FitCheck", "Holdouts", "check_fit", "check_holdouts", "holdout_count",
            "split_holdouts",
            "trusted_column", "TRUST_COLUMNS", "HEALTHY_LIMIT", "EXAMPLE_LIMIT",
-           "MIN_HOLDOUTS", "PASSED"]
+           "MIN_HOLDOUTS", "PASSED", "LABEL_CHECKS"]
 
 #: Largest mean estimate of the healthy hold-outs of a passing fit (fault-size units).
 HEALTHY_LIMIT = 0.15
@@ -314,6 +314,11 @@ TRUST_COLUMNS = ("predicted", "low", "high", "comparability", "comparable", "inp
                  "fit_check", "trusted")
 
 
+#: The predict-table columns that hold "ok" or the failed check's label (besides
+#: ``comparable`` and ``fit_check``): what :func:`trusted_column` requires to be "ok".
+LABEL_CHECKS = ("input_check", "speed_check")
+
+
 def trusted_column(frame: Any) -> Any:
     """The ``trusted`` column of a predict table: ``input_check == "ok"`` and
     ``speed_check == "ok"`` (a table without either column counts as "ok"),
@@ -322,9 +327,9 @@ def trusted_column(frame: Any) -> Any:
     import pandas as pd
 
     ok = pd.Series(True, index=frame.index)
-    for check in ("input_check", "speed_check"):
+    for check in LABEL_CHECKS:
         if check in frame:
             ok &= frame[check].astype(str) == "ok"
     ok &= frame["comparable"].astype(bool) if "comparable" in frame else False
-    ok &= (frame["fit_check"].astype(str) == "passed") if "fit_check" in frame else False
+    ok &= (frame["fit_check"].astype(str) == PASSED) if "fit_check" in frame else False
     return ok.astype(bool)

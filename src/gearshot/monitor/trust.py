@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..estimator.fit_check import LABEL_CHECKS, PASSED
+
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
            "MIN_TRUSTED_SHARE"]
 
@@ -51,15 +53,16 @@ def row_trust(frame: pd.DataFrame) -> np.ndarray:
 
 def untrusted_reason(frame: pd.DataFrame) -> str:
     """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
-    is): each check that fails, joined by "; " -- the fit's own check, the input and
-    speed checks, the segments not comparable with the fitted machine."""
+    is): each check that fails, joined by "; " -- the fit's own check, the label checks
+    that :func:`gearshot.estimator.fit_check.trusted_column` requires (input, speed), the
+    segments not comparable with the fitted machine."""
     if recording_trust(frame):
         return ""
     n, parts = len(frame), []
     verdict = frame["fit_check"].astype(str) if "fit_check" in frame else None
-    if verdict is not None and n and (verdict != "passed").all():
+    if verdict is not None and n and (verdict != PASSED).all():
         parts.append(f"fit check: {verdict.iloc[0]}")
-    for check in ("input_check", "speed_check"):
+    for check in LABEL_CHECKS:
         if check in frame:
             bad = frame[check].astype(str)
             bad = bad[bad != "ok"]
