@@ -51,6 +51,11 @@ def row_trust(frame: pd.DataFrame) -> np.ndarray:
     return ok
 
 
+#: How :func:`untrusted_reason` names the segments that comparability flags (what
+#: :func:`untrusted_counts` finds again in a note).
+NOT_COMPARABLE = "not comparable with the fitted machine"
+
+
 def untrusted_reason(frame: pd.DataFrame) -> str:
     """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
     is): each check that fails, joined by "; " -- the fit's own check, the label checks
@@ -72,9 +77,8 @@ def untrusted_reason(frame: pd.DataFrame) -> str:
     if "comparable" in frame:
         off = int((~frame["comparable"].astype(bool)).sum())
         if off:
-            parts.append(f"{off} of {n} segments not comparable with the fitted machine "
-                         f"(another load, speed, sensor or path, or a fault beyond the "
-                         f"example's)")
+            parts.append(f"{off} of {n} segments {NOT_COMPARABLE} (another load, speed, "
+                         f"sensor or path, or a fault beyond the example's)")
     if not parts:
         parts.append(f"{int(row_trust(frame).sum())} of {n} segments trusted (more than "
                      f"half needed)")
@@ -92,9 +96,9 @@ def untrusted_counts(notes) -> dict[str, int]:
     """How many untrusted recordings fail each kind of check, from their notes (the
     ``note`` of :func:`untrusted_reason` or of the monitor's condition and read checks),
     most frequent first; a recording failing several counts under each."""
-    kinds = {"fit check": "fit check failed", "input check": "input check failed",
-             "speed check": "speed check failed",
-             "not comparable": "not comparable with the fitted machine",
+    kinds = {"fit check": "fit check failed",
+             **{c.replace("_", " "): f"{c.replace('_', ' ')} failed" for c in LABEL_CHECKS},
+             NOT_COMPARABLE: NOT_COMPARABLE,
              "outside the fitted": "outside the fitted condition (index speed or load)",
              "not estimated": "not estimated (unreadable or too short)"}
     counts: dict[str, int] = {}
