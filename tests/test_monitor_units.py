@@ -61,11 +61,48 @@ def test_exponential_law_is_recovered_and_forecast_from_noisy_points():
     assert fc.low <= true_time <= fc.high
 
 
-def test_forecast_is_reproducible_with_its_seed():
+def test_forecast_is_deterministic_and_weighs_the_laws():
     rng = np.random.default_rng(1)
     y = _hinge(DAYS, 15.0, "power", 0.4, 2.0) + 0.02 * rng.standard_normal(DAYS.size)
     a, b = forecast_crossing(DAYS, y, 0.6), forecast_crossing(DAYS, y, 0.6)
     assert (a.time, a.low, a.high) == (b.time, b.low, b.high)
+    assert set(a.law_weights) == {"linear", "exponential", "power"}
+    assert sum(a.law_weights.values()) == pytest.approx(1.0)
+    assert a.law == max(a.law_weights, key=a.law_weights.get) and a.fit.law == a.law
+    assert a.low < a.time < a.high
+
+
+def _noisy_lives(n_lives, noise, seed):
+    """Lives like the rig's (40 recordings, healthy, then growth to 0.8) under four laws
+    and three onsets, read with normal noise: (times, sizes, true crossing of 0.6)."""
+    rng = np.random.default_rng(seed)
+    laws = [("power", dict(exponent=1.5)), ("power", dict(exponent=2.0)),
+            ("linear", {}), ("exponential", dict(rate=3.0))]
+    for i in range(n_lives):
+        law, shape = laws[i % 4]
+        onset = (0.2, 0.3, 0.4)[(i // 4) % 3]
+        days = DAYS + rng.uniform(-0.1, 0.1, DAYS.size)
+        days -= days[0]
+        truth = growth_size(days / days[-1], onset=onset, end_size=0.8, law=law, **shape)
+        first = np.nonzero(truth >= 0.6)[0][0]
+        crossing = np.interp(0.6, truth[first - 1:first + 1], days[first - 1:first + 1])
+        yield days, truth + noise * rng.standard_normal(DAYS.size), crossing
+
+
+def test_forecast_interval_holds_the_true_crossing_at_its_coverage():
+    """From the first 70 % of noisy lives, the 90 % interval holds the true crossing of
+    0.6 in most lives. The single best fit's parametric bootstrap this replaced held it in
+    under half of such lives (30/96 and 16/96 at noise 0.03 and 0.06, benchmarks/
+    RESULTS.md): a late onset with a steep law fits a noisy history about as well as an
+    early onset with a gentle one, and both must stay in the interval."""
+    held = made = 0
+    for days, sizes, crossing in _noisy_lives(36, 0.04, seed=5):
+        fc = forecast_crossing(days[:28], sizes[:28], 0.6)
+        if fc.time is not None:
+            made += 1
+            held += fc.low <= crossing <= fc.high
+    assert made >= 34
+    assert held >= 0.8 * made
 
 
 def test_no_forecast_from_a_flat_trend_or_too_few_points():

@@ -273,7 +273,7 @@ def _estimate_chunk(model_path: str, chunk: pd.DataFrame) -> pd.DataFrame:
 
 
 def monitor_history(model: str | Path, index: str | Path, history: str | Path, *,
-                    limit: float = 0.6, client: Any = None, seed: int = 0) -> dict:
+                    limit: float = 0.6, client: Any = None) -> dict:
     """Estimate the recordings of ``index`` that ``history`` holds no estimate of by this
     model, append them (atomically) and return the ``--json`` payload.
 
@@ -308,22 +308,22 @@ def monitor_history(model: str | Path, index: str | Path, history: str | Path, *
                                  [todo.iloc[c] for c in chunks], pure=False)
             rows = pd.concat(client.gather(futures), ignore_index=True)
         past = append_history(history, rows)
-    payload = monitor_payload(past, mdl, limit=limit, seed=seed)
+    payload = monitor_payload(past, mdl, limit=limit)
     payload["new"] = int(len(todo))
     payload["history"] = str(Path(history))
     return payload
 
 
 def monitor_fleet(jobs: Sequence[tuple[str | Path, str | Path, str | Path]], *,
-                  limit: float = 0.6, scheduler: str | None = None, workers: int = 2,
-                  seed: int = 0) -> list[dict]:
+                  limit: float = 0.6, scheduler: str | None = None,
+                  workers: int = 2) -> list[dict]:
     """:func:`monitor_history` for many machines, ``(model, index, history)`` each, the
     new recordings of all of them estimated on one Dask cluster (``scheduler``, or a
     LocalCluster of ``workers``; in-process with one worker)."""
     from .._cluster import dask_client
 
     with dask_client(scheduler, workers, needed=True) as client:
-        return [monitor_history(m, i, h, limit=limit, client=client, seed=seed)
+        return [monitor_history(m, i, h, limit=limit, client=client)
                 for m, i, h in jobs]
 
 

@@ -46,8 +46,7 @@ def _iso(value) -> str | None:
     return None if value is None else pd.Timestamp(value).isoformat()
 
 
-def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMIT,
-                    seed: int = 0) -> dict:
+def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMIT) -> dict:
     """The ``gearshot monitor --json`` payload (module docstring).
 
     Parameters
@@ -58,8 +57,6 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
         The model in use (saved: its digest names its estimates).
     limit : float
         Size whose crossing is forecast.
-    seed : int
-        Of the forecast's bootstrap.
     """
     digest = model.digest
     rows = current_records(history, digest)
@@ -77,7 +74,7 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
     ok = rows["trusted"].to_numpy(bool)
     t0 = rows["time"].iloc[0] if len(rows) else pd.Timestamp(0)
     days = ((rows["time"] - t0) / _DAY).to_numpy(float)
-    fc = forecast_crossing(days[ok], rows["predicted"].to_numpy(float)[ok], limit, seed=seed)
+    fc = forecast_crossing(days[ok], rows["predicted"].to_numpy(float)[ok], limit)
 
     def when(d):
         return None if d is None or not np.isfinite(d) else _iso(t0 + d * _DAY)
@@ -88,6 +85,7 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
         forecast["fit"] = {"onset": when(fc.fit.onset), "level": fc.fit.level,
                            "amplitude": fc.fit.amplitude, "shape": fc.fit.shape,
                            "sigma": fc.fit.sigma, "days_from": _iso(t0)}
+        forecast["law_weights"] = fc.law_weights
     earlier = history[history["model"] != digest]
     return {
         "kind": "monitor",
