@@ -282,3 +282,39 @@ def test_untrusted_counts_group_the_reasons_and_monitor_prints_them():
     text = format_monitor(payload)
     assert ("untrusted: 1 not comparable with the fitted machine; 1 outside the fitted "
             "condition (index speed or load)") in text
+
+
+def test_payload_forecast_states_its_fit_span_and_law_weights():
+    """The forecast's fit in the payload carries its own span (onset to the last trusted
+    recording: trailing untrusted recordings must not stretch the drawn law), the laws'
+    weights, and gearshot monitor prints both."""
+    from types import SimpleNamespace
+
+    from gearshot.app.monitor import format_monitor
+    from gearshot.monitor import monitor_payload
+
+    rng = np.random.default_rng(4)
+    sizes = _hinge(DAYS, 12.0, "power", 0.45, 1.5, level=0.01)
+    sizes = np.clip(sizes + 0.02 * rng.standard_normal(DAYS.size), 0, None)
+    trusted = DAYS < 30  # the last 10 recordings untrusted (e.g. a remounted sensor)
+    t0 = pd.Timestamp("2026-01-01")
+    history = pd.DataFrame({
+        "recording": [f"life_{i:03d}.h5" for i in range(DAYS.size)],
+        "time": [t0 + pd.Timedelta(days=float(d)) for d in DAYS], "predicted": sizes,
+        "low": sizes - 0.1, "high": sizes + 0.1, "segments": 4, "trusted_segments": 4,
+        "trusted": trusted, "model": "abc", "calibration": "one_fault_shot",
+        "estimated_at": t0, "note": ""})
+    model = SimpleNamespace(digest="abc", threshold=0.15, sustain=2, calibration="one_fault_shot",
+                            describe=lambda: "a model", database={}, fit_check="passed",
+                            condition={}, false_alarm_rate=0.01)
+    fc = monitor_payload(history, model, limit=0.6)["forecast"]
+    assert fc["time"] is not None and fc["reason"] is None
+    onset = (pd.Timestamp(fc["fit"]["onset"]) - t0) / pd.Timedelta(days=1)
+    assert fc["fit"]["span"] == pytest.approx(29.0 - onset)
+    assert sum(fc["law_weights"].values()) == pytest.approx(1.0)
+    payload = {"model": {"description": "a model"}, "records": [], "new": 0,
+               "calibration": "one_fault_shot",
+               "alarm": {"threshold": 0.15, "first_time": None, "active": False},
+               "forecast": fc}
+    line = format_monitor(payload).splitlines()[-1]
+    assert f"{fc['law']} law, " in line and "of the weight" in line and "90 % interval" in line

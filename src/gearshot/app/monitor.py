@@ -375,8 +375,11 @@ def format_monitor(payload: dict) -> str:
                                                       ", cleared since")
                     if al["first_time"] else "not raised"))
     if fc["time"]:
-        lines.append(f"forecast ({fc['law']} law): size {fc['limit']:g} reached {fc['time']} "
-                     f"(interval {fc['low']} … {fc['high']})")
+        share = (fc.get("law_weights") or {}).get(fc["law"])
+        law = fc["law"] + (" law" if share is None else f" law, {share:.0%} of the weight")
+        high = fc["high"] or "open (part of the weight never reaches it)"
+        lines.append(f"forecast ({law}): size {fc['limit']:g} reached {fc['time']} "
+                     f"(90 % interval {fc['low']} … {high})")
     else:
         lines.append(f"no forecast of size {fc['limit']:g}: {fc['reason']}")
     if payload["calibration"] == "zero_shot":

@@ -83,13 +83,15 @@ def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> None:
             latest = pd.to_datetime(recs["time"], format="ISO8601").max()
             end = (max(hi, latest) - t0) / pd.Timedelta(days=1)
             days = np.linspace(0, end, 200)
-            last = (latest - t0) / pd.Timedelta(days=1)
-            s = np.maximum(days - onset, 0) / max(last - onset, 1e-9)
+            # the law's own span (onset to its last trusted recording); older payloads
+            # without it: up to the latest recording
+            span = fit.get("span") or (latest - t0) / pd.Timedelta(days=1) - onset
+            s = np.maximum(days - onset, 0) / max(span, 1e-9)
             law, shape = fc["law"], fit["shape"]
             g = s if law == "linear" else np.expm1(shape * s) if law == "exponential" \
                 else s ** shape
             ax.plot(t0 + pd.to_timedelta(days, unit="D"), fit["level"] + fit["amplitude"] * g,
-                    color="tab:red", lw=1, alpha=0.7, label="fitted growth law")
+                    color="tab:red", lw=1, alpha=0.7, label=f"best {law} fit")
     else:
         ax.text(0.01, 0.97, f"no forecast: {fc.get('reason')}", transform=ax.transAxes,
                 va="top", fontsize=8)

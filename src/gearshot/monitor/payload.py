@@ -84,7 +84,8 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
     if fc.fit is not None:
         forecast["fit"] = {"onset": when(fc.fit.onset), "level": fc.fit.level,
                            "amplitude": fc.fit.amplitude, "shape": fc.fit.shape,
-                           "sigma": fc.fit.sigma, "days_from": _iso(t0)}
+                           "span": fc.fit.span, "sigma": fc.fit.sigma,
+                           "days_from": _iso(t0)}
         forecast["law_weights"] = fc.law_weights
     earlier = history[history["model"] != digest]
     return {
