@@ -350,6 +350,7 @@ def write_monitor_outputs(payload: dict, *, json_out: Path | None = None,
 def format_monitor(payload: dict) -> str:
     """What ``gearshot monitor`` prints: the model, the counts (and why recordings are
     untrusted), the alarm, the forecast."""
+    from ..monitor.payload import describe_forecast
     from ..monitor.trust import untrusted_counts
 
     recs = payload["records"]
@@ -374,14 +375,7 @@ def format_monitor(payload: dict) -> str:
                  + (f"raised {al['first_time']}" + (", active" if al["active"] else
                                                       ", cleared since")
                     if al["first_time"] else "not raised"))
-    if fc["time"]:
-        share = (fc.get("law_weights") or {}).get(fc["law"])
-        law = fc["law"] + (" law" if share is None else f" law, {share:.0%} of the weight")
-        high = fc["high"] or "open (part of the weight never reaches it)"
-        lines.append(f"forecast ({law}): size {fc['limit']:g} reached {fc['time']} "
-                     f"(90 % interval {fc['low']} … {high})")
-    else:
-        lines.append(f"no forecast of size {fc['limit']:g}: {fc['reason']}")
+    lines.append(describe_forecast(fc))
     if payload["calibration"] == "zero_shot":
         lines.append("zero-shot model: sizes are from healthy data and simulation alone; "
                      "refit with an inspected recording (gearshot fit --faulty … "

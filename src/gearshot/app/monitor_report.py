@@ -51,6 +51,7 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
     """Write ``trend.png``, ``report.md`` and ``report.html`` (model, alarm, forecast, the
     latest records) into ``out``; returns the Markdown's path."""
     from ..monitor.figure import trend_figure
+    from ..monitor.payload import describe_forecast
 
     out = Path(out)
     trend_figure(payload, out / "trend.png")
@@ -68,11 +69,8 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
               f"Alarm threshold {al['threshold']:.3f}: "
               + (f"first raised {al['first_time']}." if al["first_time"] else "not raised."),
               ""]
-    if fc.get("time"):
-        lines += [f"Forecast ({fc['law']} law): size {fc['limit']:g} reached {fc['time']} "
-                  f"(interval {fc['low']} … {fc['high']}).", ""]
-    else:
-        lines += [f"No forecast of size {fc['limit']:g}: {fc.get('reason')}.", ""]
+    sentence = describe_forecast(fc)
+    lines += [sentence[0].upper() + sentence[1:] + ".", ""]
     lines += ["![trend](trend.png)", ""]
     if len(recs):
         last = recs.tail(20).copy()

@@ -17,7 +17,7 @@ import pandas as pd
 from .alarm import alarm_states
 from .forecast import forecast_crossing
 
-__all__ = ["monitor_payload", "current_records", "DEFAULT_LIMIT"]
+__all__ = ["monitor_payload", "current_records", "describe_forecast", "DEFAULT_LIMIT"]
 
 DEFAULT_LIMIT = 0.6
 _DAY = pd.Timedelta(days=1)
@@ -106,3 +106,14 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
              "model": r.model, "calibration": r.calibration}
             for r in earlier.itertuples(index=False)],
     }
+
+
+def describe_forecast(forecast: dict) -> str:
+    """The payload's forecast in one sentence (``gearshot monitor`` and its report)."""
+    if not forecast.get("time"):
+        return f"no forecast of size {forecast['limit']:g}: {forecast.get('reason')}"
+    share = (forecast.get("law_weights") or {}).get(forecast["law"])
+    law = forecast["law"] + (" law" if share is None else f" law, {share:.0%} of the weight")
+    high = forecast.get("high") or "open (part of the weight never reaches it)"
+    return (f"forecast ({law}): size {forecast['limit']:g} reached {forecast['time']} "
+            f"(90 % interval {forecast.get('low')} … {high})")
