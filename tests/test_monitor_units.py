@@ -318,3 +318,37 @@ def test_payload_forecast_states_its_fit_span_and_law_weights():
                "forecast": fc}
     line = format_monitor(payload).splitlines()[-1]
     assert f"{fc['law']} law, " in line and "of the weight" in line and "90 % interval" in line
+
+
+def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path):
+    """A machine whose latest recordings in a row are not comparable with its fit (a
+    changed load or sensor mount, or a fault beyond the example's) raises no alarm, so
+    the monitor says so in a notice; other reasons and shorter runs do not."""
+    from gearshot.app.monitor import format_monitor
+    from gearshot.app.monitor_report import monitor_report
+    from gearshot.monitor.trust import CHANGE_RUN, NOT_COMPARABLE, change_notice
+
+    off = f"2 of 2 segments {NOT_COMPARABLE} (another load, ...)"
+    times = [f"2026-01-{d:02d}T00:00:00" for d in range(1, 7)]
+    trusted = [True, True, False, False, False, False]
+    notes = ["", "", "index load 5 N m is outside the fitted 10 N m", off, off, off]
+    notice = change_notice(times, trusted, notes)
+    assert CHANGE_RUN == 3 and notice["recordings"] == 3 and notice["since"] == times[3]
+    assert NOT_COMPARABLE in notice["message"] and times[3] in notice["message"]
+    assert change_notice(times, trusted[:-1] + [True], notes) is None   # back to normal
+    assert change_notice(times[:5], trusted[:5], notes[:5]) is None     # a run of 2
+    # a run of other reasons (here the index's load) is not this notice
+    assert change_notice(times, [True, False, False, False, False, False],
+                         [""] + ["index load 5 N m is outside the fitted 10 N m"] * 5) is None
+    records = [{"recording": f"/x/life_{i}.h5", "time": t, "predicted": 0.1, "low": 0.0,
+                "high": 0.3, "trusted": ok, "alarm": False, "note": n}
+               for i, (t, ok, n) in enumerate(zip(times, trusted, notes, strict=True))]
+    payload = {"kind": "monitor", "model": {"description": "a model"}, "records": records,
+               "new": 0, "calibration": "one_fault_shot",
+               "alarm": {"threshold": 0.2, "first_time": None, "active": False},
+               "forecast": {"limit": 0.6, "time": None, "low": None, "high": None,
+                            "law": None, "reason": "too few trusted recordings"},
+               "notice": notice}
+    assert f"notice: the latest 3 recordings (since {times[3]})" in format_monitor(payload)
+    text = monitor_report(payload, tmp_path / "rep", tmp_path / "life.json").read_text()
+    assert "**Notice**: the latest 3 recordings" in text

@@ -210,6 +210,14 @@ MALFORMED = {
         {"file": "a", "n_cycles": 3, "indicators": {"../../x": 1.0}}]}), ["../../x"]),
     "indicators file null": (json.dumps({"kind": "indicators", "records": [
         {"file": None, "n_cycles": 3, "indicators": {"rms": 1.0}}]}), ["records[0].file"]),
+    "monitor notice without a message": (json.dumps({
+        "kind": "monitor", "records": [], "alarm": {"threshold": 0.2, "first_time": None},
+        "forecast": {"limit": 0.6, "time": None, "low": None, "high": None, "law": None},
+        "notice": {"since": "2026-01-01T00:00:00", "recordings": 3}}), ["notice", "message"]),
+    "monitor law weights a list": (json.dumps({
+        "kind": "monitor", "records": [], "alarm": {"threshold": 0.2, "first_time": None},
+        "forecast": {"limit": 0.6, "time": None, "low": None, "high": None, "law": None,
+                     "law_weights": [1]}}), ["forecast.law_weights"]),
 }
 
 

@@ -376,6 +376,8 @@ def format_monitor(payload: dict) -> str:
                                                       ", cleared since")
                     if al["first_time"] else "not raised"))
     lines.append(describe_forecast(fc))
+    if payload.get("notice"):
+        lines.append(f"notice: {payload['notice']['message']}")
     if payload["calibration"] == "zero_shot":
         lines.append("zero-shot model: sizes are from healthy data and simulation alone; "
                      "refit with an inspected recording (gearshot fit --faulty … "

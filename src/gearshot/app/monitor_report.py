@@ -26,7 +26,10 @@ _ALARM = {"threshold": Field("number", low=0.0, high=1.0),
 _FORECAST = {"limit": Field("number", low=0.0, high=1.0),
              "time": Field("str", nullable=True), "low": Field("str", nullable=True),
              "high": Field("str", nullable=True), "law": Field("str", nullable=True),
-             "reason": Field("str", required=False, nullable=True)}
+             "reason": Field("str", required=False, nullable=True),
+             "law_weights": Field("numbers", required=False, nullable=True)}
+_NOTICE = {"since": Field("str"), "recordings": Field("int", low=1),
+           "message": Field("str")}
 
 
 def check_monitor(payload, where: str) -> None:
@@ -38,6 +41,8 @@ def check_monitor(payload, where: str) -> None:
         check_rows(payload["records"], MONITOR_RECORD, where, "records")
     check_fields(payload["alarm"], _ALARM, where, "alarm")
     check_fields(payload["forecast"], _FORECAST, where, "forecast")
+    if payload.get("notice") is not None:
+        check_fields(payload["notice"], _NOTICE, where, "notice")
 
 
 def is_monitor_payload(payload) -> bool:
@@ -71,6 +76,8 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
               ""]
     sentence = describe_forecast(fc)
     lines += [sentence[0].upper() + sentence[1:] + ".", ""]
+    if payload.get("notice"):
+        lines += [f"**Notice**: {payload['notice']['message']}.", ""]
     lines += ["![trend](trend.png)", ""]
     if len(recs):
         last = recs.tail(20).copy()

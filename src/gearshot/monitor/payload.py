@@ -6,7 +6,9 @@ model's estimate: ``recording``, ``time``, ``predicted``, ``low``, ``high``, ``t
 ``alarm``; times in UTC; the estimate null for a recording that could not be
 estimated, with its ``note``), ``alarm`` (``threshold``, ``first_time``) and
 ``forecast`` (``limit``, ``time``, ``low``, ``high``, ``law``; the last four null with a
-``reason`` when no forecast is made), and the estimates of earlier models (``earlier_estimates``).
+``reason`` when no forecast is made), ``notice`` (:func:`gearshot.monitor.trust.change_notice`:
+the latest recordings no longer look like the fitted machine; null otherwise) and the
+estimates of earlier models (``earlier_estimates``).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import pandas as pd
 
 from .alarm import alarm_states
 from .forecast import forecast_crossing
+from .trust import change_notice
 
 __all__ = ["monitor_payload", "current_records", "describe_forecast", "DEFAULT_LIMIT"]
 
@@ -100,6 +103,8 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                   "false_alarm_rate": float(model.false_alarm_rate),
                   "sustain": int(model.sustain)},
         "forecast": forecast,
+        "notice": change_notice([r["time"] for r in records], [r["trusted"] for r in records],
+                                [r["note"] for r in records]),
         "earlier_estimates": [
             {"recording": r.recording, "time": _iso(r.time), "predicted": _num(r.predicted),
              "low": _num(r.low), "high": _num(r.high), "trusted": bool(r.trusted),

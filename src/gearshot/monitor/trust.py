@@ -16,7 +16,7 @@ import pandas as pd
 from ..estimator.fit_check import LABEL_CHECKS, PASSED
 
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
-           "MIN_TRUSTED_SHARE"]
+           "change_notice", "MIN_TRUSTED_SHARE", "CHANGE_RUN"]
 
 #: Share of a recording's segments that must be trusted for the recording to be: more
 #: than this (a strict majority; a 2-segment recording needs both). Chosen on the
@@ -50,6 +50,13 @@ def row_trust(frame: pd.DataFrame) -> np.ndarray:
         ok &= np.asarray(frame["input_check"].astype(str) == "ok", dtype=bool)
     return ok
 
+
+#: Latest recordings in a row not comparable with the fitted machine that make
+#: :func:`change_notice` speak. Chosen on the development lives (seeds 1-10, 51-60): at 3,
+#: one notice over the 240 healthy recordings outside the load changes and remounts, every
+#: load change and remount of 16 lives noticed (at 2: 3 healthy notices; at 4: the
+#: 3-recording episodes are missed).
+CHANGE_RUN = 3
 
 #: How :func:`untrusted_reason` names the segments that comparability flags (what
 #: :func:`untrusted_counts` finds again in a note).
@@ -110,3 +117,36 @@ def untrusted_counts(notes) -> dict[str, int]:
         for label in found:
             counts[label] = counts.get(label, 0) + 1
     return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
+def change_notice(times, trusted, notes) -> dict | None:
+    """Whether the machine has stopped looking like the fitted one: the latest
+    :data:`CHANGE_RUN` or more recordings in a row untrusted because their segments are
+    not comparable with the fitted machine (another load, speed, sensor or path, or a
+    fault beyond the example's). Such recordings never raise an alarm, so a machine that
+    changed, or a fault that outgrew the fit, would otherwise go quiet.
+
+    Parameters
+    ----------
+    times, trusted, notes : sequences, one item per recording in time order
+        ISO times, whether trusted, and the ``note`` of each (:func:`untrusted_reason`).
+
+    Returns
+    -------
+    dict or None
+        ``since`` (the time of the first recording of the run), ``recordings`` (its
+        length) and ``message``; None when the latest recordings are not such a run.
+    """
+    run = 0
+    for ok, note in zip(reversed(list(trusted)), reversed(list(notes)), strict=True):
+        if ok or NOT_COMPARABLE not in str(note or ""):
+            break
+        run += 1
+    if run < CHANGE_RUN:
+        return None
+    since = list(times)[-run]
+    return {"since": since, "recordings": run,
+            "message": f"the latest {run} recordings (since {since}) are {NOT_COMPARABLE}: "
+                       f"check its load, speed and sensor mount; if none changed, the fault "
+                       f"may have grown beyond the example's size, where the estimates are "
+                       f"no longer trusted (refit with an inspected recording)"}
