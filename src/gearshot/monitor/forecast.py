@@ -58,7 +58,7 @@ _MAX_ONSETS = 40
 _REFINED = 3
 
 
-def _basis(law: str, s: np.ndarray, shape):
+def _basis(law: str, s: np.ndarray, shape: float | np.ndarray) -> np.ndarray:
     if law == "linear":
         return s
     if law == "exponential":
@@ -66,7 +66,8 @@ def _basis(law: str, s: np.ndarray, shape):
     return s ** shape
 
 
-def _inverse(law: str, rise, shape):
+def _inverse(law: str, rise: float | np.ndarray,
+             shape: float | np.ndarray) -> float | np.ndarray:
     """``s`` where ``basis(s) = rise`` (rise > 0)."""
     if law == "linear":
         return rise
