@@ -73,6 +73,13 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     sa = np.zeros((1, 2048))
     assert np.allclose(back.estimator.predict(sa), m.estimator.predict(sa))
     assert back.digest == m.digest and len(back.digest) == 16
+    # each healthy recording's measured speed is kept, and the one-run warning is set from
+    # them (this surrogate campaign's speeds drift 0.4 % between recordings: no warning)
+    from gearshot.monitor.trust import one_run_warning
+
+    speeds = back.extras["healthy_speeds"]
+    assert len(speeds) == 4 and np.allclose(speeds, 15.0, rtol=0.02)
+    assert back.extras["fit_warning"] == one_run_warning(speeds)
     # a zero-shot fit says so
     z = load_model(machine["top"] / "zero.skops")
     assert z.calibration == "zero_shot" and z.faulty is None and "zero-shot" in z.describe()
@@ -252,6 +259,7 @@ def test_fit_and_monitor_with_a_machine_file_on_phm09(tmp_path):
     model = load_model(tmp_path / "m.skops")
     assert model.machine.name and model.machine_toml == spur.read_text(encoding="utf-8")
     assert model.condition["speed_unit"] == "Hz (tacho shaft)" and model.baseline
+    assert len(model.extras["healthy_speeds"]) == 2 and model.extras["fit_warning"] is None
     rows = [("spur2_30hz_High_1.zip", "2026-01-01T00:00:00", 10),
             ("spur2_30hz_High_2.zip", "2026-01-02T00:00:00", 10),
             ("spur2_30hz_Low_1.zip", "2026-01-03T00:00:00", 5)]

@@ -74,8 +74,10 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
     MonitorModel
         Saved at ``model``.
     """
+    from ..io import Recording
     from ..monitor import MonitorModel, alarm_threshold, database_identity
     from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
+    from ..monitor.trust import one_run_warning
     from .predict import estimate_segments
 
     rate = FALSE_ALARM_RATE if false_alarm_rate is None else false_alarm_rate
@@ -107,8 +109,9 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
+        speeds = [Recording.read(p).shaft_speed() for p in healthy]
     else:
-        est, baseline, condition = _fit_with_machine(
+        est, baseline, condition, speeds = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
             coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
             holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
@@ -123,7 +126,8 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
             "recording": str(Path(faulty).resolve()), "size": float(faulty_size)},
         fit_check=getattr(est, "fit_check_", None), coverage=float(coverage), seed=int(seed),
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
-                "grade": getattr(est, "grade_", None)})
+                "grade": getattr(est, "grade_", None), "healthy_speeds": list(speeds),
+                "fit_warning": one_run_warning(speeds)})
     result.save(model)
     return result
 
@@ -155,7 +159,8 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
-    """``fit_model`` through a machine file: (estimator, healthy baseline, condition)."""
+    """``fit_model`` through a machine file: (estimator, healthy baseline, condition, the
+    healthy recordings' mean speeds)."""
     from ..machine import Machine
     from .predict import estimate_segments
     from .predict_machine import fit_machine
@@ -177,7 +182,9 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
                  "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
                  "sensor": mach.sensor(sensor).name,
                  "speed_tolerance": float(speed_tolerance)}
-    return est, baseline, condition
+    speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")],
+                          columns=["file", "speed"]).groupby("file")["speed"].mean()
+    return est, baseline, condition, [float(v) for v in speeds]
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
@@ -356,7 +363,8 @@ def format_monitor(payload: dict) -> str:
     recs = payload["records"]
     n_ok = sum(r["trusted"] for r in recs)
     al, fc = payload["alarm"], payload["forecast"]
-    lines = [payload["model"]["description"],
+    warning = payload["model"].get("warning")
+    lines = [payload["model"]["description"] + (f"\nwarning: {warning}" if warning else ""),
              f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
              f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
     why = untrusted_counts(r.get("note") for r in recs if not r["trusted"])

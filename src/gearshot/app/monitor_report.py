@@ -65,6 +65,8 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
     model = payload.get("model", {})
     lines = ["# gearshot monitor report", "", f"Source: `{source}`", "",
              model.get("description", ""), ""]
+    if model.get("warning"):
+        lines += [f"**Warning**: {model['warning']}.", ""]
     if payload.get("calibration") == "zero_shot":
         lines += ["**Zero-shot model**: no faulty example; sizes come from healthy data and "
                   "simulation alone.", ""]

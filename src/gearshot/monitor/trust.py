@@ -16,7 +16,8 @@ import pandas as pd
 from ..estimator.fit_check import LABEL_CHECKS, PASSED
 
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
-           "change_notice", "MIN_TRUSTED_SHARE", "CHANGE_RUN"]
+           "change_notice", "one_run_warning", "MIN_TRUSTED_SHARE", "CHANGE_RUN",
+           "ONE_RUN_SPREAD"]
 
 #: Share of a recording's segments that must be trusted for the recording to be: more
 #: than this (a strict majority; a 2-segment recording needs both). Chosen on the
@@ -57,6 +58,12 @@ def row_trust(frame: pd.DataFrame) -> np.ndarray:
 #: load change and remount of 16 lives noticed (at 2: 3 healthy notices; at 4: the
 #: 3-recording episodes are missed).
 CHANGE_RUN = 3
+
+#: Relative spread (standard deviation over mean) of the healthy fit recordings' speeds
+#: under which :func:`one_run_warning` speaks. Measured on the virtual rig's fit campaigns
+#: (seeds 1, 3, 9): recorded at one set-point, 0.04-0.05 %; over runs whose speed varies
+#: 1 %, 0.58-0.83 %.
+ONE_RUN_SPREAD = 0.002
 
 #: How :func:`untrusted_reason` names the segments that comparability flags (what
 #: :func:`untrusted_counts` finds again in a note).
@@ -150,3 +157,33 @@ def change_notice(times, trusted, notes) -> dict | None:
                        f"check its load, speed and sensor mount; if none changed, the fault "
                        f"may have grown beyond the example's size, where the estimates are "
                        f"no longer trusted (refit with an inspected recording)"}
+
+
+def one_run_warning(speeds) -> str | None:
+    """A warning for a model whose healthy recordings all ran at one speed (from 3 on):
+    it cannot see how a later run moves. A machine recorded on many days runs at speeds
+    that differ a little, which moves the transfer path's resonances against the mesh
+    orders: fitted on one day, later days are flagged as not comparable or read as small
+    faults (``benchmarks/RESULTS.md``, "Monitoring": alarms in time 7 of 10 development
+    lives instead of 10).
+
+    Parameters
+    ----------
+    speeds : sequence of float
+        The mean shaft speed of each healthy recording the fit used.
+
+    Returns
+    -------
+    str or None
+    """
+    values = np.asarray(list(speeds), dtype=float)
+    values = values[np.isfinite(values)]
+    if values.size < 3 or values.mean() <= 0:
+        return None
+    spread = float(values.std(ddof=1) / values.mean())
+    if spread >= ONE_RUN_SPREAD:
+        return None
+    return (f"the {values.size} healthy recordings ran within {100 * spread:.2f} % of one "
+            f"speed (as one run); if the machine's speed varies more from run to run, "
+            f"later runs may be flagged as not comparable or read as small faults: fit on "
+            f"healthy recordings from several runs or days")

@@ -60,6 +60,8 @@ def fit(
                        cycles_per_segment=cycles_per_segment, sensor=sensor,
                        speed_tolerance=speed_tolerance)
     typer.echo(result.describe())
+    if result.extras.get("fit_warning"):
+        typer.echo(f"warning: {result.extras['fit_warning']}")
     if result.calibration == "zero_shot":
         typer.echo("zero-shot: no faulty example; refit with --faulty/--faulty-size when an "
                    "inspection measures a size")
