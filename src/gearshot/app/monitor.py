@@ -74,7 +74,6 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
     MonitorModel
         Saved at ``model``.
     """
-    from ..io import Recording
     from ..monitor import MonitorModel, alarm_threshold, database_identity
     from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
     from ..monitor.trust import one_run_warning
@@ -109,7 +108,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
-        speeds = [Recording.read(p).shaft_speed() for p in healthy]
+        speeds = [_mean_speed(p) for p in healthy]
     else:
         est, baseline, condition, speeds = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
@@ -157,6 +156,16 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
     return out
 
 
+def _mean_speed(path) -> float:
+    """A recording's mean shaft speed (NaN when it cannot be measured: no warning)."""
+    from ..io import Recording
+
+    try:
+        return float(Recording.read(path).shaft_speed())
+    except GearshotError:
+        return float("nan")
+
+
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
     """``fit_model`` through a machine file: (estimator, healthy baseline, condition, the
@@ -166,10 +175,9 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
     from .predict_machine import fit_machine
 
     mach = Machine.from_toml(machine)
-    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size,
-                                 speed=speed, load=load,
-                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
-                                 holdout=holdout, seed=seed,
+    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size, speed=speed,
+                                 load=load, cycles_per_segment=cycles_per_segment,
+                                 sensor=sensor, holdout=holdout, seed=seed,
                                  speed_tolerance=speed_tolerance)
     held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
     if not held:
@@ -182,9 +190,8 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
                  "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
                  "sensor": mach.sensor(sensor).name,
                  "speed_tolerance": float(speed_tolerance)}
-    speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")],
-                          columns=["file", "speed"]).groupby("file")["speed"].mean()
-    return est, baseline, condition, [float(v) for v in speeds]
+    speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")])
+    return est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()]
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
