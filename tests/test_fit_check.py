@@ -80,6 +80,8 @@ def test_too_few_holdouts_leave_the_fit_unchecked():
     (lambda: holdout_interval([0.1], [], [0.0], 0.9), "healthy and example residuals"),
     (lambda: holdout_interval([0.1], [0.1], [0.0], 1.0), "coverage"),
     (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, run_spread=-1), "run_spread"),
+    (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, example_size=0.4,
+                              extrapolation_spread=0.7), "extrapolation_spread"),
 ])
 def test_bad_input_names_the_argument(call, words):
     with pytest.raises(GearshotError, match=words):
@@ -113,6 +115,32 @@ def test_holdout_interval_is_the_conformal_bound_of_each_side():
     z = 1.6448536269514722
     np.testing.assert_allclose([0.3 - low2[0], high2[0] - 0.3],
                                [np.hypot(over, 0.1 * z), np.hypot(under, 0.1 * z)])
+
+
+def test_holdout_interval_widens_beyond_the_example_as_an_inverse_prediction():
+    """Above the example's size the bound is the size whose own half-width (the hold-out
+    bound and the extrapolation spread in quadrature) reaches the estimate; at or below
+    it nothing changes."""
+    healthy, example = [0.02, 0.05, 0.01, 0.03], [-0.04, 0.03, -0.06, 0.01]
+    z, k, y_ex = 1.6448536269514722, 0.33, 0.4
+    pred = np.array([0.1, 0.3, 0.45, 0.6, 0.8])
+    low0, high0 = holdout_interval(pred, healthy, example, 0.9)
+    low, high = holdout_interval(pred, healthy, example, 0.9, example_size=y_ex,
+                                 extrapolation_spread=k)
+    plain = high0 <= y_ex
+    np.testing.assert_allclose(high[plain], high0[plain])
+    np.testing.assert_allclose(low[low0 <= y_ex], low0[low0 <= y_ex])
+    up = ~plain
+    assert (high[up] > high0[up]).all()
+    np.testing.assert_allclose((high[up] - pred[up]) ** 2,
+                               (high0[up] - pred[up]) ** 2 + (z * k * (high[up] - y_ex)) ** 2)
+    down = low0 > y_ex            # a lower bound above the example's size moves down
+    assert down.any() and (low[down] < low0[down]).all() and (low[down] >= y_ex).all()
+    wide = low[down] > y_ex
+    assert wide.any()
+    np.testing.assert_allclose(
+        (pred[down][wide] - low[down][wide]) ** 2,
+        (pred[down][wide] - low0[down][wide]) ** 2 + (z * k * (low[down][wide] - y_ex)) ** 2)
 
 
 def test_trusted_needs_every_check():

@@ -189,7 +189,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         check: FitCheck | None = getattr(self, "fit_check_", None)
         if check is not None and check.checked and check.n_healthy and check.n_example:
             healthy, example = check.residuals()
-            low, high = holdout_interval(self.predict(sa), healthy, example, coverage)
+            low, high = holdout_interval(self.predict(sa), healthy, example, coverage,
+                                         example_size=check.declared_size)
             return np.clip(low, 0, 1), np.clip(high, 0, 1)
         X = self.features_of(sa)
         discrepancy = float(self.model_discrepancy)
