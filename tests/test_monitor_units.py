@@ -318,6 +318,12 @@ def test_payload_forecast_states_its_fit_span_and_law_weights():
                "forecast": fc}
     line = format_monitor(payload).splitlines()[-1]
     assert f"{fc['law']} law, " in line and "of the weight" in line and "90 % interval" in line
+    # given the latest recording, the forecast is also said in days from it
+    from gearshot.monitor.payload import describe_forecast
+
+    latest = history["time"].iloc[-1]
+    ahead = (pd.Timestamp(fc["time"]) - latest) / pd.Timedelta(days=1)
+    assert f"; {ahead:+.1f} days from the latest recording" in describe_forecast(fc, latest)
 
 
 def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path):

@@ -390,7 +390,7 @@ def format_monitor(payload: dict) -> str:
                  + (f"raised {al['first_time']}" + (", active" if al["active"] else
                                                       ", cleared since")
                     if al["first_time"] else "not raised"))
-    lines.append(describe_forecast(fc))
+    lines.append(describe_forecast(fc, recs[-1]["time"] if recs else None))
     if payload.get("notice"):
         lines.append(f"notice: {payload['notice']['message']}")
     if payload["calibration"] == "zero_shot":

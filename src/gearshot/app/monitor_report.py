@@ -76,7 +76,7 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
               f"Alarm threshold {al['threshold']:.3f}: "
               + (f"first raised {al['first_time']}." if al["first_time"] else "not raised."),
               ""]
-    sentence = describe_forecast(fc)
+    sentence = describe_forecast(fc, recs["time"].iloc[-1] if len(recs) else None)
     lines += [sentence[0].upper() + sentence[1:] + ".", ""]
     if payload.get("notice"):
         lines += [f"**Notice**: {payload['notice']['message']}.", ""]

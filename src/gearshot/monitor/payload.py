@@ -114,12 +114,26 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
     }
 
 
-def describe_forecast(forecast: dict) -> str:
-    """The payload's forecast in one sentence (``gearshot monitor`` and its report)."""
+def describe_forecast(forecast: dict, latest: str | None = None) -> str:
+    """The payload's forecast in one sentence (``gearshot monitor`` and its report):
+    times to the minute, and, given the ``latest`` recording's time, in days from it."""
     if not forecast.get("time"):
         return f"no forecast of size {forecast['limit']:g}: {forecast.get('reason')}"
     share = (forecast.get("law_weights") or {}).get(forecast["law"])
     law = forecast["law"] + (" law" if share is None else f" law, {share:.0%} of the weight")
-    high = forecast.get("high") or "open (part of the weight never reaches it)"
-    return (f"forecast ({law}): size {forecast['limit']:g} reached {forecast['time']} "
-            f"(90 % interval {forecast.get('low')} … {high})")
+
+    def minute(value):
+        return pd.Timestamp(value).round("min").isoformat(timespec="minutes")
+
+    def days(value):
+        return (pd.Timestamp(value) - pd.Timestamp(latest)) / _DAY
+
+    high = forecast.get("high")
+    text = (f"forecast ({law}): size {forecast['limit']:g} reached {minute(forecast['time'])} "
+            f"(90 % interval {minute(forecast['low'])} … "
+            f"{minute(high) if high else 'open: part of the weight never reaches it'})")
+    if latest is None:
+        return text
+    span = f"{days(forecast['low']):+.1f} to " + (f"{days(high):+.1f}" if high else "open")
+    return text + (f"; {days(forecast['time']):+.1f} days from the latest recording "
+                   f"({span})")
