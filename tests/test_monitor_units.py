@@ -324,6 +324,13 @@ def test_payload_forecast_states_its_fit_span_and_law_weights():
     latest = history["time"].iloc[-1]
     ahead = (pd.Timestamp(fc["time"]) - latest) / pd.Timedelta(days=1)
     assert f"; {ahead:+.1f} days from the latest recording" in describe_forecast(fc, latest)
+    # a zero-shot model's sizes are not calibrated: the same history gives no date
+    from gearshot.monitor.payload import ZERO_SHOT_FORECAST
+
+    model.calibration = "zero_shot"
+    zero = monitor_payload(history, model, limit=0.6)["forecast"]
+    assert zero["time"] is None and zero["reason"] == ZERO_SHOT_FORECAST
+    assert "no forecast of size 0.6: zero-shot model" in describe_forecast(zero)
 
 
 def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path):
