@@ -348,6 +348,9 @@ def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path)
     notice = change_notice(times, trusted, notes)
     assert CHANGE_RUN == 3 and notice["recordings"] == 3 and notice["since"] == times[3]
     assert NOT_COMPARABLE in notice["message"] and times[3] in notice["message"]
+    assert "beyond the example's size" in notice["message"]
+    zero = change_notice(times, trusted, notes, zero_shot=True)["message"]
+    assert "zero-shot" in zero and "example" not in zero
     assert change_notice(times, trusted[:-1] + [True], notes) is None   # back to normal
     assert change_notice(times[:5], trusted[:5], notes[:5]) is None     # a run of 2
     # a run of other reasons (here the index's load) is not this notice

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -52,13 +53,13 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
                label=f"alarm threshold {al['threshold']:.2f}")
     fc = payload["forecast"]
     ax.axhline(fc["limit"], color="tab:red", ls=":", label=f"limit {fc['limit']:g}")
-    _draw_forecast(ax, fc, recs)
+    lines = _draw_forecast(ax, fc, recs)
     ax.set_ylim(-0.05, 1.05)
     ax.set_xlabel("time")
     ax.set_ylabel("estimated fault size")
     calib = payload.get("calibration", "")
     ax.set_title(title or f"fault size over time ({calib.replace('_', ' ')} model)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, 0.92))
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, 0.97 - 0.05 * lines))
     fig.autofmt_xdate()
     fig.tight_layout()
     path = Path(path)
@@ -68,8 +69,9 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
     return path
 
 
-def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> None:
-    """The forecast band and the fitted law (or the reason there is none)."""
+def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> int:
+    """The forecast band and the fitted law (or the reason there is none); the lines of
+    text written at the top of the axes."""
     if fc.get("time"):
         lo = pd.Timestamp(fc["low"]) if fc.get("low") else pd.Timestamp(fc["time"])
         hi = pd.Timestamp(fc["high"]) if fc.get("high") else pd.Timestamp(fc["time"])
@@ -93,5 +95,7 @@ def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> None:
             ax.plot(t0 + pd.to_timedelta(days, unit="D"), fit["level"] + fit["amplitude"] * g,
                     color="tab:red", lw=1, alpha=0.7, label=f"best {law} fit")
     else:
-        ax.text(0.01, 0.97, f"no forecast: {fc.get('reason')}", transform=ax.transAxes,
-                va="top", fontsize=8)
+        text = textwrap.fill(f"no forecast: {fc.get('reason')}", 120)
+        ax.text(0.01, 0.97, text, transform=ax.transAxes, va="top", fontsize=8)
+        return text.count("\n") + 1
+    return 1

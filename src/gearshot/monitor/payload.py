@@ -116,7 +116,8 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                   "sustain": int(model.sustain)},
         "forecast": forecast,
         "notice": change_notice([r["time"] for r in records], [r["trusted"] for r in records],
-                                [r["note"] for r in records]),
+                                [r["note"] for r in records],
+                                zero_shot=model.calibration == "zero_shot"),
         "earlier_estimates": [
             {"recording": r.recording, "time": _iso(r.time), "predicted": _num(r.predicted),
              "low": _num(r.low), "high": _num(r.high), "trusted": bool(r.trusted),

@@ -126,7 +126,7 @@ def untrusted_counts(notes) -> dict[str, int]:
     return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
 
-def change_notice(times, trusted, notes) -> dict | None:
+def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | None:
     """Whether the machine has stopped looking like the fitted one: the latest
     :data:`CHANGE_RUN` or more recordings in a row untrusted because their segments are
     not comparable with the fitted machine (another load, speed, sensor or path, or a
@@ -137,6 +137,8 @@ def change_notice(times, trusted, notes) -> dict | None:
     ----------
     times, trusted, notes : sequences, one item per recording in time order
         ISO times, whether trusted, and the ``note`` of each (:func:`untrusted_reason`).
+    zero_shot : bool
+        The model has no faulty example (its fitted states hold no fault at all).
 
     Returns
     -------
@@ -152,11 +154,13 @@ def change_notice(times, trusted, notes) -> dict | None:
     if run < CHANGE_RUN:
         return None
     since = list(times)[-run]
+    fault = ("a fault may be growing, which a zero-shot model's states do not hold"
+             if zero_shot else "the fault may have grown beyond the example's size, where "
+             "the estimates are no longer trusted")
     return {"since": since, "recordings": run,
             "message": f"the latest {run} recordings (since {since}) are {NOT_COMPARABLE}: "
-                       f"check its load, speed and sensor mount; if none changed, the fault "
-                       f"may have grown beyond the example's size, where the estimates are "
-                       f"no longer trusted (refit with an inspected recording)"}
+                       f"check its load, speed and sensor mount; if none changed, {fault} "
+                       f"(refit with an inspected recording)"}
 
 
 def one_run_warning(speeds) -> str | None:
