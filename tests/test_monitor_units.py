@@ -233,6 +233,9 @@ def test_untrusted_reason_names_every_failed_check():
     assert "2 of 3 segments not comparable" in untrusted_reason(both).split("; ")[2]
     other = ok.assign(comparable=[False, False, True], trusted=[False, False, True])
     assert untrusted_reason(other).startswith("2 of 3 segments not comparable")
+    assert "beyond the example's" in untrusted_reason(other)
+    # a zero-shot model has no example: any fault leaves its healthy states
+    assert untrusted_reason(other, zero_shot=True).endswith("sensor or path, or a fault)")
     half = ok.iloc[:2].assign(comparable=[True, False], trusted=[True, False])
     assert untrusted_reason(half).startswith("1 of 2 segments not comparable")
 

@@ -168,8 +168,7 @@ def _mean_speed(path) -> float:
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
-    """``fit_model`` through a machine file: (estimator, healthy baseline, condition, the
-    healthy recordings' mean speeds)."""
+    """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds."""
     from ..machine import Machine
     from .predict import estimate_segments
     from .predict_machine import fit_machine
@@ -247,7 +246,8 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
             sa, note = _segments_of(model, Path(rec.recording), machine)
             frame = estimate_segments(model.estimator, sa, coverage=model.coverage)
             row.update(combine_segments(frame))
-            note = note or _condition_note(model, rec) or untrusted_reason(frame)
+            note = (note or _condition_note(model, rec)
+                    or untrusted_reason(frame, zero_shot=model.calibration == "zero_shot"))
         except GearshotError as exc:
             row.update(predicted=np.nan, low=np.nan, high=np.nan, segments=0,
                        trusted_segments=0, trusted=False)

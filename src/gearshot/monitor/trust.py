@@ -70,7 +70,7 @@ ONE_RUN_SPREAD = 0.002
 NOT_COMPARABLE = "not comparable with the fitted machine"
 
 
-def untrusted_reason(frame: pd.DataFrame) -> str:
+def untrusted_reason(frame: pd.DataFrame, *, zero_shot: bool = False) -> str:
     """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
     is): each check that fails, joined by "; " -- the fit's own check, the label checks
     that :func:`gearshot.estimator.fit_check.trusted_column` requires (input, speed), the
@@ -91,8 +91,9 @@ def untrusted_reason(frame: pd.DataFrame) -> str:
     if "comparable" in frame:
         off = int((~frame["comparable"].astype(bool)).sum())
         if off:
+            fault = "or a fault" if zero_shot else "or a fault beyond the example's"
             parts.append(f"{off} of {n} segments {NOT_COMPARABLE} (another load, speed, "
-                         f"sensor or path, or a fault beyond the example's)")
+                         f"sensor or path, {fault})")
     if not parts:
         parts.append(f"{int(row_trust(frame).sum())} of {n} segments trusted (more than "
                      f"half needed)")
