@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from .._atomic import atomic_path
+from .forecast import GrowthFit
 
 __all__ = ["trend_figure"]
 
@@ -88,12 +89,10 @@ def _draw_forecast(ax, fc: dict, recs: pd.DataFrame) -> int:
             # the law's own span (onset to its last trusted recording); older payloads
             # without it: up to the latest recording
             span = fit.get("span") or (latest - t0) / pd.Timedelta(days=1) - onset
-            s = np.maximum(days - onset, 0) / max(span, 1e-9)
-            law, shape = fc["law"], fit["shape"]
-            g = s if law == "linear" else np.expm1(shape * s) if law == "exponential" \
-                else s ** shape
-            ax.plot(t0 + pd.to_timedelta(days, unit="D"), fit["level"] + fit["amplitude"] * g,
-                    color="tab:red", lw=1, alpha=0.7, label=f"best {law} fit")
+            law = GrowthFit(fc["law"], onset, max(span, 1e-9), fit["level"],
+                            fit["amplitude"], fit["shape"], fit.get("sigma", np.nan), np.nan)
+            ax.plot(t0 + pd.to_timedelta(days, unit="D"), law(days), color="tab:red", lw=1,
+                    alpha=0.7, label=f"best {fc['law']} fit")
     else:
         text = textwrap.fill(f"no forecast: {fc.get('reason')}", 120)
         ax.text(0.01, 0.97, text, transform=ax.transAxes, va="top", fontsize=8)
