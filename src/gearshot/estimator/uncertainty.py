@@ -197,7 +197,8 @@ def holdout_interval(predictions: ArrayLike, healthy_residuals: ArrayLike,
     run_spread : float >= 0, default :data:`RUN_SPREAD`
     example_size : float, optional
         The declared size of the example (None: no extrapolation term).
-    extrapolation_spread : float in [0, 0.6), default :data:`EXTRAPOLATION_SPREAD`
+    extrapolation_spread : float >= 0, default :data:`EXTRAPOLATION_SPREAD`
+        With ``z·extrapolation_spread < 1`` (below 0.61 at a 90 % coverage).
 
     Returns
     -------
