@@ -37,8 +37,12 @@ from scipy.stats import spearmanr
 from gearshot._paths import data_home
 from gearshot.estimator import OneFaultShotEstimator, steps
 from gearshot.estimator._database import _database_by_grade, _database_twins
-from gearshot.experiments.family_rigs import (SA_PIPELINE_VERSION, draw_family, family_paths,
-                                              rig_segments)
+from gearshot.experiments.family_rigs import (
+    SA_PIPELINE_VERSION,
+    draw_family,
+    family_paths,
+    rig_segments,
+)
 from gearshot.experiments.rig import rig_dataset
 from gearshot.paper import RIG_HEALTHY_RECORDINGS, TABLE1_SIZES
 from gearshot.sim import load_database
@@ -122,8 +126,9 @@ def main() -> None:
                          float(np.mean(np.abs(est.predict(ds.test_sa) - ds.test_size))),
                          float(np.mean(np.abs(size - ds.test_size))),
                          float(spearmanr(a, ds.test_size)[0])))
-            print("rig %d draw %d grade %2d  default MAE %.3f  template MAE %.3f  "
-                  "Spearman(a, size) %.2f" % rows[-1], flush=True)
+            seed, draw_, grade, mae_default, mae_template, rho = rows[-1]
+            print(f"rig {seed} draw {draw_} grade {grade:2d}  default MAE {mae_default:.3f}  "
+                  f"template MAE {mae_template:.3f}  Spearman(a, size) {rho:.2f}", flush=True)
     r = np.array(rows)
     print(f"mean: default {100 * r[:, 3].mean():.1f} %, template {100 * r[:, 4].mean():.1f} %, "
           f"Spearman median {np.median(r[:, 5]):.2f}")
