@@ -108,7 +108,8 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
         toml = None
-        speeds = [_mean_speed(p) for p in healthy]
+        speeds = [float(fitted.health[Path(p).resolve()].get("speed", np.nan))
+                  for p in healthy]   # measured when the fit read them
     else:
         est, baseline, condition, speeds = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
@@ -154,16 +155,6 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
         out.append(estimate_segments(est, fitted.targets[0][1],
                                      coverage=coverage)["predicted"].to_numpy())
     return out
-
-
-def _mean_speed(path) -> float:
-    """A recording's mean shaft speed (NaN when it cannot be measured: no warning)."""
-    from ..io import Recording
-
-    try:
-        return float(Recording.read(path).shaft_speed())
-    except GearshotError:
-        return float("nan")
 
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,

@@ -7,11 +7,20 @@ from typing import Any
 
 import numpy as np
 
+from .._errors import GearshotError
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 from .input_health import check_input, check_segments
 from .recording import Recording
 
 __all__ = ["recording_segments"]
+
+
+def _speed(rec: Recording) -> float:
+    """The recording's mean shaft speed, NaN when it cannot be measured."""
+    try:
+        return float(rec.shaft_speed())
+    except GearshotError:
+        return float("nan")
 
 
 def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
@@ -24,7 +33,8 @@ def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
 
     ``health``, when given, receives the input checks
     (:mod:`gearshot.io.input_health`): ``"recording"`` (the raw samples') and
-    ``"segments"`` (one per SA segment).
+    ``"segments"`` (one per SA segment), and ``"speed"``: the recording's mean shaft
+    speed (:meth:`Recording.shaft_speed`; NaN when it cannot be measured).
     """
     rec = Recording.read(path)
     sa = rec.to_sa_segments(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
@@ -32,7 +42,7 @@ def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
                             samples_per_cycle=samples_per_cycle)
     if health is not None:
         health.update(recording=check_input(rec.acceleration, units=rec.units),
-                      segments=check_segments(sa, units=rec.units))
+                      segments=check_segments(sa, units=rec.units), speed=_speed(rec))
     if not long:
         return sa
     x = rec.angle_domain(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
