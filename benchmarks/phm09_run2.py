@@ -61,13 +61,13 @@ CELLS = [(30, "High", "dev"), (30, "Low", "dev"), (40, "High", "held-out"),
 
 
 def cell_frame(machine, database, data: Path, speed: int, load: str, *, cps: int,
-               params: dict, seed: int) -> pd.DataFrame:
+               params: dict, seed: int, sensor: str | None = None) -> pd.DataFrame:
     """One cell's predict table (run-1 hold-outs and run-2 records)."""
     run1, run2 = f"{speed}hz_{load}_1.zip", f"{speed}hz_{load}_2.zip"
     frame = predict_from_machine(
         machine, database, [data / f"spur3_{run1}"], data / f"spur2_{run1}", SIZE,
         [data / f"spur3_{run2}", data / f"spur2_{run2}"], speed=float(speed), load=10.0,
-        cycles_per_segment=cps, seed=seed, params=params)
+        cycles_per_segment=cps, seed=seed, params=params, sensor=sensor)
     frame["recording"] = frame["recording"].map(lambda p: Path(p).name)
     frame["case"] = frame["recording"].str.split("_").str[0]
     frame["run"] = frame["recording"].str.extract(r"_(\d)\.zip$")[0].astype(int)
@@ -101,6 +101,7 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data" / "phm09")
     ap.add_argument("--cycles-per-segment", type=int, default=10)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--sensor", default=None, help="default: the machine's first (acc_input)")
     ap.add_argument("--cells", default="all", choices=("all", "dev", "held-out"))
     ap.add_argument("--param", action="append", default=[],
                     help="estimator parameter NAME=VALUE (JSON value), repeatable")
@@ -114,7 +115,8 @@ def main() -> None:
             continue
         t0 = time.perf_counter()
         f = cell_frame(machine, args.database, args.data, speed, load,
-                       cps=args.cycles_per_segment, params=params, seed=args.seed)
+                       cps=args.cycles_per_segment, params=params, seed=args.seed,
+                       sensor=args.sensor)
         f.insert(0, "cell", f"{speed}hz_{load}")
         f.insert(1, "part", part)
         frames.append(f)

@@ -125,7 +125,9 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
                              low=low, high=high,
                              below_detection_limit=below_detection_limit(est, predicted),
                              comparability=comp.p_value, comparable=comp.comparable))
-    return mark_rows(rows, input_check_column(**health[_key(path)], rows=rows["segment"]))
+    checks = health[_key(path)]
+    return mark_rows(rows, input_check_column(checks["recording"], checks["segments"],
+                                              rows=rows["segment"]))
 
 
 def _roles(path, n: int, fitted: set, faulty) -> list[str]:
