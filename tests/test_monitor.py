@@ -131,6 +131,30 @@ def test_rerun_adds_only_the_new_recordings_and_untrusts_the_load_change(machine
     assert (again["note"].astype(bool) == ~again["trusted"]).all()
 
 
+def test_a_folder_of_recordings_named_by_time_is_an_index(machine, tmp_path):
+    """The life's folder (its index.csv) and its recordings renamed with their times, with
+    no index at all: the same estimates in the same order."""
+    import shutil
+
+    from gearshot.app.monitor import format_monitor, monitor_history
+
+    life = machine["top"] / "life"
+    model = machine["top"] / "zero.skops"
+    by_csv = monitor_history(model, life, tmp_path / "a.parquet")
+    assert "index_source" not in by_csv and len(by_csv["records"]) == 10
+    index = pd.read_csv(life / "index.csv", keep_default_na=False)
+    named = tmp_path / "named"
+    named.mkdir()
+    for f, t in zip(index["file"], index["time"], strict=True):
+        stamp = pd.Timestamp(t).strftime("%Y-%m-%dT%H-%M-%S")
+        shutil.copy(life / f, named / f"gearbox_{stamp}.h5")
+    by_names = monitor_history(model, named, tmp_path / "b.parquet")
+    assert "file names" in by_names["index_source"]
+    assert f"index: {by_names['index_source']}" in format_monitor(by_names)
+    for a, b in zip(by_csv["records"], by_names["records"], strict=True):
+        assert a["time"] == b["time"] and a["predicted"] == b["predicted"]
+
+
 def test_an_unreadable_recording_is_kept_untrusted_with_its_reason(machine, tmp_path):
     from gearshot.app.monitor import monitor_history
 

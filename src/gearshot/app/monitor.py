@@ -287,7 +287,7 @@ def monitor_history(model: str | Path, index: str | Path, history: str | Path, *
     model : path
         Model file (``gearshot fit --model``).
     index : path
-        CSV (:func:`gearshot.monitor.read_index`).
+        CSV, folder or glob pattern (:func:`gearshot.monitor.read_index`).
     history : path
         Parquet history (created when missing).
     limit : float
@@ -316,6 +316,8 @@ def monitor_history(model: str | Path, index: str | Path, history: str | Path, *
     payload = monitor_payload(past, mdl, limit=limit)
     payload["new"] = int(len(todo))
     payload["history"] = str(Path(history))
+    if "source" in table.attrs:   # a folder or pattern of recordings, not a CSV
+        payload["index_source"] = table.attrs["source"]
     return payload
 
 
@@ -365,6 +367,8 @@ def format_monitor(payload: dict) -> str:
     lines = [payload["model"]["description"] + (f"\nwarning: {warning}" if warning else ""),
              f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
              f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
+    if payload.get("index_source"):
+        lines.append(f"index: {payload['index_source']}")
     why = untrusted_counts(r.get("note") for r in recs if not r["trusted"])
     if why:
         lines.append("untrusted: " + "; ".join(f"{n} {k}" for k, n in why.items()))

@@ -2,7 +2,8 @@
 
 The **index** (:func:`read_index`) lists the recordings to watch: columns ``file`` (or
 ``path``; relative paths are relative to the index's folder) and ``time`` (ISO 8601),
-optional ``speed`` and ``load``; other columns are kept. The **history**
+optional ``speed`` and ``load``; other columns are kept; or a folder or glob pattern of
+recording files (:mod:`gearshot.monitor.listing`). The **history**
 (:func:`read_history`, :func:`append_history`) is a Parquet table of every estimate made,
 one row per (recording, model): :data:`HISTORY_COLUMNS`. It is only ever replaced whole
 through the atomic writer, so a reader sees the old history or the new one, never half.
@@ -32,6 +33,11 @@ HISTORY_COLUMNS = ["recording", "time", "predicted", "low", "high", "segments",
 def read_index(path: str | Path) -> pd.DataFrame:
     """The index of recordings to monitor, sorted by time.
 
+    ``path`` is a CSV, a folder (its ``index.csv`` when it has one, else its recording
+    files) or a glob pattern of recording files; listed files take their times from their
+    names or time stamps (:func:`gearshot.monitor.listing.listed_index`, which says which
+    in ``attrs["source"]``).
+
     Returns
     -------
     pandas.DataFrame
@@ -44,13 +50,20 @@ def read_index(path: str | Path) -> pd.DataFrame:
         A missing file, no ``file``/``path`` or ``time`` column, an unreadable time, a
         listed recording that does not exist, or a recording listed twice.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise GearshotError(f"--index {str(path)!r} does not exist")
-    try:
-        table = pd.read_csv(path, keep_default_na=False)
-    except (ValueError, pd.errors.ParserError) as exc:
-        raise GearshotError(f"--index {str(path)!r} is not a readable CSV ({exc})") from None
+    from .listing import GLOB_CHARACTERS, listed_index
+
+    spec, path = str(path), Path(path)
+    if path.is_dir() and (path / "index.csv").is_file():
+        return read_index(path / "index.csv")
+    if path.is_dir() or (not path.exists() and GLOB_CHARACTERS & set(spec)):
+        table = listed_index(spec)
+    elif not path.is_file():
+        raise GearshotError(f"--index {spec!r} does not exist")
+    else:
+        try:
+            table = pd.read_csv(path, keep_default_na=False)
+        except (ValueError, pd.errors.ParserError) as exc:
+            raise GearshotError(f"--index {spec!r} is not a readable CSV ({exc})") from None
     column = "file" if "file" in table else "path" if "path" in table else None
     if column is None or "time" not in table:
         raise GearshotError(f"--index {str(path)!r} needs columns file (or path) and time; "
@@ -73,7 +86,10 @@ def read_index(path: str | Path) -> pd.DataFrame:
     if dup.any():
         raise GearshotError(f"--index {str(path)!r} lists {out['recording'][dup].iloc[0]!r} "
                             f"more than once")
-    return out.sort_values("time", kind="stable").reset_index(drop=True)
+    out = out.sort_values("time", kind="stable").reset_index(drop=True)
+    if "source" in table.attrs:
+        out.attrs["source"] = table.attrs["source"]
+    return out
 
 
 def read_history(path: str | Path) -> pd.DataFrame:

@@ -73,7 +73,9 @@ def monitor(
     model: list[Path] = typer.Option(..., "--model", help="Model file(s) (gearshot fit "
                                      "--model): one, or one per --index."),
     index: list[Path] = typer.Option(..., "--index", help="CSV of recordings: columns file "
-                                     "(or path) and time (ISO 8601), optional speed, load. "
+                                     "(or path) and time (ISO 8601), optional speed, load; "
+                                     "or a folder (its index.csv, else its recordings) or a "
+                                     "quoted glob, times from the file names or time stamps. "
                                      "Repeat with --history for several machines."),
     history: list[Path] = typer.Option(..., "--history", help="Parquet history of the "
                                        "estimates (created; one per --index)."),
