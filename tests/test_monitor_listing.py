@@ -53,8 +53,9 @@ def test_a_folder_with_an_index_is_that_index(tmp_path):
 def test_a_folder_of_named_recordings_is_ordered_by_the_names(tmp_path):
     names = ["m_2026-02-03T10-00-00.h5", "m_2026-02-01T10-00-00.h5", "m_2026-02-02T09-30-00.h5"]
     # modification times in the opposite order: the names win
-    _touch(tmp_path, [*names, "notes.txt.json", "model.skops"],
-           ["2026-05-01", "2026-05-03", "2026-05-02", "2026-05-04", "2026-05-05"])
+    _touch(tmp_path, [*names, "notes.txt.json", "model.skops", ".m_partial.h5"],
+           ["2026-05-01", "2026-05-03", "2026-05-02", "2026-05-04", "2026-05-05",
+            "2026-05-06"])
     table = read_index(tmp_path)
     assert [os.path.basename(p) for p in table["recording"]] == [names[1], names[2], names[0]]
     assert list(table["time"]) == [pd.Timestamp("2026-02-01 10:00"),

@@ -70,7 +70,8 @@ def _recording_files(spec: str) -> tuple[list[Path], str]:
     else:
         found, where = sorted(Path(p) for p in glob.glob(spec)), f"pattern {spec!r}"
         found = [p for p in found if p.is_file()]
-    files = [p for p in found if p.suffix.lower() in FORMATS and p.name != "index.csv"]
+    files = [p for p in found if p.suffix.lower() in FORMATS and p.name != "index.csv"
+             and not p.name.startswith(".")]   # hidden: a partial copy, an editor's file
     if not files:
         raise GearshotError(f"--index {where} holds no recording file (suffixes "
                             f"{sorted(FORMATS)})")
