@@ -260,6 +260,12 @@ def test_monitor_report_lists_why_recordings_are_untrusted(tmp_path):
     header = text.splitlines()[text.splitlines().index("## Latest recordings") + 2]
     assert header.rstrip().endswith("| alarm | note |")
     assert "2 of 2 segments not comparable with the fitted machine" in text
+    assert "index:" not in text
+    # an index listed from a folder says where its times came from
+    payload["index_source"] = "6 recording(s) of folder '/x', times from the file names (UTC)"
+    text = monitor_report(payload, tmp_path / "rep2", tmp_path / "life.json").read_text()
+    assert "untrusted and not used; index: 6 recording(s) of folder '/x', times from the " \
+           "file names (UTC)." in text
 
 
 def test_untrusted_counts_group_the_reasons_and_monitor_prints_them():

@@ -72,7 +72,9 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
                   "simulation alone.", ""]
     n_ok = int(recs["trusted"].sum()) if len(recs) else 0
     lines += [f"Recordings: {len(recs)} ({n_ok} trusted, {len(recs) - n_ok} untrusted and "
-              f"not used).", "",
+              f"not used)"
+              + (f"; index: {payload['index_source']}" if payload.get("index_source") else "")
+              + ".", "",
               f"Alarm threshold {al['threshold']:.3f}: "
               + (f"first raised {al['first_time']}." if al["first_time"] else "not raised."),
               ""]
