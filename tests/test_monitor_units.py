@@ -264,7 +264,7 @@ def test_monitor_report_lists_why_recordings_are_untrusted(tmp_path):
     # an index listed from a folder says where its times came from
     payload["index_source"] = "6 recording(s) of folder '/x', times from the file names (UTC)"
     text = monitor_report(payload, tmp_path / "rep2", tmp_path / "life.json").read_text()
-    assert "untrusted and not used; index: 6 recording(s) of folder '/x', times from the " \
+    assert "untrusted and not used); index: 6 recording(s) of folder '/x', times from the " \
            "file names (UTC)." in text
 
 
