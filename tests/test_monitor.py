@@ -80,6 +80,14 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     speeds = back.extras["healthy_speeds"]
     assert len(speeds) == 4 and np.allclose(speeds, 15.0, rtol=0.02)
     assert back.extras["fit_warning"] == one_run_warning(speeds)
+    # the faulty recording gives 2 segments: the example and one other, too few for the
+    # fit check; the model says so wherever it is used (its estimates cannot be trusted)
+    from gearshot.monitor.trust import model_warning
+
+    assert back.fit_check["verdict"].startswith("unchecked: 1 other segment(s) of the example")
+    warning = model_warning(back)
+    assert warning.startswith(f"the fit did not pass its own check ({back.fit_check['verdict']})")
+    assert "no estimate of this model is trusted" in warning and model_warning(m) == warning
     # a zero-shot fit says so
     z = load_model(machine["top"] / "zero.skops")
     assert z.calibration == "zero_shot" and z.faulty is None and "zero-shot" in z.describe()

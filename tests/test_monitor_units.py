@@ -407,3 +407,26 @@ def test_the_fit_warning_is_printed_and_reported(tmp_path):
     assert format_monitor(payload).splitlines()[1] == f"warning: {warning}"
     text = monitor_report(payload, tmp_path / "rep", tmp_path / "life.json").read_text()
     assert f"**Warning**: {warning}." in text
+
+
+def test_fit_check_warning_names_the_verdict_and_passes_silently():
+    from gearshot.estimator.fit_check import FitCheck
+    from gearshot.monitor.trust import fit_check_warning, model_warning
+
+    assert fit_check_warning(None) is None
+    assert fit_check_warning({"verdict": "passed"}) is None
+    failed = {"verdict": "healthy hold-outs read 0.23 on average (limit 0.15)"}
+    text = fit_check_warning(failed)
+    assert text.startswith("the fit did not pass its own check (healthy hold-outs read 0.23")
+    assert "no alarm can be raised and no forecast made" in text
+    fields = FitCheck.__dataclass_fields__
+    check = FitCheck(**{k: (failed["verdict"] if k == "verdict" else None) for k in fields})
+    assert fit_check_warning(check) == text
+
+    class Model:   # a model saved with a one-run warning and a failed check
+        fit_check = failed
+        extras = {"fit_warning": "the 4 healthy recordings ran within 0.05 % of one speed"}
+
+    assert model_warning(Model()) == f"{text}; {Model.extras['fit_warning']}"
+    Model.fit_check, Model.extras = {"verdict": "passed"}, {}
+    assert model_warning(Model()) is None

@@ -18,7 +18,7 @@ import pandas as pd
 
 from .alarm import alarm_states
 from .forecast import Forecast, forecast_crossing
-from .trust import change_notice
+from .trust import change_notice, model_warning
 
 __all__ = ["monitor_payload", "current_records", "describe_forecast", "DEFAULT_LIMIT",
            "ZERO_SHOT_FORECAST"]
@@ -107,7 +107,7 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
         "model": {"digest": digest, "calibration": model.calibration,
                   "description": model.describe(), "database": model.database,
                   "fit_check": model.fit_check, "condition": model.condition,
-                  "warning": (getattr(model, "extras", None) or {}).get("fit_warning")},
+                  "warning": model_warning(model)},
         "calibration": model.calibration,
         "records": records,
         "alarm": {"threshold": float(model.threshold), "first_time": first,

@@ -10,14 +10,16 @@ that column is present). :func:`recording_trust` combines the segments of one re
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pandas as pd
 
 from ..estimator.fit_check import LABEL_CHECKS, PASSED
 
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
-           "change_notice", "one_run_warning", "MIN_TRUSTED_SHARE", "CHANGE_RUN",
-           "ONE_RUN_SPREAD"]
+           "change_notice", "one_run_warning", "fit_check_warning", "model_warning",
+           "MIN_TRUSTED_SHARE", "CHANGE_RUN", "ONE_RUN_SPREAD"]
 
 #: Share of a recording's segments that must be trusted for the recording to be: more
 #: than this (a strict majority; a 2-segment recording needs both). Chosen on the
@@ -192,3 +194,36 @@ def one_run_warning(speeds) -> str | None:
             f"speed (as one run); if the machine's speed varies more from run to run, "
             f"later runs may be flagged as not comparable or read as small faults: fit on "
             f"healthy recordings from several runs or days")
+
+
+def fit_check_warning(fit_check) -> str | None:
+    """A warning for a model whose fit did not pass its own check: every estimate it makes
+    is untrusted, so ``gearshot monitor`` would raise no alarm and forecast nothing, for
+    as long as it is used.
+
+    Parameters
+    ----------
+    fit_check : FitCheck, mapping or None
+        The estimator's ``fit_check_`` (a saved model holds it as a mapping).
+
+    Returns
+    -------
+    str or None
+        None when the check passed (or the model holds none).
+    """
+    verdict = (fit_check.get("verdict") if isinstance(fit_check, Mapping)
+               else getattr(fit_check, "verdict", None))
+    if verdict is None or verdict == PASSED:
+        return None
+    return (f"the fit did not pass its own check ({verdict}): no estimate of this model is "
+            f"trusted, so no alarm can be raised and no forecast made; refit after fixing "
+            f"what the check names (longer or more recordings, or another example)")
+
+
+def model_warning(model) -> str | None:
+    """Every warning of a model, one string (None: none): its fit check's
+    (:func:`fit_check_warning`) and the one-run warning it was saved with."""
+    extras = getattr(model, "extras", None) or {}
+    found = [w for w in (fit_check_warning(getattr(model, "fit_check", None)),
+                         extras.get("fit_warning")) if w]
+    return "; ".join(found) or None

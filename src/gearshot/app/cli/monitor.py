@@ -59,9 +59,12 @@ def fit(
                        gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed,
                        cycles_per_segment=cycles_per_segment, sensor=sensor,
                        speed_tolerance=speed_tolerance)
+    from ...monitor.trust import model_warning
+
     typer.echo(result.describe())
-    if result.extras.get("fit_warning"):
-        typer.echo(f"warning: {result.extras['fit_warning']}")
+    warning = model_warning(result)
+    if warning:
+        typer.echo(f"warning: {warning}")
     if result.calibration == "zero_shot":
         typer.echo("zero-shot: no faulty example; refit with --faulty/--faulty-size when an "
                    "inspection measures a size")
