@@ -144,7 +144,8 @@ def test_a_folder_of_recordings_named_by_time_is_an_index(machine, tmp_path):
     no index at all: the same estimates in the same order."""
     import shutil
 
-    from gearshot.app.monitor import format_monitor, monitor_history
+    from gearshot.app.monitor import monitor_history
+    from gearshot.app.monitor_report import format_monitor
 
     life = machine["top"] / "life"
     model = machine["top"] / "zero.skops"

@@ -269,7 +269,7 @@ def test_monitor_report_lists_why_recordings_are_untrusted(tmp_path):
 
 
 def test_untrusted_counts_group_the_reasons_and_monitor_prints_them():
-    from gearshot.app.monitor import format_monitor
+    from gearshot.app.monitor_report import format_monitor
     from gearshot.monitor.trust import untrusted_counts
 
     notes = ["2 of 2 segments not comparable with the fitted machine (another load ...)",
@@ -299,7 +299,7 @@ def test_payload_forecast_states_its_fit_span_and_law_weights():
     weights, and gearshot monitor prints both."""
     from types import SimpleNamespace
 
-    from gearshot.app.monitor import format_monitor
+    from gearshot.app.monitor_report import format_monitor
     from gearshot.monitor import monitor_payload
 
     rng = np.random.default_rng(4)
@@ -346,8 +346,7 @@ def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path)
     """A machine whose latest recordings in a row are not comparable with its fit (a
     changed load or sensor mount, or a fault beyond the example's) raises no alarm, so
     the monitor says so in a notice; other reasons and shorter runs do not."""
-    from gearshot.app.monitor import format_monitor
-    from gearshot.app.monitor_report import monitor_report
+    from gearshot.app.monitor_report import format_monitor, monitor_report
     from gearshot.monitor.trust import CHANGE_RUN, NOT_COMPARABLE, change_notice
 
     off = f"2 of 2 segments {NOT_COMPARABLE} (another load, ...)"
@@ -394,8 +393,7 @@ def test_one_run_warning_for_healthy_recordings_at_one_speed():
 
 
 def test_the_fit_warning_is_printed_and_reported(tmp_path):
-    from gearshot.app.monitor import format_monitor
-    from gearshot.app.monitor_report import monitor_report
+    from gearshot.app.monitor_report import format_monitor, monitor_report
     from gearshot.monitor.trust import one_run_warning
 
     warning = one_run_warning([15.0, 15.001, 14.999])

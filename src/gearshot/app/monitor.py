@@ -23,7 +23,7 @@ from .._errors import GearshotError
 from .._validation import check_in_range
 
 __all__ = ["fit_model", "estimate_recordings", "monitor_history", "monitor_fleet",
-           "write_monitor_outputs", "format_monitor", "LOAD_TOLERANCE"]
+           "write_monitor_outputs", "LOAD_TOLERANCE"]
 
 #: Relative distance of an index's ``load`` from the model's load beyond which a
 #: recording is not covered by the fit (untrusted).
@@ -204,7 +204,8 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     return sa, note
 
 
-def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
+def estimate_recordings(model, recordings: pd.DataFrame, *,
+                        progress: bool = False) -> pd.DataFrame:
     """Estimate recordings with a saved model: one history row per recording.
 
     Parameters
@@ -220,7 +221,8 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
     pandas.DataFrame
         :data:`gearshot.monitor.HISTORY_COLUMNS`. A recording that cannot be
         read or segmented, or whose index ``load`` (or ``speed``) lies outside the fitted
-        condition, is kept, untrusted, with the reason in ``note``.
+        condition, is kept, untrusted, with the reason in ``note``. ``progress``: a
+        progress bar, or plain lines on standard error (:mod:`gearshot._progress`).
     """
     from ..monitor import combine_segments
     from ..monitor.trust import untrusted_reason
@@ -230,7 +232,10 @@ def estimate_recordings(model, recordings: pd.DataFrame) -> pd.DataFrame:
     digest = model.digest
     now = pd.Timestamp.now(tz="UTC").tz_localize(None)
     rows = []
-    for rec in recordings.itertuples(index=False):
+    from .._progress import track
+
+    for rec in track(list(recordings.itertuples(index=False)), "estimating recordings",
+                     enabled=progress):
         row = {"recording": rec.recording, "time": pd.Timestamp(rec.time), "model": digest,
                "calibration": model.calibration, "estimated_at": now}
         try:
@@ -305,7 +310,7 @@ def monitor_history(model: str | Path, index: str | Path, history: str | Path, *
     todo = pending(table, past, mdl.digest)
     if len(todo):
         if client is None:
-            rows = estimate_recordings(mdl, todo)
+            rows = estimate_recordings(mdl, todo, progress=True)
         else:
             n = max(1, min(len(todo), 4 * len(client.nthreads())))
             chunks = [c for c in np.array_split(np.arange(len(todo)), n) if c.size]
@@ -352,44 +357,3 @@ def write_monitor_outputs(payload: dict, *, json_out: Path | None = None,
             pd.DataFrame(payload["records"]).to_csv(tmp, index=False)
         written.append(Path(out) / "records.csv")
     return written
-
-
-def format_monitor(payload: dict) -> str:
-    """What ``gearshot monitor`` prints: the model, the counts (and why recordings are
-    untrusted), the alarm, the forecast."""
-    from ..monitor.payload import describe_forecast
-    from ..monitor.trust import untrusted_counts
-
-    recs = payload["records"]
-    n_ok = sum(r["trusted"] for r in recs)
-    al, fc = payload["alarm"], payload["forecast"]
-    warning = payload["model"].get("warning")
-    lines = [payload["model"]["description"] + (f"\nwarning: {warning}" if warning else ""),
-             f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
-             f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
-    if payload.get("index_source"):
-        lines.append(f"index: {payload['index_source']}")
-    why = untrusted_counts(r.get("note") for r in recs if not r["trusted"])
-    if why:
-        lines.append("untrusted: " + "; ".join(f"{n} {k}" for k, n in why.items()))
-    if recs:
-        last = recs[-1]
-        if last["predicted"] is None:
-            lines.append(f"latest {last['time']}: {last.get('note', 'not estimated')}")
-        else:
-            lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
-                         f"[{last['low']:.3f}, {last['high']:.3f}]"
-                         + ("" if last["trusted"] else
-                            f" (untrusted: {last.get('note') or 'see the history'})"))
-    lines.append(f"alarm (threshold {al['threshold']:.3f}): "
-                 + (f"raised {al['first_time']}" + (", active" if al["active"] else
-                                                      ", cleared since")
-                    if al["first_time"] else "not raised"))
-    lines.append(describe_forecast(fc, recs[-1]["time"] if recs else None))
-    if payload.get("notice"):
-        lines.append(f"notice: {payload['notice']['message']}")
-    if payload["calibration"] == "zero_shot":
-        lines.append("zero-shot model: sizes are from healthy data and simulation alone; "
-                     "refit with an inspected recording (gearshot fit --faulty … "
-                     "--faulty-size …) when one is measured")
-    return "\n".join(lines)

@@ -9,7 +9,8 @@ import pandas as pd
 from .markdown import md_table, write_markdown
 from .report_schema import Field, check_fields, check_rows
 
-__all__ = ["is_monitor_payload", "monitor_report", "check_monitor", "MONITOR_RECORD"]
+__all__ = ["is_monitor_payload", "monitor_report", "check_monitor", "format_monitor",
+           "MONITOR_RECORD"]
 
 #: One record of ``gearshot monitor --json`` (more keys are allowed).
 MONITOR_RECORD = {
@@ -91,3 +92,44 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
             cols.append("note")
         lines += ["## Latest recordings", "", *md_table(last[cols])]
     return write_markdown(out, lines)
+
+
+def format_monitor(payload: dict) -> str:
+    """What ``gearshot monitor`` prints: the model, the counts (and why recordings are
+    untrusted), the alarm, the forecast."""
+    from ..monitor.payload import describe_forecast
+    from ..monitor.trust import untrusted_counts
+
+    recs = payload["records"]
+    n_ok = sum(r["trusted"] for r in recs)
+    al, fc = payload["alarm"], payload["forecast"]
+    warning = payload["model"].get("warning")
+    lines = [payload["model"]["description"] + (f"\nwarning: {warning}" if warning else ""),
+             f"{payload.get('new', 0)} new recording(s) estimated; {len(recs)} in the "
+             f"history, {n_ok} trusted, {len(recs) - n_ok} untrusted (not used)"]
+    if payload.get("index_source"):
+        lines.append(f"index: {payload['index_source']}")
+    why = untrusted_counts(r.get("note") for r in recs if not r["trusted"])
+    if why:
+        lines.append("untrusted: " + "; ".join(f"{n} {k}" for k, n in why.items()))
+    if recs:
+        last = recs[-1]
+        if last["predicted"] is None:
+            lines.append(f"latest {last['time']}: {last.get('note', 'not estimated')}")
+        else:
+            lines.append(f"latest {last['time']}: size {last['predicted']:.3f} "
+                         f"[{last['low']:.3f}, {last['high']:.3f}]"
+                         + ("" if last["trusted"] else
+                            f" (untrusted: {last.get('note') or 'see the history'})"))
+    lines.append(f"alarm (threshold {al['threshold']:.3f}): "
+                 + (f"raised {al['first_time']}" + (", active" if al["active"] else
+                                                      ", cleared since")
+                    if al["first_time"] else "not raised"))
+    lines.append(describe_forecast(fc, recs[-1]["time"] if recs else None))
+    if payload.get("notice"):
+        lines.append(f"notice: {payload['notice']['message']}")
+    if payload["calibration"] == "zero_shot":
+        lines.append("zero-shot model: sizes are from healthy data and simulation alone; "
+                     "refit with an inspected recording (gearshot fit --faulty … "
+                     "--faulty-size …) when one is measured")
+    return "\n".join(lines)

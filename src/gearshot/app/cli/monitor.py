@@ -111,7 +111,8 @@ def monitor(
     early(out, "--out", folder=True)
     for h in history:
         early(h, "--history")
-    from ..monitor import format_monitor, monitor_fleet, write_monitor_outputs
+    from ..monitor import monitor_fleet, write_monitor_outputs
+    from ..monitor_report import format_monitor
 
     models = model * len(index) if len(model) == 1 else model
     payloads = monitor_fleet(list(zip(models, index, history, strict=True)), limit=limit,
