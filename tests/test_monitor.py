@@ -66,6 +66,9 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     # the baseline: the last healthy recording (a quarter of 4) kept out of the fit, and
     # each of the 3 fit recordings estimated by a fit on the other two: 4 x 2 segments
     assert len(back.baseline) == 8 and back.threshold == pytest.approx(m.threshold)
+    # what the threshold was set from is said with it
+    assert (f"set from 8 healthy estimates, mean {np.mean(back.baseline):.3f}, largest "
+            f"{np.max(back.baseline):.3f})") in back.describe()
     from gearshot.monitor import alarm_threshold
 
     assert back.threshold == pytest.approx(alarm_threshold(back.baseline))

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import sklearn
 
 from .. import __version__
@@ -128,10 +129,14 @@ class MonitorModel:
                f"one faulty example ({Path(self.faulty['recording']).name}, size "
                f"{self.faulty['size']:g})" if self.faulty else "one faulty example")
         unit = self.condition.get("speed_unit", "rps")
+        base = np.asarray(self.baseline, dtype=float)
+        base = base[np.isfinite(base)]
+        source = (f"; set from {base.size} healthy estimates, mean {base.mean():.3f}, "
+                  f"largest {base.max():.3f}" if base.size else "")
         return (f"model fitted {how} at {self.condition['speed']:g} {unit}, "
                 f"{self.condition['load']:g} N m; alarm threshold {self.threshold:.3f} "
                 f"(false-alarm rate {self.false_alarm_rate:g} per recording, "
-                f"{self.sustain} consecutive)")
+                f"{self.sustain} consecutive{source})")
 
     def _payload(self) -> dict:
         return {"format": _FORMAT, "gearshot_version": __version__,
