@@ -202,6 +202,13 @@ def test_real_fit_passes_and_its_intervals_cover_run_two(spur_db):
     assert ((chipped["low"] <= 0.5) & (0.5 <= chipped["high"])).mean() >= 0.9
     assert (run2["high"] - run2["low"]).mean() <= 0.40
     assert chipped["predicted"].min() > healthy["predicted"].max()
+    # the passed fit's detection limit comes from its hold-outs: an estimate is below it
+    # exactly when its interval reaches 0 (the healthy gear's run 2 below, the chipped
+    # gear's above: the simulated limit put most chipped segments below)
+    limit = frame.attrs["detection_limit"]
+    assert 0.1 < limit < 0.35
+    assert (run2["below_detection_limit"] == (run2["low"] <= 0)).all()
+    assert healthy["below_detection_limit"].all() and not chipped["below_detection_limit"].any()
 
 
 def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
@@ -209,6 +216,8 @@ def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
     verdict = frame.attrs["fit_check"]["verdict"]
     assert verdict != "passed" and "against the declared 0.95" in verdict
     assert (frame["fit_check"] == verdict).all() and not frame["trusted"].any()
+    # a failed fit keeps the limit of its simulated validation rows
+    assert frame.attrs["detection_limit"] > 0.3
 
 
 def test_too_short_healthy_record_is_unchecked_not_silent(spur_db):

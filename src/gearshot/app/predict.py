@@ -230,8 +230,8 @@ def _inputs(database, healthy, faulty, faulty_size, frame, *, machine, speed, se
 
 #: The keys of the fit a predict JSON carries, when the frame's ``attrs`` hold them
 #: (``fit_check``: the frame's fit verdict, when a fit check ran).
-FIT_KEYS = ("grade", "calibration", "simulated_reference", "fit_check", "load_source",
-            "load_choice")
+FIT_KEYS = ("grade", "calibration", "simulated_reference", "detection_limit", "fit_check",
+            "load_source", "load_choice")
 
 
 def _summary(frame: pd.DataFrame) -> dict:
@@ -314,6 +314,18 @@ def input_check_summary(frame: pd.DataFrame) -> str:
             f"{len(failed)} ({counts}): no estimate is given for them")
 
 
+def detection_summary(frame: pd.DataFrame) -> str | None:
+    """One line counting the segments below the fit's detection limit (issue #30): their
+    estimates say "no fault resolved", not a small size. None without the column."""
+    if "below_detection_limit" not in frame or not len(frame):
+        return None
+    n = int(frame["below_detection_limit"].fillna(False).astype(bool).sum())
+    limit = frame.attrs.get("detection_limit")
+    at = "" if limit is None else f" {limit:.3f}"
+    return (f"below the detection limit{at}: {n} of {len(frame)} segment(s) (not told apart "
+            f"from healthy: read as no fault resolved, not as a small size)")
+
+
 def format_predictions(frame: pd.DataFrame, where: str) -> str:
     """What ``gearshot predict`` prints: the condition, the fit's verdict
     (:func:`fit_check_line`), the summary per recording and role (:func:`summary_table`),
@@ -323,6 +335,9 @@ def format_predictions(frame: pd.DataFrame, where: str) -> str:
     if "fit_check" in frame or frame.attrs.get("fit_check"):
         lines.append(fit_check_line(frame))
     lines += [table, comparable_summary(frame), input_check_summary(frame)]
+    detection = detection_summary(frame)
+    if detection:
+        lines.append(detection)
     if "trusted" in frame:
         lines.append(trust_summary(frame))
     return "\n".join(lines)

@@ -63,7 +63,7 @@ from ._prediction import _Prediction
 from ._target import fit_target_side
 from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
 from .comparability import fit_comparability
-from .detection import detection_limit
+from .detection import detection_limit, holdout_detection
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
 from .regressors import ESTIMATORS
@@ -209,9 +209,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         The fit's hold-outs read back against 0 and ``faulty_size`` and a ``verdict``
         (:mod:`~gearshot.estimator.fit_check`); they calibrate :meth:`predict_interval`.
     detection_limit_, detection_threshold_ : float
-        The smallest size told apart from healthy at 95 % confidence, and the healthy
-        validation estimates' 95 % quantile it starts from
-        (:mod:`~gearshot.estimator.detection`).
+        The smallest size told apart from healthy at 95 % confidence and the estimate it
+        starts from: from the simulated validation rows, or from the real hold-outs when
+        the fit check passed (:mod:`~gearshot.estimator.detection`).
     """
 
     _parameter_constraints: ClassVar[dict[str, list[Constraint]]] = {
@@ -347,7 +347,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             del self._fitting_orders
         n_fit = len(self.target_healthy_features_) + len(self.references_)
         self.fit_check_ = check_holdouts(self.predict, holdouts, n_fit, self.faulty_size_)
-        return self
+        return holdout_detection(self)   # a passed check: the limit from the hold-outs
 
     def _fit(self, database: Any, target_healthy: ArrayLike, recordings: Any,
              faulty_example: ArrayLike | None, faulty_size: float | None,
