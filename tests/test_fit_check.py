@@ -168,7 +168,7 @@ def spur_db(tmp_path_factory):
 
     store = tmp_path_factory.mktemp("fitcheck") / "db"
     _record("spur3_30hz_High_1.zip")
-    simulate_machine_database(SPUR, store, speeds=[30], loads=[10], grades=range(1, 13),
+    simulate_machine_database(SPUR, store, speeds=[30, 40], loads=[10], grades=range(1, 13),
                               n_healthy=6, n_faulty=24, seed=0, workers=1)
     return store
 
@@ -209,6 +209,37 @@ def test_real_fit_passes_and_its_intervals_cover_run_two(spur_db):
     assert 0.1 < limit < 0.35
     assert (run2["below_detection_limit"] == (run2["low"] <= 0)).all()
     assert healthy["below_detection_limit"].all() and not chipped["below_detection_limit"].any()
+
+
+def test_a_sensor_whose_fit_refuses_itself_gives_way_to_one_whose_fit_passes(spur_db):
+    """40 Hz High: the input-shaft accelerometer's fit fails its check; with no --sensor
+    the output-shaft one is fitted and used, and says why; a named sensor is kept."""
+    from gearshot.app.predict_machine import predict_from_machine
+
+    def predict(sensor):
+        return predict_from_machine(
+            Machine.from_toml(SPUR), spur_db, [_record("spur3_40hz_High_1.zip")],
+            _record("spur2_40hz_High_1.zip"), 0.5,
+            [_record("spur3_40hz_High_2.zip"), _record("spur2_40hz_High_2.zip")],
+            speed=40.0, load=10.0, cycles_per_segment=10, seed=0, sensor=sensor)
+
+    named = predict("acc_input")
+    assert named.attrs["sensor"] == "acc_input" and named.attrs["sensor_note"] == ""
+    verdict = named.attrs["fit_check"]["verdict"]
+    assert verdict != "passed" and not named["trusted"].any()
+    chosen = predict(None)
+    assert chosen.attrs["sensor"] == "acc_output"
+    assert chosen.attrs["sensor_note"] == (f"sensor acc_output: the fit on acc_input did not "
+                                           f"pass its check ({verdict})")
+    assert chosen.attrs["fit_check"]["verdict"] == "passed"
+    run2 = chosen[chosen["recording"].str.endswith("_2.zip")]
+    healthy = run2[run2["recording"].str.contains("spur3")]
+    chipped = run2[run2["recording"].str.contains("spur2")]
+    assert chipped["predicted"].min() > healthy["predicted"].max()
+    assert ((healthy["low"] <= 0) & (0 <= healthy["high"])).all()
+    # a passing first sensor is kept: 30 Hz High
+    kept = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.5)
+    assert kept.attrs["sensor"] == "acc_input" and kept.attrs["sensor_note"] == ""
 
 
 def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
@@ -273,7 +304,8 @@ def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(sp
         cycles_per_segment=10)
     text = format_predictions(frame, where)
     lines = text.splitlines()
-    assert lines[1].startswith("fit check: passed (2 healthy hold-out(s) read")
+    assert lines[1] == "sensor: acc_input (the machine's first)"
+    assert lines[2].startswith("fit check: passed (2 healthy hold-out(s) read")
     n_trusted = int(frame["trusted"].sum())
     assert f"trusted: {n_trusted} of {len(frame)} segment(s)" in text
     # the Low-load record under the High-load fit: estimated, mostly not trusted (this

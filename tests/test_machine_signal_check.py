@@ -169,7 +169,7 @@ def test_a_helical_stage_without_its_angle_is_refused_for_the_simulator(tmp_path
 
 
 def test_predict_refuses_a_database_of_another_pair(tmp_path):
-    from gearshot.app.predict_machine import check_database_pair
+    from gearshot.app.conditions import check_database_pair
 
     helical = Machine.from_toml(_helical_file(tmp_path))
     spur_pair = helical.gear_pair(helix_angle=0.0)

@@ -32,9 +32,12 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from .._errors import GearshotError
 
-__all__ = ["SPEED_TOLERANCE", "database_conditions", "choose_condition", "check_speeds"]
+__all__ = ["SPEED_TOLERANCE", "database_conditions", "choose_condition", "check_speeds",
+           "check_database_pair"]
 
 #: Largest relative distance between a recording's tacho speed and the database condition
 SPEED_TOLERANCE = 0.05
@@ -134,3 +137,32 @@ def check_speeds(measured: Sequence[tuple[str, float]], condition: float, *,
                 f"tolerance {100 * tolerance:.0f} %); estimate it against a database "
                 f"simulated at its speed (gearshot simulate --machine ... --speed "
                 f"{round(hz):d})")
+
+
+def check_database_pair(database: str | Path, machine) -> None:
+    """Refuse a database simulated for another pair than the machine's monitored pair.
+
+    Teeth, module, face width, pressure angle and helix angle of the store's pair
+    (its manifest) must be those of :meth:`gearshot.Machine.gear_pair` (which itself
+    refuses a helical stage without its helix angle). A store whose manifest holds no
+    readable pair is left to the estimator's tooth check.
+    """
+    from ..sim._db_manifest import pair_from_manifest, read_manifest
+
+    want = machine.gear_pair()
+    have = pair_from_manifest(read_manifest(Path(database)))
+    if have is None:
+        return
+    diffs = []
+    for name, unit, scale in (("z_pinion", "", 1.0), ("z_gear", "", 1.0),
+                              ("module", " mm", 1e3), ("face_width", " mm", 1e3),
+                              ("pressure_angle", " deg", 180 / np.pi),
+                              ("helix_angle", " deg", 180 / np.pi)):
+        a, b = float(getattr(have, name)), float(getattr(want, name))
+        if not np.isclose(a, b, rtol=1e-9, atol=1e-12):
+            diffs.append(f"{name} {a * scale:g}{unit} in the database, {b * scale:g}{unit} "
+                         f"in the machine")
+    if diffs:
+        raise GearshotError(f"--database {str(database)!r} was simulated for another pair than "
+                            f"the monitored pair of machine {machine.name!r}: "
+                            f"{'; '.join(diffs)}; build it with gearshot simulate --machine")

@@ -110,8 +110,9 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         toml = None
         speeds = [float(fitted.health[Path(p).resolve()].get("speed", np.nan))
                   for p in healthy]   # measured when the fit read them
+        sensor_note = ""
     else:
-        est, baseline, condition, speeds = _fit_with_machine(
+        est, baseline, condition, speeds, sensor_note = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
             coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
             holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
@@ -127,7 +128,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         fit_check=getattr(est, "fit_check_", None), coverage=float(coverage), seed=int(seed),
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
                 "grade": getattr(est, "grade_", None), "healthy_speeds": list(speeds),
-                "fit_warning": one_run_warning(speeds)})
+                "fit_warning": one_run_warning(speeds), "sensor_note": sensor_note})
     result.save(model)
     return result
 
@@ -159,16 +160,19 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
-    """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds."""
+    """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds and
+    why the sensor is not the machine's first ("" when it is:
+    :mod:`gearshot.app.sensor_choice`)."""
     from ..machine import Machine
     from .predict import estimate_segments
     from .predict_machine import fit_machine
+    from .sensor_choice import fit_with_sensor_choice
 
     mach = Machine.from_toml(machine)
-    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size, speed=speed,
-                                 load=load, cycles_per_segment=cycles_per_segment,
-                                 sensor=sensor, holdout=holdout, seed=seed,
-                                 speed_tolerance=speed_tolerance)
+    (est, seg, cond), used, note = fit_with_sensor_choice(lambda name: fit_machine(
+        mach, database, healthy, faulty, faulty_size, speed=speed, load=load,
+        cycles_per_segment=cycles_per_segment, sensor=name, holdout=holdout, seed=seed,
+        speed_tolerance=speed_tolerance), mach, sensor)
     held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
     if not held:
         raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
@@ -178,10 +182,10 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
     assert cps is not None   # fit_machine refused a machine without one
     condition = {"speed": float(cond.speed), "load": float(cond.load),
                  "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
-                 "sensor": mach.sensor(sensor).name,
+                 "sensor": used,
                  "speed_tolerance": float(speed_tolerance)}
     speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")])
-    return est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()]
+    return est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()], note
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:

@@ -198,8 +198,10 @@ def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, ma
                                         machine=machine, speed=frame.attrs.get("speed_hz"),
                                         seed=seed, coverage=coverage,
                                         speed_unit="Hz (tacho shaft)")
+        note = frame.attrs.get("sensor_note") or "the machine's first"
         return frame, (f"database condition: tacho shaft {frame.attrs['speed_hz']:.4g} Hz, "
-                       f"load {frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}")
+                       f"load {frame.attrs['load']:g} N m{frame.attrs.get('load_note', '')}\n"
+                       f"sensor: {frame.attrs['sensor']} ({note})")
     if speed is None:
         raise GearshotError("--speed is required without --machine (the database's "
                             "speed, rps)")
@@ -231,7 +233,7 @@ def _inputs(database, healthy, faulty, faulty_size, frame, *, machine, speed, se
 #: The keys of the fit a predict JSON carries, when the frame's ``attrs`` hold them
 #: (``fit_check``: the frame's fit verdict, when a fit check ran).
 FIT_KEYS = ("grade", "calibration", "simulated_reference", "detection_limit", "fit_check",
-            "load_source", "load_choice")
+            "load_source", "load_choice", "sensor", "sensor_note")
 
 
 def _summary(frame: pd.DataFrame) -> dict:

@@ -15,7 +15,13 @@ from .._validation import check_in_range, check_int
 from ..estimator.fit_check import typical_segment
 from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
 from ..machine.signal_check import speed_check, verify_machine
-from .conditions import SPEED_TOLERANCE, check_speeds, choose_condition, database_conditions
+from .conditions import (
+    SPEED_TOLERANCE,
+    check_database_pair,
+    check_speeds,
+    choose_condition,
+    database_conditions,
+)
 from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
 from .predict_fit import recording_labels
@@ -134,7 +140,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
     cycles_per_segment : int, optional
         Shaft revolutions per SA segment (default: the machine's).
     sensor : str, optional
-        Default: the machine's first sensor.
+        Default: chosen (:mod:`gearshot.app.sensor_choice`: the machine's first sensor,
+        or the next whose fit passes its check when the first one's does not).
     holdout : float
         Fraction of each healthy recording's segments (the last ``floor(holdout · n)``)
         kept out of the fit and estimated (``role="healthy_holdout"``); the faulty
@@ -163,16 +170,19 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         failed check (:mod:`gearshot.io.input_health`; the estimate withdrawn); ``fit_check``
         the fit's verdict; ``trusted`` every check passed
         (:func:`gearshot.estimator.trusted_column`). ``attrs``: the ``fit_check``, the
-        condition, the grade and the simulated reference.
+        condition, the grade, the simulated reference, the ``sensor`` used and
+        ``sensor_note`` (why, when not the first).
     """
-    est, seg, cond = fit_machine(machine, database, healthy, faulty, faulty_size, recordings,
-                                 speed=speed, load=load,
-                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
-                                 holdout=holdout, example_segment=example_segment, seed=seed,
-                                 params=params, speed_tolerance=speed_tolerance)
+    from .sensor_choice import fit_with_sensor_choice
+
+    (est, seg, cond), used, note = fit_with_sensor_choice(lambda name: fit_machine(
+        machine, database, healthy, faulty, faulty_size, recordings, speed=speed, load=load,
+        cycles_per_segment=cycles_per_segment, sensor=name, holdout=holdout,
+        example_segment=example_segment, seed=seed, params=params,
+        speed_tolerance=speed_tolerance), machine, sensor)
     frame = _estimates(est, seg, cond, coverage)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs.update(fit_attrs(est))
+    frame.attrs.update(fit_attrs(est), sensor=used, sensor_note=note)
     return frame
 
 
@@ -221,35 +231,6 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
             healthy_holdout=seg.holdout_sas("healthy_holdout"),
             example_record=None if faulty is None else seg.holdout_sas("faulty_rest"))
     return est, seg, cond
-
-
-def check_database_pair(database: str | Path, machine) -> None:
-    """Refuse a database simulated for another pair than the machine's monitored pair.
-
-    Teeth, module, face width, pressure angle and helix angle of the store's pair
-    (its manifest) must be those of :meth:`gearshot.Machine.gear_pair` (which itself
-    refuses a helical stage without its helix angle). A store whose manifest holds no
-    readable pair is left to the estimator's tooth check.
-    """
-    from ..sim._db_manifest import pair_from_manifest, read_manifest
-
-    want = machine.gear_pair()
-    have = pair_from_manifest(read_manifest(Path(database)))
-    if have is None:
-        return
-    diffs = []
-    for name, unit, scale in (("z_pinion", "", 1.0), ("z_gear", "", 1.0),
-                              ("module", " mm", 1e3), ("face_width", " mm", 1e3),
-                              ("pressure_angle", " deg", 180 / np.pi),
-                              ("helix_angle", " deg", 180 / np.pi)):
-        a, b = float(getattr(have, name)), float(getattr(want, name))
-        if not np.isclose(a, b, rtol=1e-9, atol=1e-12):
-            diffs.append(f"{name} {a * scale:g}{unit} in the database, {b * scale:g}{unit} "
-                         f"in the machine")
-    if diffs:
-        raise GearshotError(f"--database {str(database)!r} was simulated for another pair than "
-                            f"the monitored pair of machine {machine.name!r}: "
-                            f"{'; '.join(diffs)}; build it with gearshot simulate --machine")
 
 
 def _check_options(machine, healthy, others, cycles_per_segment, holdout) -> int:

@@ -62,6 +62,8 @@ def fit(
     from ...monitor.trust import model_warning
 
     typer.echo(result.describe())
+    if result.extras.get("sensor_note"):
+        typer.echo(result.extras["sensor_note"])
     warning = model_warning(result)
     if warning:
         typer.echo(f"warning: {warning}")

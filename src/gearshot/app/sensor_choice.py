@@ -1,0 +1,66 @@
+"""Which sensor a machine-file fit estimates with when ``--sensor`` is not given.
+
+The machine's first sensor, unless its fit does not pass its own check
+(:mod:`gearshot.estimator.fit_check`: the healthy hold-outs must read near 0 and the
+example record's other segments near the declared size). Then the machine's other
+sensors are fitted in their order, and the first whose fit passes is used; when none
+passes, the first sensor's fit is kept (and every estimate of it stays untrusted). A
+named ``--sensor`` is always used as it is.
+
+Why: a sensor whose fit refuses itself gives no trusted number at all, while the same
+fault may stand clearly in another sensor's signal. On the PHM09 spur gearbox at 40 Hz
+High load the input-shaft accelerometer's fit fails (healthy hold-outs 0.16, the example
+record 0.24 against 0.5) and the output-shaft one's passes (0.08 / 0.44), and then reads
+the healthy gear's run 2 at 0.10 and the chipped one's at 0.43, every chipped segment
+above every healthy one (``benchmarks/RESULTS.md``, "Trust: fit check, intervals and
+run-to-run"). Only the fit's own check chooses: a passing fit is never swapped for
+another sensor's (at 40 Hz Low the output sensor's fit also passes, and its run 2 reads
+the healthy gear at 0.21, where the input sensor's reads 0.10).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+__all__ = ["fit_with_sensor_choice"]
+
+
+def fit_with_sensor_choice(fit: Callable[[str | None], Any], machine,
+                           sensor: str | None) -> tuple[Any, str, str]:
+    """Fit with ``sensor``, or choose it (module docstring).
+
+    Parameters
+    ----------
+    fit : callable
+        ``fit(sensor_name)`` → a result whose first item is the fitted estimator (with
+        ``fit_check_``), e.g. :func:`gearshot.app.predict_machine.fit_machine`'s.
+    machine : gearshot.Machine
+    sensor : str or None
+        A named sensor (used as it is) or None (chosen).
+
+    Returns
+    -------
+    result
+        The chosen fit's.
+    name : str
+        The sensor it used.
+    note : str
+        "" when the first sensor (or the named one) was used; else why another was.
+    """
+    if sensor is not None or len(machine.sensors) < 2:
+        return fit(sensor), machine.sensor(sensor).name, ""
+    first = None
+    refused: list[tuple[str, str]] = []
+    for candidate in machine.sensors:
+        result = fit(candidate.name)
+        check = getattr(result[0], "fit_check_", None)
+        if check is not None and check.passed:
+            note = "" if not refused else (
+                f"sensor {candidate.name}: the fit on " + "; on ".join(
+                    f"{name} did not pass its check ({verdict})" for name, verdict in refused))
+            return result, candidate.name, note
+        refused.append((candidate.name, "unchecked" if check is None else check.verdict))
+        first = first or (result, candidate.name)
+    assert first is not None
+    return first[0], first[1], ""
