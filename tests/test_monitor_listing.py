@@ -50,6 +50,17 @@ def test_a_folder_with_an_index_is_that_index(tmp_path):
     assert list(from_folder["speed"]) == [14.9, 15.1] and "source" not in from_folder.attrs
 
 
+def test_a_folder_index_says_which_recordings_it_leaves_out(tmp_path):
+    _touch(tmp_path, ["a.h5", "b.h5", "c.zip"])
+    (tmp_path / "index.csv").write_text("file,time\na.h5,2026-01-01T00:00:00\n")
+    table = read_index(tmp_path)
+    assert len(table) == 1
+    assert table.attrs["source"] == (f"{tmp_path / 'index.csv'}; 2 recording file(s) of "
+                                     f"the folder are not in it and not estimated (e.g. "
+                                     f"'b.h5')")
+    assert "source" not in read_index(tmp_path / "index.csv").attrs
+
+
 def test_a_folder_of_named_recordings_is_ordered_by_the_names(tmp_path):
     names = ["m_2026-02-03T10-00-00.h5", "m_2026-02-01T10-00-00.h5", "m_2026-02-02T09-30-00.h5"]
     # modification times in the opposite order: the names win

@@ -54,7 +54,7 @@ def read_index(path: str | Path) -> pd.DataFrame:
 
     spec, path = str(path), Path(path)
     if path.is_dir() and (path / "index.csv").is_file():
-        return read_index(path / "index.csv")
+        return _folder_index(path)
     if path.is_dir() or (not path.exists() and GLOB_CHARACTERS & set(spec)):
         table = listed_index(spec)
     elif not path.is_file():
@@ -90,6 +90,21 @@ def read_index(path: str | Path) -> pd.DataFrame:
     if "source" in table.attrs:
         out.attrs["source"] = table.attrs["source"]
     return out
+
+
+def _folder_index(folder: Path) -> pd.DataFrame:
+    """A folder's ``index.csv``, saying so when recordings of the folder are not in it
+    (new files dropped beside an index are not estimated until it lists them)."""
+    from .listing import recording_files
+
+    table = read_index(folder / "index.csv")
+    listed = set(table["recording"])
+    extra = [p.name for p in recording_files(folder) if str(p.resolve()) not in listed]
+    if extra:
+        table.attrs["source"] = (f"{folder / 'index.csv'}; {len(extra)} recording file(s) "
+                                 f"of the folder are not in it and not estimated (e.g. "
+                                 f"{extra[0]!r})")
+    return table
 
 
 def read_history(path: str | Path) -> pd.DataFrame:

@@ -25,7 +25,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 
-__all__ = ["listed_index", "name_time", "GLOB_CHARACTERS"]
+__all__ = ["listed_index", "recording_files", "name_time", "GLOB_CHARACTERS"]
 
 #: Characters that make ``--index`` a glob pattern (when no such file or folder exists).
 GLOB_CHARACTERS = frozenset("*?[")
@@ -60,18 +60,23 @@ def name_time(name: str) -> pd.Timestamp | None:
     return None
 
 
+def recording_files(spec: str | Path) -> list[Path]:
+    """The recording files of a folder or glob pattern, sorted: a recording suffix, not
+    ``index.csv``, not hidden (a partial copy, an editor's file)."""
+    from ..io import FORMATS
+
+    path = Path(spec)
+    found = (path.iterdir() if path.is_dir() else (Path(p) for p in glob.glob(str(spec))))
+    return sorted(p for p in found if p.is_file() and p.suffix.lower() in FORMATS
+                  and p.name != "index.csv" and not p.name.startswith("."))
+
+
 def _recording_files(spec: str) -> tuple[list[Path], str]:
     """The recording files a folder or pattern names, and how to say where they came from."""
     from ..io import FORMATS
 
-    path = Path(spec)
-    if path.is_dir():
-        found, where = sorted(p for p in path.iterdir() if p.is_file()), f"folder {spec!r}"
-    else:
-        found, where = sorted(Path(p) for p in glob.glob(spec)), f"pattern {spec!r}"
-        found = [p for p in found if p.is_file()]
-    files = [p for p in found if p.suffix.lower() in FORMATS and p.name != "index.csv"
-             and not p.name.startswith(".")]   # hidden: a partial copy, an editor's file
+    files = recording_files(spec)
+    where = f"folder {spec!r}" if Path(spec).is_dir() else f"pattern {spec!r}"
     if not files:
         raise GearshotError(f"--index {where} holds no recording file (suffixes "
                             f"{sorted(FORMATS)})")
