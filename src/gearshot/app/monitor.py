@@ -166,13 +166,12 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
     from ..machine import Machine
     from .predict import estimate_segments
     from .predict_machine import fit_machine
-    from .sensor_choice import fit_with_sensor_choice
 
     mach = Machine.from_toml(machine)
-    (est, seg, cond), used, note = fit_with_sensor_choice(lambda name: fit_machine(
-        mach, database, healthy, faulty, faulty_size, speed=speed, load=load,
-        cycles_per_segment=cycles_per_segment, sensor=name, holdout=holdout, seed=seed,
-        speed_tolerance=speed_tolerance), mach, sensor)
+    est, seg, cond = fit_machine(mach, database, healthy, faulty, faulty_size, speed=speed,
+                                 load=load, cycles_per_segment=cycles_per_segment,
+                                 sensor=sensor, holdout=holdout, seed=seed,
+                                 speed_tolerance=speed_tolerance)
     held = [r[4] for r in seg.rows if r[1] == "healthy_holdout"]
     if not held:
         raise GearshotError(f"--holdout {holdout:g} keeps no healthy segment out of the "
@@ -182,10 +181,11 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
     assert cps is not None   # fit_machine refused a machine without one
     condition = {"speed": float(cond.speed), "load": float(cond.load),
                  "speed_unit": "Hz (tacho shaft)", "cycles_per_segment": int(cps),
-                 "sensor": used,
+                 "sensor": seg.sensor,
                  "speed_tolerance": float(speed_tolerance)}
     speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")])
-    return est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()], note
+    return (est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()],
+            seg.sensor_note)
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
@@ -228,6 +228,7 @@ def estimate_recordings(model, recordings: pd.DataFrame, *,
         condition, is kept, untrusted, with the reason in ``note``. ``progress``: a
         progress bar, or plain lines on standard error (:mod:`gearshot._progress`).
     """
+    from .._progress import track
     from ..monitor import combine_segments
     from ..monitor.trust import untrusted_reason
     from .predict import estimate_segments
@@ -236,8 +237,6 @@ def estimate_recordings(model, recordings: pd.DataFrame, *,
     digest = model.digest
     now = pd.Timestamp.now(tz="UTC").tz_localize(None)
     rows = []
-    from .._progress import track
-
     for rec in track(list(recordings.itertuples(index=False)), "estimating recordings",
                      enabled=progress):
         row = {"recording": rec.recording, "time": pd.Timestamp(rec.time), "model": digest,

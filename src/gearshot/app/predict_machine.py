@@ -173,16 +173,14 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         condition, the grade, the simulated reference, the ``sensor`` used and
         ``sensor_note`` (why, when not the first).
     """
-    from .sensor_choice import fit_with_sensor_choice
-
-    (est, seg, cond), used, note = fit_with_sensor_choice(lambda name: fit_machine(
-        machine, database, healthy, faulty, faulty_size, recordings, speed=speed, load=load,
-        cycles_per_segment=cycles_per_segment, sensor=name, holdout=holdout,
-        example_segment=example_segment, seed=seed, params=params,
-        speed_tolerance=speed_tolerance), machine, sensor)
+    est, seg, cond = fit_machine(machine, database, healthy, faulty, faulty_size, recordings,
+                                 speed=speed, load=load,
+                                 cycles_per_segment=cycles_per_segment, sensor=sensor,
+                                 holdout=holdout, example_segment=example_segment, seed=seed,
+                                 params=params, speed_tolerance=speed_tolerance)
     frame = _estimates(est, seg, cond, coverage)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs.update(fit_attrs(est), sensor=used, sensor_note=note)
+    frame.attrs.update(fit_attrs(est), sensor=seg.sensor, sensor_note=seg.sensor_note)
     return frame
 
 
@@ -193,18 +191,21 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
                 holdout: float = 0.25, example_segment: int | None = None, seed: int = 0,
                 params: dict | None = None, speed_tolerance: float = SPEED_TOLERANCE):
     """The fit of :func:`predict_from_machine` (same parameters); ``faulty`` None fits
-    zero-shot (``calibration="zero_shot"``).
+    zero-shot (``calibration="zero_shot"``). With ``sensor`` None the sensor is chosen
+    (:mod:`gearshot.app.sensor_choice`); every file is read once whatever it tries.
 
     Returns
     -------
     estimator : OneFaultShotEstimator
     segments : _Segments
-        Every recording's SA segments by role (``rows``: file, role, segment, speed, SA).
+        Every recording's SA segments by role (``rows``: file, role, segment, speed, SA),
+        the ``sensor`` they are of and ``sensor_note`` (why, when not the first).
     condition : _Condition
         The database condition estimated at.
     """
     from ..estimator import OneFaultShotEstimator, default_selection_tf
     from ..io import Recording
+    from .sensor_choice import fit_with_sensor_choice
 
     others = [*([] if faulty is None else [faulty]), *recordings]
     cps = _check_options(machine, healthy, others, cycles_per_segment, holdout)
@@ -213,23 +214,31 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
     # the machine file must put its mesh orders where the healthy recordings have them
     read = {str(p): Recording.read(p, machine=machine) for p in healthy}   # read once
     verify_machine(machine, list(read.values()))
-    seg = _segment_recordings(machine, healthy, faulty, recordings, read=read, cps=cps,
-                              sensor=sensor, holdout=holdout, example_segment=example_segment)
-    cond = _condition(database, machine, seg, speed=speed, load=load,
-                      speed_tolerance=speed_tolerance)
+    read.update((str(p), Recording.read(p, machine=machine)) for p in others)
     # every mesh synchronous with the shaft leaves the difference signal, on both sides
     meshes = list(machine.mesh_orders(machine.monitored.shaft))
     calibration = {} if faulty is not None else {"calibration": "zero_shot"}
-    est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
-                                   "mesh_order": meshes, **calibration})
-    # the database must be of the machine's monitored pair (refused otherwise)
-    est.fit(cond.slice, np.vstack(seg.train), seg.example,
-            None if faulty is None else faulty_size, seg.long,
-            selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
-            pinion_teeth=machine.mate()[1], holdout=holdout,
-            healthy_recordings=recording_labels(seg.train),
-            healthy_holdout=seg.holdout_sas("healthy_holdout"),
-            example_record=None if faulty is None else seg.holdout_sas("faulty_rest"))
+
+    def fit_on(name: str | None):
+        seg = _segment_recordings(machine, healthy, faulty, recordings, read=read, cps=cps,
+                                  sensor=name, holdout=holdout,
+                                  example_segment=example_segment)
+        cond = _condition(database, machine, seg, speed=speed, load=load,
+                          speed_tolerance=speed_tolerance)
+        est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
+                                       "mesh_order": meshes, **calibration})
+        # the database must be of the machine's monitored pair (refused otherwise)
+        est.fit(cond.slice, np.vstack(seg.train), seg.example,
+                None if faulty is None else faulty_size, seg.long,
+                selection_tf=default_selection_tf(seed), gear_teeth=machine.monitored.teeth,
+                pinion_teeth=machine.mate()[1], holdout=holdout,
+                healthy_recordings=recording_labels(seg.train),
+                healthy_holdout=seg.holdout_sas("healthy_holdout"),
+                example_record=None if faulty is None else seg.holdout_sas("faulty_rest"))
+        return est, seg, cond
+
+    (est, seg, cond), seg_sensor, note = fit_with_sensor_choice(fit_on, machine, sensor)
+    seg.sensor, seg.sensor_note = seg_sensor, note
     return est, seg, cond
 
 
@@ -260,6 +269,8 @@ class _Segments:
     speeds: dict = field(default_factory=dict)  # file -> tacho speed, Hz
     healthy_speeds: list = field(default_factory=list)
     sources: dict = field(default_factory=dict)  # file -> speed_source, uncertainty
+    sensor: str = ""                             # the sensor the SAs are of
+    sensor_note: str = ""                        # why it is not the machine's first
 
     def holdout_sas(self, role: str) -> np.ndarray:
         """The SAs of the rows of ``role`` (hold-outs), stacked; (0, n) when none."""

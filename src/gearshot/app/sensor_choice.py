@@ -34,7 +34,8 @@ def fit_with_sensor_choice(fit: Callable[[str | None], Any], machine,
     ----------
     fit : callable
         ``fit(sensor_name)`` → a result whose first item is the fitted estimator (with
-        ``fit_check_``), e.g. :func:`gearshot.app.predict_machine.fit_machine`'s.
+        ``fit_check_``): :func:`gearshot.app.predict_machine.fit_machine` passes its fit
+        on one sensor (the files read once for all).
     machine : gearshot.Machine
     sensor : str or None
         A named sensor (used as it is) or None (chosen).
