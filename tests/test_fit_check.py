@@ -70,6 +70,25 @@ def test_too_few_holdouts_leave_the_fit_unchecked():
     assert "(and healthy hold-outs read 0.50" in check_fit([0.5], [], 0.5).verdict
 
 
+def test_a_fit_that_misreads_its_own_example_fails_whatever_its_holdouts():
+    own = ("the example itself reads 0.20 against the declared 0.5 (limit ± "
+           f"{EXAMPLE_LIMIT:g}): no simulated grade reproduces it")
+    # the only evidence on the example: the example record has no other segment
+    check = check_fit([0.0, 0.01], [], 0.5, example_self=0.2)
+    assert check.verdict == (f"unchecked: 0 other segment(s) of the example record, 2 "
+                             f"needed (and {own})") and not check.passed
+    assert check.example_self == pytest.approx(0.2)
+    # named first, as the cause, when the record's other segments fail too
+    both = check_fit([0.0, 0.01], [0.25, 0.3], 0.5, example_self=0.2)
+    assert both.verdict.startswith(own + "; example record's other segments read 0.28")
+    # the record's other segments are held out: when they read right, they decide
+    kept = check_fit([0.0, 0.01], [0.45, 0.5], 0.5, example_self=0.2)
+    assert kept.passed and kept.example_self == pytest.approx(0.2)
+    # within the limit, or zero-shot (nothing declared): no failure from the example
+    assert check_fit([0.0, 0.01], [0.45, 0.5], 0.5, example_self=0.4).passed
+    assert check_fit([0.0, 0.01], [], None, example_self=0.9).passed
+
+
 @pytest.mark.parametrize("call, words", [
     (lambda: check_fit([np.nan, 0.0], [0.5, 0.5], 0.5), "healthy_estimates"),
     (lambda: check_fit([0.0, 0.0], [0.5, 0.5], 1.5), "declared_size"),
@@ -242,13 +261,79 @@ def test_a_sensor_whose_fit_refuses_itself_gives_way_to_one_whose_fit_passes(spu
     assert kept.attrs["sensor"] == "acc_input" and kept.attrs["sensor_note"] == ""
 
 
+def test_another_sensor_is_tried_only_when_the_example_is_not_read(monkeypatch):
+    """The sensor choice (gearshot.app.sensor_choice): a first sensor whose fit fails only
+    on its healthy hold-outs is kept (the recordings' own spread, shared by every
+    sensor); one that cannot read its example gives way to the next that passes."""
+    from types import SimpleNamespace
+
+    from gearshot.app.sensor_choice import fit_with_sensor_choice
+
+    machine = Machine.from_toml(SPUR)
+    names = [s.name for s in machine.sensors]
+
+    def fits(checks):
+        tried = []
+
+        def fit(name):
+            tried.append(name)
+            return (SimpleNamespace(fit_check_=checks[name]),)
+        return fit, tried
+
+    healthy_only = check_fit([0.16, 0.17], [0.52, 0.55], 0.5, example_self=0.47)
+    example_off = check_fit([0.16, 0.17], [0.24, 0.25], 0.5, example_self=0.19)
+    passing = check_fit([0.05, 0.1], [0.45, 0.44], 0.5, example_self=0.40)
+    assert not healthy_only.example_failed and example_off.example_failed
+    assert check_fit([0.0, 0.0], [0.5, 0.5], 0.5, example_self=0.2).example_failed
+    fit, tried = fits({names[0]: healthy_only, names[1]: passing})
+    (est,), used, note = fit_with_sensor_choice(fit, machine, None)
+    assert tried == [names[0]] and used == names[0] and note == ""
+    assert est.fit_check_ is healthy_only
+    fit, tried = fits({names[0]: example_off, names[1]: passing})
+    (est,), used, note = fit_with_sensor_choice(fit, machine, None)
+    assert tried == names and used == names[1] and est.fit_check_ is passing
+    assert note.startswith(f"sensor {names[1]}: the fit on {names[0]} did not pass")
+
+
+def test_a_segment_is_trusted_only_in_a_mostly_trusted_recording():
+    from gearshot.estimator.fit_check import recording_majority
+
+    rec = pd.Series(["a"] * 3 + ["b"] * 4 + ["c"] * 2)
+    ok = pd.Series([True, True, False, True, True, False, False, True, False])
+    # a: 2 of 3 pass; b: 2 of 4 (half is not more than half); c: 1 of 2
+    assert recording_majority(rec, ok).tolist() == [True] * 3 + [False] * 6
+
+
 def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
     frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.95)
     verdict = frame.attrs["fit_check"]["verdict"]
     assert verdict != "passed" and "against the declared 0.95" in verdict
+    # the example itself is read back too (0.80 here: within the limit, not named)
+    own = frame.attrs["fit_check"]["example_self"]
+    assert 0.5 < own < 0.95 and "the example itself" not in verdict
     assert (frame["fit_check"] == verdict).all() and not frame["trusted"].any()
     # a failed fit keeps the limit of its simulated validation rows
     assert frame.attrs["detection_limit"] > 0.3
+
+
+def test_a_fit_that_cannot_reproduce_its_example_says_so_first(spur_db):
+    """40 Hz High on the input sensor: the example itself reads 0.19 against the declared
+    0.5 (no grade reproduces it) and its record's other segments 0.24; the first cause
+    named is the example itself."""
+    from gearshot.app.predict_machine import predict_from_machine
+
+    frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
+                                 [_record("spur3_40hz_High_1.zip")],
+                                 _record("spur2_40hz_High_1.zip"), 0.5, speed=40.0,
+                                 load=10.0, cycles_per_segment=10, seed=0,
+                                 sensor="acc_input")
+    check = frame.attrs["fit_check"]
+    assert check["example_self"] < 0.5 - EXAMPLE_LIMIT
+    assert check["verdict"].startswith(f"the example itself reads "
+                                       f"{check['example_self']:.2f} against the declared "
+                                       f"0.5 (limit ± {EXAMPLE_LIMIT:g}): no simulated "
+                                       f"grade reproduces it; ")
+    assert not frame["trusted"].any()
 
 
 def test_too_short_healthy_record_is_unchecked_not_silent(spur_db):
@@ -289,8 +374,16 @@ def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
     assert not other_load["trusted"].any()
     flagged = est.trust(healthy[-2:], input_check=["ok", "dead channel"])
     assert flagged["trusted"].tolist() == [True, False]
+    # given their recording, a segment passes only with most of its recording's
+    both = est.trust(healthy[-2:], input_check=["ok", "dead channel"], recording="r1")
+    assert both["trusted"].tolist() == [False, False]
+    apart = est.trust(healthy[-2:], input_check=["ok", "dead channel"],
+                      recording=["r1", "r2"])
+    assert apart["trusted"].tolist() == [True, False]
     with pytest.raises(GearshotError, match="input_check holds 1 value"):
         est.trust(healthy[-2:], input_check=["ok"])
+    with pytest.raises(GearshotError, match="recording holds 3 value"):
+        est.trust(healthy[-2:], recording=["a", "b", "c"])
 
 
 def test_predict_output_carries_the_trust_columns_and_the_summary_counts_them(spur_db,

@@ -119,6 +119,9 @@ def test_readme_journey_flags_the_low_records_of_the_healthy_gears(journey):
         assert len(rows) and (~rows["comparable"]).mean() >= 0.8, case
         assert rows["comparability"].median() < 0.01, case
     assert frame.loc[frame["role"] != "test", "comparable"].mean() >= 0.9
+    # issue #29's must-show: Low records under a High fit are not trusted, the chipped
+    # gear's included (its Low record lies within the example's fault states)
+    assert not frame.loc[name.str.contains("_Low_"), "trusted"].any()
 
 
 def test_readme_journey_report(journey):

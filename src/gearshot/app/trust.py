@@ -13,13 +13,17 @@ def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
 
     ``fit_check``: ``check.verdict`` in every row ("passed" or the reason); ``trusted``:
     :func:`gearshot.estimator.trusted_column` (input check "ok" — a table without
-    ``input_check`` counts as "ok" —, comparable and the fit check passed);
+    ``input_check`` counts as "ok" —, comparable and the fit check passed; with a
+    ``recording`` column, only in a recording more than half of whose segments pass:
+    :func:`gearshot.estimator.fit_check.recording_majority`);
     ``frame.attrs["fit_check"]``: ``check.as_dict()``.
     """
-    from ..estimator import trusted_column
+    from ..estimator.fit_check import recording_majority, trusted_column
 
     frame["fit_check"] = check.verdict
     frame["trusted"] = trusted_column(frame) if len(frame) else pd.Series(dtype=bool)
+    if "recording" in frame and len(frame):
+        frame["trusted"] &= recording_majority(frame["recording"], frame["trusted"])
     frame.attrs["fit_check"] = check.as_dict()
     return frame
 
@@ -40,6 +44,8 @@ def fit_check_line(frame: pd.DataFrame) -> str:
         parts.append(f"{check['n_example']} other segment(s) of the example record read "
                      f"{check['example_mean']:.3f} against the declared "
                      f"{check['declared_size']:g}")
+    if check.get("example_self") is not None:
+        parts.append(f"the example itself reads {check['example_self']:.3f}")
     line = f"fit check: {check['verdict']}"
     if parts:
         line += " (" + "; ".join(parts) + ")"

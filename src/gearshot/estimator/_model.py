@@ -321,8 +321,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             taken against the references of the other recordings (as a new recording's
             is) and comparability leaves whole recordings out (run-to-run).
 
-        Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``);
-        the hold-outs also calibrate :meth:`predict_interval`.
+        Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``)
+        or fails if it misreads its own example; hold-outs calibrate :meth:`predict_interval`.
 
         Returns
         -------
@@ -345,8 +345,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                       faulty_example, faulty_size, healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
-        n_fit = len(self.target_healthy_features_) + len(self.references_)
-        self.fit_check_ = check_holdouts(self.predict, holdouts, n_fit, self.faulty_size_)
+        self.fit_check_ = check_holdouts(self.predict, holdouts, len(self.references_) + len(
+            self.target_healthy_features_), self.faulty_size_, faulty_example)  # + the example
         return holdout_detection(self)   # a passed check: the limit from the hold-outs
 
     def _fit(self, database: Any, target_healthy: ArrayLike, recordings: Any,

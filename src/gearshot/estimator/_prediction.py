@@ -13,7 +13,7 @@ from .._errors import GearshotError, NotFittedError
 from .._validation import as_signal_array, check_in_range
 from ._target import target_features
 from .comparability import Comparability, ComparabilityReference
-from .fit_check import TRUST_COLUMNS, FitCheck, trusted_column
+from .fit_check import TRUST_COLUMNS, FitCheck, recording_majority, trusted_column
 from .uncertainty import conformal_quantile, holdout_interval, mixture_interval
 
 FloatArray = NDArray[np.float64]
@@ -115,7 +115,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         return reference.evaluate(sa, false_alarm_rate)
 
     def trust(self, sa: ArrayLike, input_check: Any = None, *,
-              coverage: float = 0.9) -> Any:
+              coverage: float = 0.9, recording: Any = None) -> Any:
         """Every estimate with the checks it passed or failed (issue #29).
 
         Parameters
@@ -126,6 +126,11 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             one per SA; None: "ok".
         coverage : float in (0, 1), default 0.9
             Coverage of ``low`` and ``high``.
+        recording : sequence, optional
+            Each SA's recording (any labels): a segment is then trusted only in a
+            recording more than half of whose segments pass every check
+            (:func:`~gearshot.estimator.fit_check.recording_majority`), as ``gearshot
+            predict`` does.
 
         Returns
         -------
@@ -152,6 +157,9 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         frame["fit_check"] = "unchecked: fitted before the fit check existed" \
             if check is None else check.verdict
         frame["trusted"] = trusted_column(frame)
+        if recording is not None:
+            labels = pd.Series(_per_row(recording, len(arr), "recording"), index=frame.index)
+            frame["trusted"] &= recording_majority(labels, frame["trusted"])
         return frame.loc[:, list(TRUST_COLUMNS)]
 
     def predict_interval(self, sa: ArrayLike, coverage: float = 0.9,

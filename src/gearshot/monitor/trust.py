@@ -15,18 +15,11 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ..estimator.fit_check import LABEL_CHECKS, PASSED
+from ..estimator.fit_check import LABEL_CHECKS, MIN_TRUSTED_SHARE, PASSED
 
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
            "change_notice", "one_run_warning", "fit_check_warning", "model_warning",
            "MIN_TRUSTED_SHARE", "CHANGE_RUN", "ONE_RUN_SPREAD"]
-
-#: Share of a recording's segments that must be trusted for the recording to be: more
-#: than this (a strict majority; a 2-segment recording needs both). Chosen on the
-#: development lives (``benchmarks/monitor_lives.py``, seeds 1-4): at "at least half", a
-#: remounted recording with one of its two segments comparable was trusted and alarmed.
-MIN_TRUSTED_SHARE = 0.5
-
 
 def row_trust(frame: pd.DataFrame) -> np.ndarray:
     """Whether each row (segment) of a predict table can be acted on.
