@@ -461,3 +461,45 @@ def test_typical_segment_is_the_one_nearest_the_record_mean():
     record[4] = base                                                   # the typical one
     assert typical_segment(record) == 4
     assert typical_segment(base) == 0
+
+
+def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
+    """40 Hz records under a 30 Hz fit, let through the database gate by
+    ``speed_tolerance=0.5``: estimated, but none trusted, and ``speed_check`` says why (the
+    healthy gear's 40 Hz run-2 record read 0.77 with most of its segments comparable)."""
+    from gearshot.app.conditions import fit_speed_check
+    from gearshot.app.predict import speed_check_summary
+    from gearshot.app.predict_machine import predict_from_machine
+
+    assert fit_speed_check(31.0, [29.2, 29.9]) == "ok"          # 3.7 % above the range
+    assert fit_speed_check(float("nan"), [29.2]) == "ok"
+    assert fit_speed_check(27.0, [29.2, 29.9]).startswith("speed 27.00 Hz lies 7 % outside")
+    frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
+                                 [_record("spur3_30hz_High_1.zip")],
+                                 _record("spur2_30hz_High_1.zip"), 0.5,
+                                 [_record("spur3_40hz_High_2.zip"),
+                                  _record("spur3_30hz_High_2.zip")],
+                                 speed=30.0, load=10.0, cycles_per_segment=10, seed=0,
+                                 speed_tolerance=0.5)
+    name = frame["recording"].map(lambda r: Path(r).name)
+    at40 = frame[name == "spur3_40hz_High_2.zip"]
+    assert len(at40) and not at40["trusted"].any()
+    assert at40["speed_check"].str.match(r"speed 39\.\d\d Hz lies 3\d % outside").all()
+    assert (frame.loc[name == "spur3_30hz_High_2.zip", "speed_check"] == "ok").all()
+    assert "speed_check: failed for 1 recording(s) (spur3_40hz_High_2.zip: speed" in \
+        speed_check_summary(frame)
+
+
+def test_without_a_machine_file_the_measured_speeds_are_checked_too(tmp_path):
+    """``gearshot predict`` without ``--machine``: each recording's measured speed (rev/s,
+    kept by the fit's read) against the healthy recordings'."""
+    from gearshot.app.predict import _fit_speed_checks
+
+    h1, h2, fast, unknown = (tmp_path / n for n in ("h1.h5", "h2.h5", "fast.h5", "u.h5"))
+    health = {p.resolve(): {"speed": s} for p, s in
+              ((h1, 15.0), (h2, 15.1), (fast, 20.0), (unknown, float("nan")))}
+    rows = pd.Series([str(h1), str(fast), str(fast), str(unknown)])
+    checks = _fit_speed_checks(rows, health, [h1, h2])
+    assert checks[0] == "ok" and checks[3] == "ok" and checks[1] == checks[2]
+    assert checks[1] == ("speed 20.00 rev/s lies 33 % outside the fit's healthy recordings' "
+                         "15.00-15.10 rev/s")

@@ -16,6 +16,13 @@ nominal condition and refuses one at the next 5 Hz step (35 Hz against a 30 or 4
 database: 12-14 %). Within the tolerance the record is estimated; its own tacho speed
 and the condition are both in the output (``speed_hz``, ``database_speed_hz``).
 
+Beyond the gate (``--speed-tolerance`` wider than 5 %), a recording is still estimated but
+not trusted when its speed lies more than :data:`SPEED_TOLERANCE` outside the speeds of
+the fit's healthy recordings (:func:`fit_speed_check`, the ``speed_check`` column): the
+fit has not seen the machine there. Measured on the PHM09 spur records (the README
+database, a 30 Hz High fit, ``--speed-tolerance 0.5``): the healthy gear's 40 Hz run-2
+record read 0.77 with 8 of its 15 segments comparable, and was trusted.
+
 Load
 ----
 A database slice is one (speed, load) condition. When the load is not quantified (the PHM
@@ -37,7 +44,7 @@ import numpy as np
 from .._errors import GearshotError
 
 __all__ = ["SPEED_TOLERANCE", "database_conditions", "choose_condition", "check_speeds",
-           "check_database_pair"]
+           "check_database_pair", "fit_speed_check"]
 
 #: Largest relative distance between a recording's tacho speed and the database condition
 SPEED_TOLERANCE = 0.05
@@ -166,3 +173,25 @@ def check_database_pair(database: str | Path, machine) -> None:
         raise GearshotError(f"--database {str(database)!r} was simulated for another pair than "
                             f"the monitored pair of machine {machine.name!r}: "
                             f"{'; '.join(diffs)}; build it with gearshot simulate --machine")
+
+
+def fit_speed_check(speed: float, healthy_speeds: Sequence[float],
+                    tolerance: float = SPEED_TOLERANCE) -> str:
+    """``"ok"``, or why a recording's speed is outside what the fit has seen: further than
+    ``tolerance`` (relative to their mean) outside the range of the fit's healthy
+    recordings' speeds. Unknown speeds (NaN) pass.
+
+    >>> fit_speed_check(29.6, [29.1, 29.4])
+    'ok'
+    >>> fit_speed_check(39.6, [29.1, 29.4])
+    "speed 39.60 Hz lies 35 % outside the fit's healthy recordings' 29.10-29.40 Hz"
+    """
+    known = np.asarray([h for h in healthy_speeds if np.isfinite(h)], dtype=float)
+    if not known.size or not np.isfinite(speed):
+        return "ok"
+    lo, hi = float(known.min()), float(known.max())
+    off = max(lo - speed, speed - hi, 0.0) / float(known.mean())
+    if off <= tolerance:
+        return "ok"
+    return (f"speed {speed:.2f} Hz lies {100 * off:.0f} % outside the fit's healthy "
+            f"recordings' {lo:.2f}-{hi:.2f} Hz")

@@ -107,6 +107,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
                             fit.health, start=1))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
+    frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy)
     add_trust_columns(frame, est.fit_check_)
     frame.attrs.update(fit_attrs(est))
     return frame
@@ -128,6 +129,18 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
     checks = health[_key(path)]
     return mark_rows(rows, input_check_column(checks["recording"], checks["segments"],
                                               rows=rows["segment"]))
+
+
+def _fit_speed_checks(recordings: pd.Series, health: dict, healthy) -> list[str]:
+    """Per row: :func:`gearshot.app.conditions.fit_speed_check` of its recording's
+    measured speed (rev/s) against the healthy recordings' (unknown speeds pass)."""
+    from .conditions import fit_speed_check
+
+    speed = {k: float(v.get("speed", np.nan)) for k, v in health.items()}
+    fitted = [speed.get(_key(p), np.nan) for p in healthy]
+    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted).replace(" Hz", " rev/s")
+              for r in set(recordings)}
+    return [checks[r] for r in recordings]
 
 
 def _roles(path, n: int, fitted: set, faulty) -> list[str]:
@@ -316,6 +329,19 @@ def input_check_summary(frame: pd.DataFrame) -> str:
             f"{len(failed)} ({counts}): no estimate is given for them")
 
 
+def speed_check_summary(frame: pd.DataFrame) -> str | None:
+    """One line naming the recordings whose ``speed_check`` failed (a tracked speed not to
+    be trusted, or a speed outside the fit's healthy recordings'); None when none did."""
+    if "speed_check" not in frame or not len(frame):
+        return None
+    bad = frame.loc[frame["speed_check"] != "ok"].drop_duplicates("recording")
+    if bad.empty:
+        return None
+    first = f"{Path(str(bad['recording'].iloc[0])).name}: {bad['speed_check'].iloc[0]}"
+    return (f"speed_check: failed for {len(bad)} recording(s) ({first}"
+            + (", …" if len(bad) > 1 else "") + "): their estimates are not trusted")
+
+
 def detection_summary(frame: pd.DataFrame) -> str | None:
     """One line counting the segments below the fit's detection limit (issue #30): their
     estimates say "no fault resolved", not a small size. None without the column."""
@@ -337,9 +363,7 @@ def format_predictions(frame: pd.DataFrame, where: str) -> str:
     if "fit_check" in frame or frame.attrs.get("fit_check"):
         lines.append(fit_check_line(frame))
     lines += [table, comparable_summary(frame), input_check_summary(frame)]
-    detection = detection_summary(frame)
-    if detection:
-        lines.append(detection)
+    lines += [line for line in (speed_check_summary(frame), detection_summary(frame)) if line]
     if "trusted" in frame:
         lines.append(trust_summary(frame))
     return "\n".join(lines)

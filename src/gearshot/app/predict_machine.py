@@ -21,6 +21,7 @@ from .conditions import (
     check_speeds,
     choose_condition,
     database_conditions,
+    fit_speed_check,
 )
 from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
@@ -387,5 +388,7 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
-    frame["speed_check"] = [seg.sources[r]["speed_check"] for r in frame["recording"]]
+    tracked = [seg.sources[r]["speed_check"] for r in frame["recording"]]  # else: the fit's
+    frame["speed_check"] = [c if c != "ok" else fit_speed_check(seg.speeds[r], seg.healthy_speeds)
+                            for r, c in zip(frame["recording"], tracked, strict=True)]
     return frame
