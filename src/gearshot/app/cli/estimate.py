@@ -51,13 +51,16 @@ _HELP = {
     "machine": "Machine description (TOML): SAs of the monitored gear's shaft through its "
                "gear train; speeds in tacho-shaft Hz.",
     "cycles": "With --machine: revolutions per SA segment (default: the machine's).",
-    "sensor": "With --machine: sensor name (default the first).",
+    "sensor": ("With --machine: sensor name (default the first, or the next whose fit "
+               "passes when the first cannot read its own example)."),
     "holdout": "Fraction of each healthy recording's segments (the last ones) kept out of "
                "the fit and estimated; with the example record's other segments they check "
                "the fit (the fit_check column: 'passed' or the reason) and calibrate the "
                "intervals.",
     "tolerance": "With --machine: largest relative distance between a recording's tacho "
-                 "speed and the database condition (beyond it the recording is refused).",
+                 "speed and the database condition (beyond it the recording is refused; "
+                 "within it, a recording more than 5 % outside the fit's healthy "
+                 "recordings' speeds is estimated but not trusted: speed_check).",
     "speed_hint": "Nominal speed (Hz) of the machine's reference shaft for every record "
                   "without a tacho and without its own FILE@HZ: the speed is searched "
                   "within ±10 % of it (instead of the machine file's [speed] range_hz), so "
