@@ -21,18 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from gearshot._paths import data_home
-from gearshot.estimator import OneFaultShotEstimator
 from gearshot.estimator.fit_check import EXAMPLE_LIMIT
-from gearshot.experiments.family_rigs import (
-    SA_PIPELINE_VERSION,
-    draw_family,
-    family_paths,
-    rig_segments,
-)
-from gearshot.experiments.rig import rig_dataset
-from gearshot.paper import RIG_HEALTHY_RECORDINGS, TABLE1_SIZES
-from gearshot.sim import load_database
-from gearshot.transfer import TransferFunctionBank
+from gearshot.experiments.family_rigs import cached_family_fits
 
 
 def main() -> None:
@@ -48,28 +38,15 @@ def main() -> None:
     config = rows[0]["config"]
     mae = {(r["seed"], r["draw"]): 100 * r["mae"] for r in rows
            if r["config"] == config and r["variant"] == "full"}
-    data = data_home()
-    paths = family_paths(args.frf_folder, n_synthetic=4, seed=2023)
-    store = next((data / "family").glob("db-4conditions-*-paired"))
-    campaign = dict(duration=None, segments=4, healthy=int(RIG_HEALTHY_RECORDINGS),
-                    sizes=[float(y) for y in TABLE1_SIZES], repetitions=2,
-                    sa_pipeline=SA_PIPELINE_VERSION)
     misread, other = [], []
-    for rig in draw_family(args.seeds, paths):
-        index, segments = rig_segments(rig, paths, data / "family" / "rigs", campaign)
-        database = load_database(store, speed=rig.speed, load=rig.load)
-        selection = TransferFunctionBank.synthetic(
-            1, rng=np.random.default_rng([rig.seed, 99]))[0]
-        for draw in range(args.draws):
-            ds = rig_dataset(index, random_state=[rig.seed, draw], segments=segments)
-            est = OneFaultShotEstimator(random_state=1000 * rig.seed + draw).fit(
-                *ds.fit_args(database), selection_tf=selection, **ds.fit_kwargs())
-            own = est.fit_check_.example_self
-            off = abs(own - ds.faulty_size) > EXAMPLE_LIMIT
-            err = mae.get((rig.seed, draw), float("nan"))
-            (misread if off else other).append(err)
-            print(f"rig {rig.seed} draw {draw} grade {rig.grade:2d} example {ds.faulty_size:.2f}"
-                  f" reads {own:.2f}{' MISREAD' if off else ''}  MAE {err:.1f} %", flush=True)
+    for rig, draw, ds, _, est in cached_family_fits(args.seeds, data_home(), args.frf_folder,
+                                                    draws=args.draws):
+        own = est.fit_check_.example_self
+        off = abs(own - ds.faulty_size) > EXAMPLE_LIMIT
+        err = mae.get((rig.seed, draw), float("nan"))
+        (misread if off else other).append(err)
+        print(f"rig {rig.seed} draw {draw} grade {rig.grade:2d} example {ds.faulty_size:.2f}"
+              f" reads {own:.2f}{' MISREAD' if off else ''}  MAE {err:.1f} %", flush=True)
     n = len(misread) + len(other)
     print(f"\nfits misreading their own example by more than {EXAMPLE_LIMIT:g}: "
           f"{len(misread)} / {n}; MAE {np.nanmean(misread):.1f} % against "

@@ -35,18 +35,9 @@ from scipy.ndimage import uniform_filter1d
 from scipy.stats import spearmanr
 
 from gearshot._paths import data_home
-from gearshot.estimator import OneFaultShotEstimator, steps
+from gearshot.estimator import steps
 from gearshot.estimator._database import _database_by_grade, _database_twins
-from gearshot.experiments.family_rigs import (
-    SA_PIPELINE_VERSION,
-    draw_family,
-    family_paths,
-    rig_segments,
-)
-from gearshot.experiments.rig import rig_dataset
-from gearshot.paper import RIG_HEALTHY_RECORDINGS, TABLE1_SIZES
-from gearshot.sim import load_database
-from gearshot.transfer import TransferFunctionBank
+from gearshot.experiments.family_rigs import cached_family_fits
 
 GRID = np.round(np.arange(0.0, 1.001, 0.01), 2)
 
@@ -92,43 +83,30 @@ def main() -> None:
                     default=Path(__file__).resolve().parents[2] / "shared" / "data" / "frf")
     args = ap.parse_args()
     data = args.data or data_home()
-    paths = family_paths(args.frf_folder, n_synthetic=4, seed=2023)
-    store = next((data / "family").glob("db-4conditions-*-paired"))
-    campaign = dict(duration=None, segments=4, healthy=int(RIG_HEALTHY_RECORDINGS),
-                    sizes=[float(y) for y in TABLE1_SIZES], repetitions=2,
-                    sa_pipeline=SA_PIPELINE_VERSION)
     rows = []
-    for rig in draw_family(args.seeds, paths):
-        index, segments = rig_segments(rig, paths, data / "family" / "rigs", campaign)
-        database = load_database(store, speed=rig.speed, load=rig.load)
-        selection = TransferFunctionBank.synthetic(
-            1, rng=np.random.default_rng([rig.seed, 99]))[0]
-        for draw in range(args.draws):
-            ds = rig_dataset(index, random_state=[rig.seed, draw], segments=segments)
-            est = OneFaultShotEstimator(random_state=1000 * rig.seed + draw).fit(
-                *ds.fit_args(database), selection_tf=selection, **ds.fit_kwargs())
+    for rig, draw, ds, database, est in cached_family_fits(args.seeds, data, args.frf_folder,
+                                                           draws=args.draws):
+        def spectrum(x, est=est):
+            y = steps.normalize_rms(np.atleast_2d(x), scale=est.target_scale_)
+            d = steps.suppress_harmonics_target(y, est.references_,
+                                                upsample=est._options().upsample)
+            return np.abs(np.fft.rfft(d, axis=-1)) ** 2
 
-            def spectrum(x, est=est):
-                y = steps.normalize_rms(np.atleast_2d(x), scale=est.target_scale_)
-                d = steps.suppress_harmonics_target(y, est.references_,
-                                                    upsample=est._options().upsample)
-                return np.abs(np.fft.rfft(d, axis=-1)) ** 2
-
-            keep = off_mesh(est.n_points_, est.mesh_orders_)
-            noise = uniform_filter1d(est.target_residue_power_, 9)
-            template = uniform_filter1d(
-                np.clip(spectrum(ds.faulty_example)[0] - noise, 0, None) * keep, 5)
-            a = statistic(spectrum(ds.test_sa) * keep, template, noise)
-            growth = simulated_growth(database, ds.faulty_size, est.transfer_function_,
-                                      noise, keep)
-            size = np.interp(a, growth, GRID)
-            rows.append((rig.seed, draw, rig.grade,
-                         float(np.mean(np.abs(est.predict(ds.test_sa) - ds.test_size))),
-                         float(np.mean(np.abs(size - ds.test_size))),
-                         float(spearmanr(a, ds.test_size)[0])))
-            seed, draw_, grade, mae_default, mae_template, rho = rows[-1]
-            print(f"rig {seed} draw {draw_} grade {grade:2d}  default MAE {mae_default:.3f}  "
-                  f"template MAE {mae_template:.3f}  Spearman(a, size) {rho:.2f}", flush=True)
+        keep = off_mesh(est.n_points_, est.mesh_orders_)
+        noise = uniform_filter1d(est.target_residue_power_, 9)
+        template = uniform_filter1d(
+            np.clip(spectrum(ds.faulty_example)[0] - noise, 0, None) * keep, 5)
+        a = statistic(spectrum(ds.test_sa) * keep, template, noise)
+        growth = simulated_growth(database, ds.faulty_size, est.transfer_function_,
+                                  noise, keep)
+        size = np.interp(a, growth, GRID)
+        rows.append((rig.seed, draw, rig.grade,
+                     float(np.mean(np.abs(est.predict(ds.test_sa) - ds.test_size))),
+                     float(np.mean(np.abs(size - ds.test_size))),
+                     float(spearmanr(a, ds.test_size)[0])))
+        seed, draw_, grade, mae_default, mae_template, rho = rows[-1]
+        print(f"rig {seed} draw {draw_} grade {grade:2d}  default MAE {mae_default:.3f}  "
+              f"template MAE {mae_template:.3f}  Spearman(a, size) {rho:.2f}", flush=True)
     r = np.array(rows)
     print(f"mean: default {100 * r[:, 3].mean():.1f} %, template {100 * r[:, 4].mean():.1f} %, "
           f"Spearman median {np.median(r[:, 5]):.2f}")

@@ -29,7 +29,8 @@ from ..paper import (
 
 __all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS", "RANGES",
            "SA_PIPELINE_VERSION", "FamilyRig", "path_kind", "family_paths", "draw_family",
-           "true_path_on_grid", "rig_segments", "campaign_duration", "tf_digest", "config_hash"]
+           "true_path_on_grid", "rig_segments", "campaign_duration", "tf_digest", "config_hash",
+           "cached_family_fits"]
 
 #: The paper's four rig conditions (speed rev/s, load N m), :data:`gearshot.paper.RIG_CONDITIONS`
 PAPER_CONDITIONS = RIG_CONDITIONS
@@ -239,3 +240,31 @@ def config_hash(obj) -> str:
     """A short hash of a JSON-able configuration (keys sorted)."""
     return hashlib.sha1(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
+
+
+def cached_family_fits(seeds, data, frf_folder=None, *, draws: int = 2):
+    """Each (rig, draw) of the family over its cached segments, fitted with the library
+    defaults as ``benchmarks/rig_family.py`` fits it: yields ``(rig, draw, dataset,
+    database, estimator)`` (the paired family database under ``data/family``). For the
+    benchmarks that look inside those fits."""
+    from ..estimator import OneFaultShotEstimator
+    from ..paper import RIG_HEALTHY_RECORDINGS, TABLE1_SIZES
+    from ..sim import load_database
+    from ..transfer import TransferFunctionBank
+    from .rig import rig_dataset
+
+    paths = family_paths(frf_folder, n_synthetic=4, seed=2023)
+    store = next((Path(data) / "family").glob("db-4conditions-*-paired"))
+    campaign = dict(duration=None, segments=4, healthy=int(RIG_HEALTHY_RECORDINGS),
+                    sizes=[float(y) for y in TABLE1_SIZES], repetitions=2,
+                    sa_pipeline=SA_PIPELINE_VERSION)
+    for rig in draw_family(seeds, paths):
+        index, segments = rig_segments(rig, paths, Path(data) / "family" / "rigs", campaign)
+        database = load_database(store, speed=rig.speed, load=rig.load)
+        selection = TransferFunctionBank.synthetic(
+            1, rng=np.random.default_rng([rig.seed, 99]))[0]
+        for draw in range(draws):
+            ds = rig_dataset(index, random_state=[rig.seed, draw], segments=segments)
+            est = OneFaultShotEstimator(random_state=1000 * rig.seed + draw).fit(
+                *ds.fit_args(database), selection_tf=selection, **ds.fit_kwargs())
+            yield rig, draw, ds, database, est
