@@ -59,5 +59,5 @@ def trust_summary(frame: pd.DataFrame) -> str:
     if "trusted" not in frame or not len(frame):
         return "trusted: no segment estimated"
     n_yes = int(frame["trusted"].astype(bool).sum())
-    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input check ok, comparable and "
-            f"fit check passed)")
+    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input and speed checks ok, "
+            f"comparable and fit check passed, in a recording most of whose segments pass)")
