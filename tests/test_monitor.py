@@ -180,6 +180,29 @@ def test_an_unreadable_recording_is_kept_untrusted_with_its_reason(machine, tmp_
     json.dumps(payload, allow_nan=False)       # strict JSON: no NaN
 
 
+def test_a_recording_at_a_speed_the_fit_never_saw_is_untrusted(machine, tmp_path):
+    """The same rig run 20 % faster (a recording's own measured speed, no index speed):
+    estimated, kept untrusted with the reason; a run at the fitted speed is not flagged
+    for its speed."""
+    from gearshot.app.monitor import monitor_history
+    from gearshot.rig import VirtualRig
+
+    fast = VirtualRig(3, engine="surrogate").campaign(
+        tmp_path / "fast", speed=18, load=10, duration=16, healthy=1, sizes=(),
+        repetitions=1, progress=False)
+    path = tmp_path / "fast" / fast["path"].iloc[0]
+    same = machine["healthy"][-1]
+    (tmp_path / "index.csv").write_text(f"file,time\n{same},2026-01-01T00:00:00\n"
+                                        f"{path},2026-01-02T00:00:00\n")
+    payload = monitor_history(machine["top"] / "zero.skops", tmp_path / "index.csv",
+                              tmp_path / "h.parquet")
+    at15, at18 = payload["records"]
+    assert "speed" not in (at15["note"] or "")
+    assert not at18["trusted"] and not at18["alarm"] and at18["predicted"] is not None
+    assert at18["note"].startswith("speed 18.") and "% outside the fit's healthy " \
+        "recordings' 1" in at18["note"] and at18["note"].endswith("rev/s")
+
+
 @pytest.mark.slow
 def test_monitor_adds_only_the_new_then_reestimates_after_a_refit(machine, tmp_path):
     life = machine["top"] / "life"

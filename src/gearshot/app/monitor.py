@@ -190,14 +190,21 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     """SA segments of one recording as the model's fit segmented its recordings, and a
-    note ("" or why the recording is not covered)."""
+    note ("" or why the recording is not covered: with a machine file, a tacho speed
+    beyond the model's speed tolerance; with or without one, a speed more than 5 %
+    outside the fit's healthy recordings', :func:`gearshot.app.conditions.fit_speed_check`)."""
+    from .conditions import fit_speed_check
+
     cond = model.condition
+    seen = (getattr(model, "extras", None) or {}).get("healthy_speeds") or []
     if machine is None:
         from ..io import recording_segments
 
+        health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
-                                pinion_teeth=cond["pinion_teeth"])
-        return np.asarray(sa), ""
+                                pinion_teeth=cond["pinion_teeth"], health=health)
+        check = fit_speed_check(float(health.get("speed", np.nan)), seen)
+        return np.asarray(sa), "" if check == "ok" else check.replace(" Hz", " rev/s")
     from .predict_machine import machine_segments
 
     sa, _, hz = machine_segments(path, machine, cycles_per_segment=cond["cycles_per_segment"],
@@ -205,7 +212,8 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     off = abs(hz - cond["speed"]) / cond["speed"]
     note = "" if off <= cond["speed_tolerance"] else (
         f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
-    return sa, note
+    check = fit_speed_check(hz, seen)   # within the gate: the fit's own healthy speeds
+    return sa, note or ("" if check == "ok" else check)
 
 
 def estimate_recordings(model, recordings: pd.DataFrame, *,
