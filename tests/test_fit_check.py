@@ -284,7 +284,10 @@ def test_another_sensor_is_tried_only_when_the_example_is_not_read(monkeypatch):
     example_off = check_fit([0.16, 0.17], [0.24, 0.25], 0.5, example_self=0.19)
     passing = check_fit([0.05, 0.1], [0.45, 0.44], 0.5, example_self=0.40)
     assert not healthy_only.example_failed and example_off.example_failed
-    assert check_fit([0.0, 0.0], [0.5, 0.5], 0.5, example_self=0.2).example_failed
+    # the example's own reading counts where the verdict counts it: not when its
+    # record's other segments read right
+    assert not check_fit([0.0, 0.0], [0.5, 0.5], 0.5, example_self=0.2).example_failed
+    assert check_fit([0.0, 0.0], [0.5], 0.5, example_self=0.2).example_failed
     fit, tried = fits({names[0]: healthy_only, names[1]: passing})
     (est,), used, note = fit_with_sensor_choice(fit, machine, None)
     assert tried == [names[0]] and used == names[0] and note == ""

@@ -112,14 +112,18 @@ class FitCheck:
 
     @property
     def example_failed(self) -> bool:
-        """Whether the fit failed on the example side: the example record's other
-        segments (enough to check) or the example itself read more than
-        ``example_limit`` from the declared size."""
-        if self.declared_size is None:
+        """Whether the verdict fails the fit on the example side: its record's other
+        segments (enough to check) read more than ``example_limit`` from the declared
+        size, or the example itself does while they are too few or fail too."""
+        size = self.declared_size
+        if size is None:
             return False
-        off = [m for m in (self.example_mean if self.n_example >= MIN_HOLDOUTS else None,
-                           getattr(self, "example_self", None)) if m is not None]
-        return any(abs(m - self.declared_size) > self.example_limit for m in off)
+        mean = self.example_mean
+        checked = self.n_example >= MIN_HOLDOUTS and mean is not None
+        record_off = mean is not None and checked and abs(mean - size) > self.example_limit
+        own = getattr(self, "example_self", None)
+        own_off = own is not None and abs(own - size) > self.example_limit
+        return bool(record_off or (own_off and not checked))
 
     @property
     def checked(self) -> bool:
