@@ -78,6 +78,23 @@ def test_report_reads_predict_csv_new_json_and_bare_list(name, tmp_path):
     assert 'src="estimates.png"' not in page and "<td>faulty_rest</td>" in page
 
 
+def test_report_says_which_recordings_failed_the_speed_check(tmp_path):
+    frame = _frame()
+    frame["speed_check"] = ["ok"] * 3 + ["speed 39.90 Hz lies 33 % outside the fit's "
+                                         "healthy recordings' 29.92-29.92 Hz"] * 2
+    frame["trusted"] = [True, True, False, False, False]
+    write_predictions(frame, tmp_path / "p.json")
+    text = report_from_any_json(tmp_path / "p.json", tmp_path / "rep").read_text()
+    assert ("`speed_check`: failed for 1 recording(s) (b.zip: speed 39.90 Hz lies 33 % "
+            "outside") in text
+    assert "Trusted segments: 2 of 5 (input and speed checks ok" in text
+    # every recording ok: no speed line
+    frame["speed_check"] = "ok"
+    write_predictions(frame, tmp_path / "q.json")
+    assert "speed_check" not in report_from_any_json(tmp_path / "q.json",
+                                                     tmp_path / "rep2").read_text()
+
+
 def test_report_reads_the_demo_ablations_csv(tmp_path):
     rows = pd.DataFrame({"variant": ["full", "full", "before_da", "before_da"],
                          "repeat": [0, 1, 0, 1], "mae_percent": [10.0, 12.0, 30.0, 34.0]})

@@ -32,7 +32,7 @@ def short_value(value: Any) -> str:
 def predict_report(payload, out: Path, source: Path) -> Path:
     import pandas as pd
 
-    from .predict import summary_table
+    from .predict import speed_check_summary, summary_table
 
     frame = pd.DataFrame(predict_rows(payload))
     table = summary_table(frame)
@@ -49,10 +49,14 @@ def predict_report(payload, out: Path, source: Path) -> Path:
     if "comparable" in frame:
         lines += [f"Comparable segments: {int(frame['comparable'].astype(bool).sum())} of "
                   f"{len(frame)}.", ""]
+    speed = speed_check_summary(frame)
+    if speed:
+        lines += ["`" + speed.replace(": ", "`: ", 1) + ".", ""]
     if "trusted" in frame:
         lines += [f"Trusted segments: {int(frame['trusted'].astype(bool).sum())} of "
-                  f"{len(frame)} (input check ok, comparable, fit check passed); the figure "
-                  "draws the untrusted ones as hollow grey markers.", ""]
+                  f"{len(frame)} (input and speed checks ok, comparable, fit check passed, "
+                  "in a recording most of whose segments pass); the figure draws the "
+                  "untrusted ones as hollow grey markers.", ""]
     lines += _md_table(table)
     for caption, fig in figs.items():
         lines += [f"## {caption}", "", f"![{caption}]({fig.name})", ""]
