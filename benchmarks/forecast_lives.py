@@ -33,16 +33,11 @@ import pandas as pd
 
 from gearshot.monitor import forecast_crossing, load_model, read_history
 from gearshot.monitor.payload import current_records
-from gearshot.rig.history import growth_size
+from gearshot.rig.history import first_crossing, growth_size
 
 LIMIT = 0.6
 _LAWS = [("power", {"exponent": 1.5}), ("power", {"exponent": 2.0}), ("linear", {}),
          ("exponential", {"rate": 3.0})]
-
-
-def true_time(days: np.ndarray, sizes: np.ndarray) -> float:
-    i = int(np.nonzero(sizes >= LIMIT)[0][0])
-    return float(np.interp(LIMIT, sizes[i - 1:i + 1], days[i - 1:i + 1]))
 
 
 def synthetic(n: int, noise: float, gain: float, seed: int) -> list[dict]:
@@ -91,7 +86,7 @@ def score(lives: list[dict], oracle: bool = False) -> str:
         k = int(np.floor(0.7 * life["days"].size))
         use = life["trusted"][:k]
         t, y = life["days"][:k][use], life["pred"][:k][use]
-        now, truth = life["days"][k - 1], true_time(life["days"], life["size"])
+        now, truth = life["days"][k - 1], first_crossing(life["days"], life["size"], LIMIT)
         remaining = truth - now
         fc = forecast_crossing(t, y, LIMIT)
         if fc.time is not None:

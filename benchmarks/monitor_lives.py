@@ -27,16 +27,12 @@ DB = None
 
 def true_crossing(index: pd.DataFrame, level: float) -> pd.Timestamp | None:
     """Time the true size first reaches ``level`` (linear between recordings)."""
+    from gearshot.rig.history import first_crossing
+
     t = pd.to_datetime(index["time"], format="ISO8601")
-    y = index["size"].to_numpy(float)
-    above = np.nonzero(y >= level)[0]
-    if not above.size:
-        return None
-    i = above[0]
-    if i == 0:
-        return t.iloc[0]
-    frac = (level - y[i - 1]) / (y[i] - y[i - 1])
-    return t.iloc[i - 1] + frac * (t.iloc[i] - t.iloc[i - 1])
+    days = first_crossing(((t - t.iloc[0]) / pd.Timedelta(days=1)).to_numpy(),
+                          index["size"].to_numpy(float), level)
+    return None if days is None else t.iloc[0] + pd.Timedelta(days=days)
 
 
 def evaluate(seed: int, work: Path, database: str) -> list[dict]:

@@ -428,3 +428,16 @@ def test_fit_check_warning_names_the_verdict_and_passes_silently():
     assert model_warning(Model()) == f"{text}; {Model.extras['fit_warning']}"
     Model.fit_check, Model.extras = {"verdict": "passed"}, {}
     assert model_warning(Model()) is None
+
+
+def test_first_crossing_of_a_life_is_linear_between_recordings():
+    from gearshot.rig.history import first_crossing, growth_size
+
+    days = np.arange(40.0)
+    size = growth_size(days / 39, onset=0.3, end_size=0.8, law="power", exponent=1.5)
+    at = first_crossing(days, size, 0.6)
+    i = int(np.argmax(size >= 0.6))
+    assert days[i - 1] < at <= days[i]
+    assert np.interp(at, days, size) == pytest.approx(0.6)
+    assert first_crossing(days, size, 0.0) == 0.0          # healthy from the start: now
+    assert first_crossing(days, size, 0.9) is None          # never reached

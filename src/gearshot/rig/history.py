@@ -35,7 +35,7 @@ from .._atomic import atomic_path, check_writable, commit_staged, staging_dir
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int, check_load, check_positive, check_speed
 
-__all__ = ["record_history", "growth_size", "LAWS", "HISTORY_COLUMNS"]
+__all__ = ["record_history", "growth_size", "first_crossing", "LAWS", "HISTORY_COLUMNS"]
 
 #: Growth laws of :func:`growth_size`.
 LAWS = ("linear", "exponential", "power")
@@ -79,6 +79,26 @@ def growth_size(life: np.ndarray, *, onset: float, end_size: float, law: str = "
     else:
         g = v ** exponent
     return end_size * g
+
+
+def first_crossing(times: np.ndarray, sizes: np.ndarray, level: float) -> float | None:
+    """When a life's true size first reaches ``level``: linear between the recordings
+    (``times`` in any unit, e.g. days), the first time itself when it starts there, None
+    when it never does. What the monitoring benchmarks score an alarm and a forecast
+    against.
+
+    >>> first_crossing(np.array([0.0, 1.0, 2.0]), np.array([0.0, 0.4, 0.8]), 0.6)
+    1.5
+    """
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(sizes, dtype=float)
+    above = np.nonzero(y >= level)[0]
+    if not above.size:
+        return None
+    i = int(above[0])
+    if i == 0:
+        return float(t[0])
+    return float(t[i - 1] + (level - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]))
 
 
 def _episode(value, name: str, n: int, *, with_load: bool) -> tuple[int, int, float | None]:
