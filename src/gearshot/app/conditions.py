@@ -176,10 +176,11 @@ def check_database_pair(database: str | Path, machine) -> None:
 
 
 def fit_speed_check(speed: float, healthy_speeds: Sequence[float],
-                    tolerance: float = SPEED_TOLERANCE) -> str:
+                    tolerance: float = SPEED_TOLERANCE, *, unit: str = "Hz") -> str:
     """``"ok"``, or why a recording's speed is outside what the fit has seen: further than
     ``tolerance`` (relative to their mean) outside the range of the fit's healthy
-    recordings' speeds. Unknown speeds (NaN) pass.
+    recordings' speeds. Unknown speeds (NaN) pass. ``unit`` names the speeds' unit in
+    the reason ("Hz" of the tacho shaft with a machine file, "rev/s" without).
 
     >>> fit_speed_check(29.6, [29.1, 29.4])
     'ok'
@@ -193,5 +194,5 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float],
     off = max(lo - speed, speed - hi, 0.0) / float(known.mean())
     if off <= tolerance:
         return "ok"
-    return (f"speed {speed:.2f} Hz lies {100 * off:.0f} % outside the fit's healthy "
-            f"recordings' {lo:.2f}-{hi:.2f} Hz")
+    return (f"speed {speed:.2f} {unit} lies {100 * off:.0f} % outside the fit's healthy "
+            f"recordings' {lo:.2f}-{hi:.2f} {unit}")

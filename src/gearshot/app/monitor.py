@@ -203,8 +203,8 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
         health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
                                 pinion_teeth=cond["pinion_teeth"], health=health)
-        check = fit_speed_check(float(health.get("speed", np.nan)), seen)
-        return np.asarray(sa), "" if check == "ok" else check.replace(" Hz", " rev/s")
+        check = fit_speed_check(float(health.get("speed", np.nan)), seen, unit="rev/s")
+        return np.asarray(sa), "" if check == "ok" else check
     from .predict_machine import machine_segments
 
     sa, _, hz = machine_segments(path, machine, cycles_per_segment=cond["cycles_per_segment"],

@@ -138,7 +138,7 @@ def _fit_speed_checks(recordings: pd.Series, health: dict, healthy) -> list[str]
 
     speed = {k: float(v.get("speed", np.nan)) for k, v in health.items()}
     fitted = [speed.get(_key(p), np.nan) for p in healthy]
-    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted).replace(" Hz", " rev/s")
+    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted, unit="rev/s")
               for r in set(recordings)}
     return [checks[r] for r in recordings]
 

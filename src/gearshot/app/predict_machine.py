@@ -388,7 +388,8 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
-    tracked = [seg.sources[r]["speed_check"] for r in frame["recording"]]  # else: the fit's
-    frame["speed_check"] = [c if c != "ok" else fit_speed_check(seg.speeds[r], seg.healthy_speeds)
-                            for r, c in zip(frame["recording"], tracked, strict=True)]
+    checks = {r: seg.sources[r]["speed_check"] for r in set(frame["recording"])}
+    for r, c in checks.items():   # a tracked speed's check first, else the fit's speeds
+        checks[r] = c if c != "ok" else fit_speed_check(seg.speeds[r], seg.healthy_speeds)
+    frame["speed_check"] = frame["recording"].map(checks)
     return frame

@@ -241,7 +241,6 @@ def config_hash(obj) -> str:
     return hashlib.sha1(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
-
 def cached_family_fits(seeds, data, frf_folder=None, *, draws: int = 2):
     """Each (rig, draw) of the family over its cached segments, fitted with the library
     defaults as ``benchmarks/rig_family.py`` fits it: yields ``(rig, draw, dataset,

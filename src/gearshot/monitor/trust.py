@@ -21,6 +21,7 @@ __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust
            "change_notice", "one_run_warning", "fit_check_warning", "model_warning",
            "MIN_TRUSTED_SHARE", "CHANGE_RUN", "ONE_RUN_SPREAD"]
 
+
 def row_trust(frame: pd.DataFrame) -> np.ndarray:
     """Whether each row (segment) of a predict table can be acted on.
 
