@@ -37,7 +37,10 @@ PHM09 fits in the 30 Hz cells (both loads, both sensors) and rig seed 701. Held-
 703.
 
 Rates are per segment (``comparable``) and per recording (``record_comparable``: the
-record's median score, all its segments judged together).
+record's median score, all its segments judged together). ``with_speed`` is what a predict
+table's ``comparable`` holds: the SA's comparability and the recording's speed within what
+the fit's recordings showed (:func:`gearshot.app.conditions.fit_speed_check` on the tacho
+speeds; the rigs record at their set-point speeds).
 
     GEARSHOT_DATA=... PYTHONPATH=src python benchmarks/comparability_matrix.py --part dev
     GEARSHOT_DATA=... PYTHONPATH=src python benchmarks/comparability_matrix.py --part held-out
@@ -53,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from gearshot import Machine
+from gearshot.app.conditions import fit_speed_check
 from gearshot.estimator.comparability import fit_comparability
 from gearshot.estimator.fit_check import typical_segment
 
@@ -74,12 +78,13 @@ class _Phm:
         self.meshes = list(self.machine.mesh_orders(self.machine.monitored.shaft))
         self._read = machine_segments
         self._cache: dict[tuple[str, str], np.ndarray] = {}
+        self.speed: dict[str, float] = {}    # record name -> tacho speed, Hz
 
     def __call__(self, name: str, sensor: str) -> np.ndarray:
         if (name, sensor) not in self._cache:
-            self._cache[name, sensor] = self._read(
-                self.data / f"{name}.zip", self.machine, cycles_per_segment=10,
-                sensor=sensor)[0]
+            sa, _, speed = self._read(self.data / f"{name}.zip", self.machine,
+                                      cycles_per_segment=10, sensor=sensor)
+            self._cache[name, sensor], self.speed[name] = sa, float(speed)
         return self._cache[name, sensor]
 
 
@@ -89,10 +94,11 @@ def _fit_part(sa: np.ndarray) -> int:
 
 
 def _score(rows: list[dict], ref, setting: str, kind: str, record: str,
-           sa: np.ndarray) -> None:
+           sa: np.ndarray, speed_check: str = "ok") -> None:
     res = ref.evaluate(sa)
     rows.extend(dict(setting=setting, kind=kind, record=record, score=s, p_value=p,
-                     comparable=bool(c), record_comparable=res.record_comparable)
+                     comparable=bool(c), record_comparable=res.record_comparable,
+                     speed_check=speed_check, with_speed=bool(c) and speed_check == "ok")
                 for s, p, c in zip(res.score, res.p_value, res.comparable))
 
 
@@ -111,9 +117,12 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
                 ref = fit_comparability(healthy[:n_fit], phm.meshes,
                                         faulty_example=example[k], faulty_size=size)
                 setting = f"phm09 {sp}hz_{ld} {se}"
+                fit_speeds = [phm.speed[f"spur3_{sp}hz_{ld}_1"], phm.speed[f"spur2_{sp}hz_{ld}_1"]]
 
-                def add(kind, record, sa, ref=ref, setting=setting):
-                    _score(rows, ref, setting, kind, record, sa)
+                def add(kind, record, sa, ref=ref, setting=setting, fit_speeds=fit_speeds):
+                    speed = phm.speed[record.split()[0]]
+                    _score(rows, ref, setting, kind, record, sa,
+                           fit_speed_check(speed, fit_speeds))
                 add("same machine", f"spur3_{sp}hz_{ld}_1 hold-out", healthy[n_fit:])
                 add("same machine", f"spur2_{sp}hz_{ld}_1 rest", np.delete(example, k, 0))
                 for case in ("spur3", "spur2"):
@@ -136,9 +145,12 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
             ref = fit_comparability(np.vstack([f[:_fit_part(f)] for f in fit]), phm.meshes,
                                     faulty_example=ex[typical_segment(ex)],
                                     faulty_size=size)
+            fit_speeds = [phm.speed[f"{c}_{sp}hz_High_1"] for c in ("spur1", "spur3", "spur2")]
             for case in ("spur1", "spur2", "spur3"):
-                _score(rows, ref, f"phm09 {sp}hz journey {se}", "another load",
-                       f"{case}_{sp}hz_Low_1", phm(f"{case}_{sp}hz_Low_1", se))
+                name = f"{case}_{sp}hz_Low_1"
+                sa = phm(name, se)
+                _score(rows, ref, f"phm09 {sp}hz journey {se}", "another load", name, sa,
+                       fit_speed_check(phm.speed[name], fit_speeds))
     return rows
 
 
@@ -156,8 +168,8 @@ def rig_rows(seed: int) -> list[dict]:
     setting = f"rig {seed}"
     rows: list[dict] = []
 
-    def add(kind, record, sa):
-        _score(rows, ref, setting, kind, record, sa)
+    def add(kind, record, sa, speed=15.0):   # the rigs record at their set-points
+        _score(rows, ref, setting, kind, record, sa, fit_speed_check(speed, [15.0]))
     add("same machine", "healthy rep 5", _rig_sa(rig, rep=5))
     add("same machine", "size 0.6 rep 0 rest", np.delete(example, k, 0))
     for size, rep in ((0.3, 0), (0.3, 1), (0.6, 1)):
@@ -175,7 +187,8 @@ def rig_rows(seed: int) -> list[dict]:
     }
     for (kind, what), (other, kw) in others.items():
         for size in (0.0, 0.6):
-            add(kind, f"{what}, size {size}", _rig_sa(other, size=size, rep=0, **kw))
+            add(kind, f"{what}, size {size}", _rig_sa(other, size=size, rep=0, **kw),
+                speed=kw.get("speed", 15.0))
     return rows
 
 
@@ -186,7 +199,8 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
     out = table.groupby(["source", "kind"], sort=False).agg(
         segments=("comparable", "size"), records=("pair", "nunique"),
         flagged=("comparable", lambda c: 1 - c.mean()),
-        record_flagged=("record_comparable", lambda c: 1 - c.mean()))
+        record_flagged=("record_comparable", lambda c: 1 - c.mean()),
+        with_speed=("with_speed", lambda c: 1 - c.mean()))
     return out.reset_index()
 
 
@@ -208,13 +222,16 @@ def main() -> None:
     out = args.out or ROOT / "benchmarks" / "results" / f"comparability_matrix_{args.part}.csv"
     out.parent.mkdir(parents=True, exist_ok=True)
     table.to_csv(out, index=False, float_format="%.4g")
-    fmt = {"flagged": "{:.1%}".format, "record_flagged": "{:.1%}".format}
+    fmt = {"flagged": "{:.1%}".format, "record_flagged": "{:.1%}".format,
+           "with_speed": "{:.1%}".format}
     print(f"part: {args.part}")
     print(summary(table).to_string(index=False, formatters=fmt))
-    per = table.groupby(["setting", "kind"], sort=False).comparable.agg(
-        n="size", flagged=lambda c: 1 - c.mean()).unstack("kind")["flagged"]
-    with pd.option_context("display.width", 250):
-        print(per.to_string(float_format=lambda v: f"{v:.2f}"))
+    for column in ("comparable", "with_speed"):
+        per = table.groupby(["setting", "kind"], sort=False)[column].agg(
+            n="size", flagged=lambda c: 1 - c.mean()).unstack("kind")["flagged"]
+        print(f"flagged per fit ({column}):")
+        with pd.option_context("display.width", 250):
+            print(per.to_string(float_format=lambda v: f"{v:.2f}"))
     rig = table[table.setting.str.startswith("rig")]
     if len(rig):
         state = np.where(rig.record.str.contains("size 0.0|healthy"), "healthy state",

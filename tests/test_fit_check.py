@@ -474,9 +474,15 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
     from gearshot.app.predict import speed_check_summary
     from gearshot.app.predict_machine import predict_from_machine
 
-    assert fit_speed_check(31.0, [29.2, 29.9]) == "ok"          # 3.7 % above the range
+    # beyond the range of the fit's speeds by more than 6 relative standard deviations of
+    # them (0.67 % here: 4 %), and at least 0.3 %
+    assert fit_speed_check(15.65, [15.0, 15.1, 14.9]) == "ok"
+    assert fit_speed_check(15.75, [15.0, 15.1, 14.9]) != "ok"
+    assert fit_speed_check(14.25, [15.0, 15.1, 14.9]) != "ok"
+    assert fit_speed_check(29.92, [29.9]) == "ok"                 # 0.07 %: one run to the next
+    assert fit_speed_check(29.72, [29.9]).endswith("(another load?)")   # 0.6 %
     assert fit_speed_check(float("nan"), [29.2]) == "ok"
-    assert fit_speed_check(27.0, [29.2, 29.9]).startswith("speed 27.00 Hz lies 7 % outside")
+    assert fit_speed_check(27.0, [29.9]).startswith("speed 27.00 Hz lies 9.7 % outside")
     frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
                                  [_record("spur3_30hz_High_1.zip")],
                                  _record("spur2_30hz_High_1.zip"), 0.5,
@@ -493,6 +499,32 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
         speed_check_summary(frame)
 
 
+def test_another_load_runs_at_another_speed_and_is_not_comparable(spur_db):
+    """The PHM09 motor runs about 1.5 % slower at "Low" load than at "High": under a High
+    fit the chipped gear's Low record (0.6 % below the fit's recordings, its regular part
+    close to a larger fault of the High machine) is not comparable and says why; run 2 of
+    the Low condition, whose speeds the Low fit's two recordings span, stays comparable."""
+    from gearshot.app.predict_machine import predict_from_machine
+
+    def fit(load, others):
+        frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
+                                     [_record(f"spur3_30hz_{load}_1.zip")],
+                                     _record(f"spur2_30hz_{load}_1.zip"), 0.5,
+                                     [_record(n) for n in others], speed=30.0, load=10.0,
+                                     cycles_per_segment=10, seed=0)
+        return frame, frame["recording"].map(lambda r: Path(r).name)
+
+    frame, name = fit("High", ["spur2_30hz_Low_1.zip", "spur2_30hz_High_2.zip"])
+    low = frame[name == "spur2_30hz_Low_1.zip"]
+    assert len(low) and not low["comparable"].any() and not low["trusted"].any()
+    assert low["speed_check"].str.match(
+        r"speed 29\.72 Hz lies 0\.\d+ % outside the fit's recordings' 29\.89-29\.92 Hz "
+        r"\(another load\?\)$").all()
+    assert (frame.loc[name == "spur2_30hz_High_2.zip", "speed_check"] == "ok").all()
+    frame, name = fit("Low", ["spur2_30hz_Low_2.zip", "spur3_30hz_Low_2.zip"])
+    assert (frame.loc[name.str.endswith("_2.zip"), "speed_check"] == "ok").all()
+
+
 def test_without_a_machine_file_the_measured_speeds_are_checked_too(tmp_path):
     """``gearshot predict`` without ``--machine``: each recording's measured speed (rev/s,
     kept by the fit's read) against the healthy recordings'."""
@@ -504,5 +536,5 @@ def test_without_a_machine_file_the_measured_speeds_are_checked_too(tmp_path):
     rows = pd.Series([str(h1), str(fast), str(fast), str(unknown)])
     checks = _fit_speed_checks(rows, health, [h1, h2])
     assert checks[0] == "ok" and checks[3] == "ok" and checks[1] == checks[2]
-    assert checks[1] == ("speed 20.00 rev/s lies 33 % outside the fit's healthy recordings' "
+    assert checks[1] == ("speed 20.00 rev/s lies 33 % outside the fit's recordings' "
                          "15.00-15.10 rev/s")

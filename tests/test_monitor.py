@@ -199,7 +199,7 @@ def test_a_recording_at_a_speed_the_fit_never_saw_is_untrusted(machine, tmp_path
     at15, at18 = payload["records"]
     assert "speed" not in (at15["note"] or "")
     assert not at18["trusted"] and not at18["alarm"] and at18["predicted"] is not None
-    assert at18["note"].startswith("speed 18.") and "% outside the fit's healthy " \
+    assert at18["note"].startswith("speed 18.") and "% outside the fit's " \
         "recordings' 1" in at18["note"] and at18["note"].endswith("rev/s")
 
 

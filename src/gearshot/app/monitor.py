@@ -110,9 +110,11 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         toml = None
         speeds = [float(fitted.health[Path(p).resolve()].get("speed", np.nan))
                   for p in healthy]   # measured when the fit read them
+        example_speed = np.nan if faulty is None else float(
+            fitted.health[Path(faulty).resolve()].get("speed", np.nan))
         sensor_note = ""
     else:
-        est, baseline, condition, speeds, sensor_note = _fit_with_machine(
+        est, baseline, condition, speeds, example_speed, sensor_note = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
             coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
             holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
@@ -128,6 +130,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         fit_check=getattr(est, "fit_check_", None), coverage=float(coverage), seed=int(seed),
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
                 "grade": getattr(est, "grade_", None), "healthy_speeds": list(speeds),
+                "example_speed": None if not np.isfinite(example_speed) else example_speed,
                 "fit_warning": one_run_warning(speeds), "sensor_note": sensor_note})
     result.save(model)
     return result
@@ -160,8 +163,9 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
 
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
-    """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds and
-    why the sensor is not the machine's first ("" when it is:
+    """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds,
+    the faulty recording's speed (NaN without one) and why the sensor is not the
+    machine's first ("" when it is:
     :mod:`gearshot.app.sensor_choice`)."""
     from ..machine import Machine
     from .predict import estimate_segments
@@ -185,18 +189,21 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
                  "speed_tolerance": float(speed_tolerance)}
     speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")])
     return (est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()],
-            seg.sensor_note)
+            float(seg.example_speed), seg.sensor_note)
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     """SA segments of one recording as the model's fit segmented its recordings, and a
     note ("" or why the recording is not covered: with a machine file, a tacho speed
-    beyond the model's speed tolerance; with or without one, a speed more than 5 %
-    outside the fit's healthy recordings', :func:`gearshot.app.conditions.fit_speed_check`)."""
+    beyond the model's speed tolerance; with or without one, a speed outside the fit's
+    recordings', healthy and the faulty example:
+    :func:`gearshot.app.conditions.fit_speed_check`)."""
     from .conditions import fit_speed_check
 
     cond = model.condition
-    seen = (getattr(model, "extras", None) or {}).get("healthy_speeds") or []
+    extras = getattr(model, "extras", None) or {}
+    seen = [*(extras.get("healthy_speeds") or []),
+            *([] if extras.get("example_speed") is None else [extras["example_speed"]])]
     if machine is None:
         from ..io import recording_segments
 

@@ -107,7 +107,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
                             fit.health, start=1))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
-    frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy)
+    frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health,
+                                             [*healthy, *([] if faulty is None else [faulty])])
     add_trust_columns(frame, est.fit_check_)
     frame.attrs.update(fit_attrs(est))
     return frame
@@ -131,13 +132,14 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
                                               rows=rows["segment"]))
 
 
-def _fit_speed_checks(recordings: pd.Series, health: dict, healthy) -> list[str]:
+def _fit_speed_checks(recordings: pd.Series, health: dict, fit_files) -> list[str]:
     """Per row: :func:`gearshot.app.conditions.fit_speed_check` of its recording's
-    measured speed (rev/s) against the healthy recordings' (unknown speeds pass)."""
+    measured speed (rev/s) against the fit's recordings' (``fit_files``: the healthy
+    recordings and the faulty one; unknown speeds pass)."""
     from .conditions import fit_speed_check
 
     speed = {k: float(v.get("speed", np.nan)) for k, v in health.items()}
-    fitted = [speed.get(_key(p), np.nan) for p in healthy]
+    fitted = [speed.get(_key(p), np.nan) for p in fit_files]
     checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted, unit="rev/s")
               for r in set(recordings)}
     return [checks[r] for r in recordings]

@@ -269,6 +269,7 @@ class _Segments:
     example: np.ndarray | None = None           # the faulty example's SA
     speeds: dict = field(default_factory=dict)  # file -> tacho speed, Hz
     healthy_speeds: list = field(default_factory=list)
+    example_speed: float = float("nan")          # the faulty recording's tacho speed, Hz
     sources: dict = field(default_factory=dict)  # file -> speed_source, uncertainty
     sensor: str = ""                             # the sensor the SAs are of
     sensor_note: str = ""                        # why it is not the machine's first
@@ -309,6 +310,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
                         for k in range(n_fit, sa.shape[0]))
     if faulty is not None:
         fsa, _, fsp = cut(faulty)
+        seg.example_speed = fsp
         _require_fit_input(seg.sources[str(faulty)], faulty, "faulty")
         example_segment = typical_segment(fsa) if example_segment is None else check_int(
             example_segment, "example_segment", minimum=0, maximum=fsa.shape[0] - 1)
@@ -390,6 +392,7 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
                                      for r in frame["recording"]]
     checks = {r: seg.sources[r]["speed_check"] for r in set(frame["recording"])}
     for r, c in checks.items():   # a tracked speed's check first, else the fit's speeds
-        checks[r] = c if c != "ok" else fit_speed_check(seg.speeds[r], seg.healthy_speeds)
+        checks[r] = c if c != "ok" else fit_speed_check(
+            seg.speeds[r], [*seg.healthy_speeds, seg.example_speed])
     frame["speed_check"] = frame["recording"].map(checks)
     return frame

@@ -11,7 +11,11 @@ __all__ = ["add_trust_columns", "fit_check_line", "trust_summary"]
 def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
     """Add the fit's verdict and ``trusted`` to a predict table, in place.
 
-    ``fit_check``: ``check.verdict`` in every row ("passed" or the reason); ``trusted``:
+    ``comparable``: false too where ``speed_check`` failed (the recording's speed lies
+    outside what the fit's recordings showed: another operating condition,
+    :func:`gearshot.app.conditions.fit_speed_check`; ``comparability``, the p-value of its
+    SA, is left as it is); ``fit_check``: ``check.verdict`` in every row ("passed" or the
+    reason); ``trusted``:
     :func:`gearshot.estimator.trusted_column` (input check "ok" — a table without
     ``input_check`` counts as "ok" —, comparable and the fit check passed; with a
     ``recording`` column, only in a recording more than half of whose segments pass:
@@ -20,6 +24,9 @@ def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
     """
     from ..estimator.fit_check import recording_majority, trusted_column
 
+    if "speed_check" in frame and "comparable" in frame:
+        frame["comparable"] = frame["comparable"].astype(bool) & (
+            frame["speed_check"].astype(str) == "ok")
     frame["fit_check"] = check.verdict
     frame["trusted"] = trusted_column(frame) if len(frame) else pd.Series(dtype=bool)
     if "recording" in frame and len(frame):

@@ -59,8 +59,9 @@ _HELP = {
                "intervals.",
     "tolerance": "With --machine: largest relative distance between a recording's tacho "
                  "speed and the database condition (beyond it the recording is refused; "
-                 "within it, a recording more than 5 % outside the fit's healthy "
-                 "recordings' speeds is estimated but not trusted: speed_check).",
+                 "within it, a recording whose speed lies outside the fit's recordings' "
+                 "speeds by more than their run-to-run spread, at least 0.3 %, is "
+                 "estimated but not trusted: speed_check).",
     "speed_hint": "Nominal speed (Hz) of the machine's reference shaft for every record "
                   "without a tacho and without its own FILE@HZ: the speed is searched "
                   "within ±10 % of it (instead of the machine file's [speed] range_hz), so "
