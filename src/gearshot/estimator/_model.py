@@ -266,9 +266,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         """The mesh orders as the signal functions take them (an int or a list of ints):
         those of the fit under way, else ``mesh_orders_`` (else, for an estimator saved
         before ``mesh_orders_`` existed, ``mesh_order``)."""
-        orders = self.__dict__.get("_fitting_orders") or self.__dict__.get("mesh_orders_")
-        if orders is None:
-            orders = as_orders(self.mesh_order)
+        orders = (self.__dict__.get("_fitting_orders") or self.__dict__.get("mesh_orders_")
+                  or as_orders(self.mesh_order))
         return orders[0] if len(orders) == 1 else list(orders)
 
     # ------------------------------------------------------------------ fit
@@ -347,7 +346,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             del self._fitting_orders
         self.fit_check_ = check_holdouts(self.predict, holdouts, len(self.references_) + len(
             self.target_healthy_features_), self.faulty_size_, faulty_example)  # + the example
-        return holdout_detection(self)   # a passed check: the limit from the hold-outs
+        if (limit := holdout_detection(self.fit_check_)) is not None:   # a passed check
+            self.detection_limit_ = self.detection_threshold_ = limit  # from the hold-outs
+        return self
 
     def _fit(self, database: Any, target_healthy: ArrayLike, recordings: Any,
              faulty_example: ArrayLike | None, faulty_size: float | None,
@@ -395,6 +396,5 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             simulated_reference_=reference, comparability_reference_=comparability,
             mesh_orders_=orders, detection_limit_=detection.limit,
             detection_threshold_=detection.threshold, **grade_choice)
-        for name, value in learned.items():
-            setattr(self, name, value)
+        self.__dict__.update(learned)
         return self

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -44,7 +44,6 @@ __all__ = ["DETECTION_CONFIDENCE", "DetectionLimit", "below_detection_limit",
            "detection_limit", "holdout_detection"]
 
 FloatArray = NDArray[np.float64]
-_Estimator = TypeVar("_Estimator")
 
 #: Share of healthy estimates below the threshold (the limit's stated confidence).
 DETECTION_CONFIDENCE = 0.95
@@ -133,26 +132,19 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
                           float(confidence))
 
 
-def holdout_detection(estimator: _Estimator,
-                      confidence: float = DETECTION_CONFIDENCE) -> _Estimator:
-    """Set a fitted estimator's ``detection_limit_`` (and ``detection_threshold_``) from
-    its hold-outs when its fit check passed (module docstring); otherwise leave them.
-
-    Returns
-    -------
-    The estimator.
+def holdout_detection(check: Any, confidence: float = DETECTION_CONFIDENCE) -> float | None:
+    """The detection limit a fit takes from its hold-outs (module docstring): the lower
+    half-width of its hold-out-calibrated interval at ``2 · confidence - 1``, when its
+    fit check (``fit_check_``, a :class:`~gearshot.estimator.fit_check.FitCheck`) passed
+    with healthy and example hold-outs; otherwise None (the simulated limit stands).
     """
     from .uncertainty import holdout_interval
 
-    check = getattr(estimator, "fit_check_", None)
     if check is None or not check.passed or not check.n_healthy or not check.n_example:
-        return estimator
+        return None
     healthy, example = check.residuals()
     low, _ = holdout_interval(np.zeros(1), healthy, example, 2 * confidence - 1)
-    limit = float(min(-low[0], 1.0))
-    setattr(estimator, "detection_limit_", limit)   # noqa: B010 (any fitted estimator)
-    setattr(estimator, "detection_threshold_", limit)   # noqa: B010
-    return estimator
+    return float(min(-low[0], 1.0))
 
 
 def below_detection_limit(estimator: Any, estimates: ArrayLike) -> NDArray[np.bool_]:
