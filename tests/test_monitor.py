@@ -83,6 +83,8 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     speeds = back.extras["healthy_speeds"]
     assert len(speeds) == 4 and np.allclose(speeds, 15.0, rtol=0.02)
     assert back.extras["fit_warning"] == one_run_warning(speeds)
+    # and the faulty recording's: a later recording's speed is checked against all of them
+    assert back.extras["example_speed"] == pytest.approx(15.0, rel=0.02)
     # the faulty recording gives 2 segments: the example and one other, too few for the
     # fit check; the model says so wherever it is used (its estimates cannot be trusted)
     from gearshot.monitor.trust import model_warning
@@ -319,6 +321,7 @@ def test_fit_and_monitor_with_a_machine_file_on_phm09(tmp_path):
     assert model.machine.name and model.machine_toml == spur.read_text(encoding="utf-8")
     assert model.condition["speed_unit"] == "Hz (tacho shaft)" and model.baseline
     assert len(model.extras["healthy_speeds"]) == 2 and model.extras["fit_warning"] is None
+    assert model.extras["example_speed"] is None                      # zero-shot: no example
     rows = [("spur2_30hz_High_1.zip", "2026-01-01T00:00:00", 10),
             ("spur2_30hz_High_2.zip", "2026-01-02T00:00:00", 10),
             ("spur2_30hz_Low_1.zip", "2026-01-03T00:00:00", 5)]
