@@ -383,8 +383,14 @@ def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
     apart = est.trust(healthy[-2:], input_check=["ok", "dead channel"],
                       recording=["r1", "r2"])
     assert apart["trusted"].tolist() == [True, False]
+    # a recording at a speed the fit has not seen: not comparable, not trusted
+    slow = est.trust(healthy[-2:], speed_check=["ok", "speed 29.10 Hz lies 1.1 % outside …"])
+    assert slow["comparable"].tolist() == [True, False]
+    assert slow["trusted"].tolist() == [True, False]
     with pytest.raises(GearshotError, match="input_check holds 1 value"):
         est.trust(healthy[-2:], input_check=["ok"])
+    with pytest.raises(GearshotError, match="speed_check holds 3 value"):
+        est.trust(healthy[-2:], speed_check=["ok"] * 3)
     with pytest.raises(GearshotError, match="recording holds 3 value"):
         est.trust(healthy[-2:], recording=["a", "b", "c"])
 

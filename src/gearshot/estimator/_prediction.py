@@ -115,7 +115,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         return reference.evaluate(sa, false_alarm_rate)
 
     def trust(self, sa: ArrayLike, input_check: Any = None, *,
-              coverage: float = 0.9, recording: Any = None) -> Any:
+              coverage: float = 0.9, recording: Any = None, speed_check: Any = None) -> Any:
         """Every estimate with the checks it passed or failed (issue #29).
 
         Parameters
@@ -131,6 +131,12 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             recording more than half of whose segments pass every check
             (:func:`~gearshot.estimator.fit_check.recording_majority`), as ``gearshot
             predict`` does.
+        speed_check : str or sequence of str, optional
+            Whether each SA's recording ran at a speed the fit has seen ("ok" or why not,
+            one for all or one per SA; e.g.
+            :func:`gearshot.app.conditions.fit_speed_check` of its speed against the fit's
+            recordings'): a segment that fails it is not comparable, as in ``gearshot
+            predict``'s tables. None: "ok".
 
         Returns
         -------
@@ -140,7 +146,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             (:meth:`comparability`: its p-value and verdict), ``input_check``,
             ``fit_check`` (the fit's verdict, ``fit_check_.verdict``: "passed" or the
             reason) and ``trusted``: the input
-            check is "ok", the segment is comparable and the fit check passed.
+            check is "ok", the segment is comparable (and its speed check "ok") and the
+            fit check passed.
         """
         import pandas as pd
 
@@ -153,6 +160,9 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
                                   comparability=comp.p_value, comparable=comp.comparable))
         frame["input_check"] = "ok" if input_check is None else _per_row(
             input_check, len(arr), "input_check")
+        if speed_check is not None:
+            frame["comparable"] &= pd.Series(_per_row(speed_check, len(arr), "speed_check"),
+                                             index=frame.index) == "ok"
         check: FitCheck | None = getattr(self, "fit_check_", None)
         frame["fit_check"] = "unchecked: fitted before the fit check existed" \
             if check is None else check.verdict
