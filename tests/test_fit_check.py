@@ -489,6 +489,13 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
     assert fit_speed_check(29.72, [29.9]).endswith("(another load?)")   # 0.6 %
     assert fit_speed_check(float("nan"), [29.2]) == "ok"
     assert fit_speed_check(27.0, [29.9]).startswith("speed 27.00 Hz lies 9.7 % outside")
+    # 3 or more healthy recordings of one run (within 0.2 %) cannot show how a later run's
+    # speed moves: the database gate's 5 % bounds it (a virtual rig's one-set-point fit
+    # campaign and its life, whose runs vary 1 %)
+    one_run = [15.0, 15.001, 14.999, 15.0]
+    assert fit_speed_check(15.3, one_run, example_speed=15.0) == "ok"
+    assert fit_speed_check(16.0, one_run, example_speed=15.0).startswith("speed 16.00 Hz lies 6.7")
+    assert fit_speed_check(15.3, one_run[:2], example_speed=15.0) != "ok"   # 2: not one run
     frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
                                  [_record("spur3_30hz_High_1.zip")],
                                  _record("spur2_30hz_High_1.zip"), 0.5,

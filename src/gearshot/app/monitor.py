@@ -202,15 +202,15 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
 
     cond = model.condition
     extras = getattr(model, "extras", None) or {}
-    seen = [*(extras.get("healthy_speeds") or []),
-            *([] if extras.get("example_speed") is None else [extras["example_speed"]])]
+    seen, example = extras.get("healthy_speeds") or [], extras.get("example_speed")
     if machine is None:
         from ..io import recording_segments
 
         health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
                                 pinion_teeth=cond["pinion_teeth"], health=health)
-        check = fit_speed_check(float(health.get("speed", np.nan)), seen, unit="rev/s")
+        check = fit_speed_check(float(health.get("speed", np.nan)), seen,
+                                example_speed=example, unit="rev/s")
         return np.asarray(sa), "" if check == "ok" else check
     from .predict_machine import machine_segments
 
@@ -219,7 +219,7 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     off = abs(hz - cond["speed"]) / cond["speed"]
     note = "" if off <= cond["speed_tolerance"] else (
         f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
-    check = fit_speed_check(hz, seen)   # within the gate: the fit's own healthy speeds
+    check = fit_speed_check(hz, seen, example_speed=example)   # within the gate: the fit's
     return sa, note or ("" if check == "ok" else check)
 
 

@@ -107,8 +107,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
                             fit.health, start=1))
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
-    frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health,
-                                             [*healthy, *([] if faulty is None else [faulty])])
+    frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy, faulty)
     add_trust_columns(frame, est.fit_check_)
     frame.attrs.update(fit_attrs(est))
     return frame
@@ -132,15 +131,18 @@ def _rows(est, path, roles, sa, coverage, health, start: int = 0) -> pd.DataFram
                                               rows=rows["segment"]))
 
 
-def _fit_speed_checks(recordings: pd.Series, health: dict, fit_files) -> list[str]:
+def _fit_speed_checks(recordings: pd.Series, health: dict, healthy, faulty=None
+                      ) -> list[str]:
     """Per row: :func:`gearshot.app.conditions.fit_speed_check` of its recording's
-    measured speed (rev/s) against the fit's recordings' (``fit_files``: the healthy
-    recordings and the faulty one; unknown speeds pass)."""
+    measured speed (rev/s) against the fit's recordings' (the healthy recordings and the
+    faulty one; unknown speeds pass)."""
     from .conditions import fit_speed_check
 
     speed = {k: float(v.get("speed", np.nan)) for k, v in health.items()}
-    fitted = [speed.get(_key(p), np.nan) for p in fit_files]
-    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted, unit="rev/s")
+    fitted = [speed.get(_key(p), np.nan) for p in healthy]
+    example = None if faulty is None else speed.get(_key(faulty), np.nan)
+    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted, example_speed=example,
+                                 unit="rev/s")
               for r in set(recordings)}
     return [checks[r] for r in recordings]
 

@@ -393,6 +393,6 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     checks = {r: seg.sources[r]["speed_check"] for r in set(frame["recording"])}
     for r, c in checks.items():   # a tracked speed's check first, else the fit's speeds
         checks[r] = c if c != "ok" else fit_speed_check(
-            seg.speeds[r], [*seg.healthy_speeds, seg.example_speed])
+            seg.speeds[r], seg.healthy_speeds, example_speed=seg.example_speed)
     frame["speed_check"] = frame["recording"].map(checks)
     return frame
