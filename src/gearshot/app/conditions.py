@@ -23,8 +23,9 @@ and ``comparable`` false) when its speed lies outside the speeds of the fit's ow
 recordings (healthy and the faulty example) by more than their run-to-run spread allows
 (:func:`fit_speed_check`): further than :data:`RUN_SPEED_SPREADS` of their relative
 standard deviations beyond their range, and at least :data:`RUN_SPEED_FLOOR` beyond it.
-A machine's speed tells its operating condition: an induction motor slips more under a
-heavier load, so another load runs at another speed, and the PHM 2009 gearbox runs about
+A machine's speed tells its operating condition: a motor's slip (or its drive's
+response) changes with the load, so another load runs at another speed; the PHM 2009
+gearbox runs about
 1.5 % slower at its "Low" load than at "High" at every case and speed (30 Hz: High
 29.89-29.92 Hz, Low 29.41-29.72 Hz), while a run recorded again at the same condition
 lies within 0.07 % of the first (the chipped gear's Low records: 0.65 %, and the fit's
