@@ -25,9 +25,9 @@ recordings (healthy and the faulty example) by more than their run-to-run spread
 standard deviations beyond their range, and at least :data:`RUN_SPEED_FLOOR` beyond it.
 A machine's speed tells its operating condition: a motor's slip (or its drive's
 response) changes with the load, so another load runs at another speed; the PHM 2009
-gearbox runs about
-1.5 % slower at its "Low" load than at "High" at every case and speed (30 Hz: High
-29.89-29.92 Hz, Low 29.41-29.72 Hz), while a run recorded again at the same condition
+gearbox runs about 1.5 % slower at its "Low" load than at "High" at every case and speed
+(30 Hz: High 29.89-29.92 Hz, Low 29.41-29.72 Hz), while a run recorded again at the same
+condition
 lies within 0.07 % of the first (the chipped gear's Low records: 0.65 %, and the fit's
 example record spans them). When 3 or more healthy recordings ran within 0.2 % of one
 speed (recorded as one run: ``gearshot fit``'s one-run warning), their speeds cannot
@@ -67,9 +67,8 @@ SPEED_TOLERANCE = 0.05
 #: Smallest relative distance beyond the fit's recordings' speeds that fails
 #: :func:`fit_speed_check` (unless its healthy recordings ran as one run): above what
 #: the supply frequency moves a mains-fed motor (about ±0.2 %: ±0.1 Hz on 50 Hz) and the
-#: 0.07 % between two runs of one PHM09
-#: condition, below the 0.58 % of the nearest other load (chosen on the 30 Hz PHM09
-#: records, ``benchmarks/comparability_matrix.py``).
+#: 0.07 % between two runs of one PHM09 condition, below the 0.58 % of the nearest other
+#: load (chosen on the 30 Hz PHM09 records, ``benchmarks/comparability_matrix.py``).
 RUN_SPEED_FLOOR = 0.003
 
 #: Relative standard deviations of the fit's recordings' speeds beyond their range that

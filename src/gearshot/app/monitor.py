@@ -219,7 +219,7 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     off = abs(hz - cond["speed"]) / cond["speed"]
     note = "" if off <= cond["speed_tolerance"] else (
         f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
-    check = fit_speed_check(hz, seen, example_speed=example)   # within the gate: the fit's
+    check = fit_speed_check(hz, seen, example_speed=example)   # within the gate
     return sa, note or ("" if check == "ok" else check)
 
 
