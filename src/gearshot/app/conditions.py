@@ -27,13 +27,12 @@ A machine's speed tells its operating condition: a motor's slip (or its drive's
 response) changes with the load, so another load runs at another speed; the PHM 2009
 gearbox runs about 1.5 % slower at its "Low" load than at "High" at every case and speed
 (30 Hz: High 29.89-29.92 Hz, Low 29.41-29.72 Hz), while a run recorded again at the same
-condition
-lies within 0.07 % of the first (the chipped gear's Low records: 0.65 %, and the fit's
-example record spans them). When 3 or more healthy recordings ran within 0.2 % of one
-speed (recorded as one run: ``gearshot fit``'s one-run warning), their speeds cannot
-show how far a later run's moves, and the bound is :data:`SPEED_TOLERANCE`: a virtual
-rig's fit campaign recorded at one set-point must not untrust the life it watches,
-whose runs vary 1 %. Measured on the PHM09 spur records (the README database, a
+condition lies within 0.07 % of the first (the chipped gear's Low records: 0.65 %, and
+the fit's example record spans them). When 3 or more healthy recordings ran within 0.2 %
+of one speed (recorded as one run: ``gearshot fit``'s one-run warning), their speeds
+cannot show how far a later run's moves, and the bound is :data:`SPEED_TOLERANCE`: a
+virtual rig's fit campaign recorded at one set-point must not untrust the life it
+watches, whose runs vary 1 %. Measured on the PHM09 spur records (the README database, a
 30 Hz High fit, ``--speed-tolerance 0.5``): the healthy gear's 40 Hz run-2 record read
 0.77 with 8 of its 15 segments comparable; under the README journey's High fit the
 chipped gear's Low record read 0.73 [0.52, 1.00], comparable: both are refused trust now.
