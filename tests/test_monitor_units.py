@@ -276,11 +276,13 @@ def test_untrusted_counts_group_the_reasons_and_monitor_prints_them():
              "index load 5 N m is outside the fitted 10 N m", "",
              "fit check: healthy hold-outs read 0.23 on average (limit 0.15); 1 of 2 "
              "segments not comparable with the fitted machine (...)",
-             "not estimated: 'x.h5' holds 3 revolution(s)"]
+             "not estimated: 'x.h5' holds 3 revolution(s)",
+             "speed 14.70 rev/s lies 1.5 % outside the fit's recordings' 14.95-15.05 rev/s"]
     assert untrusted_counts(notes) == {
         "not comparable with the fitted machine": 2,
         "outside the fitted condition (index speed or load)": 1, "fit check failed": 1,
-        "not estimated (unreadable or too short)": 1}
+        "not estimated (unreadable or too short)": 1,
+        "speed outside the fit's recordings' (another load?)": 1}
     records = [{"recording": "a.h5", "time": "2026-01-01T00:00:00", "predicted": 0.1,
                 "low": 0.0, "high": 0.3, "trusted": False, "alarm": False, "note": n}
                for n in notes[:2]]
@@ -361,6 +363,9 @@ def test_change_notice_speaks_after_a_run_of_recordings_not_comparable(tmp_path)
     assert "zero-shot" in zero and "example" not in zero
     assert change_notice(times, trusted[:-1] + [True], notes) is None   # back to normal
     assert change_notice(times[:5], trusted[:5], notes[:5]) is None     # a run of 2
+    # a run at a speed outside the fit's recordings' (another load or speed) is one too
+    slow = "speed 14.70 rev/s lies 1.5 % outside the fit's recordings' 14.95-15.05 rev/s"
+    assert change_notice(times, trusted, notes[:3] + [slow, off, slow])["recordings"] == 3
     # a run of other reasons (here the index's load) is not this notice
     assert change_notice(times, [True, False, False, False, False, False],
                          [""] + ["index load 5 N m is outside the fitted 10 N m"] * 5) is None

@@ -57,8 +57,9 @@ import numpy as np
 
 from .._errors import GearshotError
 
-__all__ = ["SPEED_TOLERANCE", "RUN_SPEED_FLOOR", "RUN_SPEED_SPREADS", "database_conditions",
-           "choose_condition", "check_speeds", "check_database_pair", "fit_speed_check"]
+__all__ = ["SPEED_TOLERANCE", "RUN_SPEED_FLOOR", "RUN_SPEED_SPREADS", "OUTSIDE_FIT_SPEEDS",
+           "database_conditions", "choose_condition", "check_speeds", "check_database_pair",
+           "fit_speed_check"]
 
 #: Largest relative distance between a recording's tacho speed and the database condition
 SPEED_TOLERANCE = 0.05
@@ -76,6 +77,9 @@ RUN_SPEED_FLOOR = 0.003
 #: ``benchmarks/monitor_lives.py``, speeds varying 1 % run to run: 3, 4, 5 and 6 leave
 #: 9, 5, 4 and 1 of 680 ordinary recordings untrusted).
 RUN_SPEED_SPREADS = 6.0
+
+#: What every reason of :func:`fit_speed_check` holds (found again in a monitor's note).
+OUTSIDE_FIT_SPEEDS = "outside the fit's recordings'"
 
 
 def database_conditions(store: str | Path, machine=None) -> tuple[list[float], list[float]]:
@@ -240,5 +244,5 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     if off <= tolerance:
         return "ok"
     hint = " (another load?)" if off < SPEED_TOLERANCE else ""
-    return (f"speed {speed:.2f} {unit} lies {100 * off:.2g} % outside the fit's recordings' "
+    return (f"speed {speed:.2f} {unit} lies {100 * off:.2g} % {OUTSIDE_FIT_SPEEDS} "
             f"{lo:.2f}-{hi:.2f} {unit}{hint}")

@@ -107,7 +107,10 @@ def untrusted_counts(notes) -> dict[str, int]:
     """How many untrusted recordings fail each kind of check, from their notes (the
     ``note`` of :func:`untrusted_reason` or of the monitor's condition and read checks),
     most frequent first; a recording failing several counts under each."""
+    from ..app.conditions import OUTSIDE_FIT_SPEEDS
+
     kinds = {"fit check": "fit check failed",
+             OUTSIDE_FIT_SPEEDS: "speed outside the fit's recordings' (another load?)",
              **{c.replace("_", " "): f"{c.replace('_', ' ')} failed" for c in LABEL_CHECKS},
              NOT_COMPARABLE: NOT_COMPARABLE,
              "outside the fitted": "outside the fitted condition (index speed or load)",
@@ -127,8 +130,10 @@ def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | N
     """Whether the machine has stopped looking like the fitted one: the latest
     :data:`CHANGE_RUN` or more recordings in a row untrusted because their segments are
     not comparable with the fitted machine (another load, speed, sensor or path, or a
-    fault beyond the example's). Such recordings never raise an alarm, so a machine that
-    changed, or a fault that outgrew the fit, would otherwise go quiet.
+    fault beyond the example's) or because they ran at a speed outside the fit's
+    recordings' (:func:`gearshot.app.conditions.fit_speed_check`: another load or speed,
+    which makes a predict row not comparable too). Such recordings never raise an alarm,
+    so a machine that changed, or a fault that outgrew the fit, would otherwise go quiet.
 
     Parameters
     ----------
@@ -143,9 +148,12 @@ def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | N
         ``since`` (the time of the first recording of the run), ``recordings`` (its
         length) and ``message``; None when the latest recordings are not such a run.
     """
+    from ..app.conditions import OUTSIDE_FIT_SPEEDS
+
     run = 0
     for ok, note in zip(reversed(list(trusted)), reversed(list(notes)), strict=True):
-        if ok or NOT_COMPARABLE not in str(note or ""):
+        if ok or not any(why in str(note or "") for why in (NOT_COMPARABLE,
+                                                            OUTSIDE_FIT_SPEEDS)):
             break
         run += 1
     if run < CHANGE_RUN:
