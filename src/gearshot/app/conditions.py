@@ -57,9 +57,8 @@ import numpy as np
 
 from .._errors import GearshotError
 
-__all__ = ["SPEED_TOLERANCE", "RUN_SPEED_FLOOR", "RUN_SPEED_SPREADS", "OUTSIDE_FIT_SPEEDS",
-           "database_conditions", "choose_condition", "check_speeds", "check_database_pair",
-           "fit_speed_check"]
+__all__ = ["SPEED_TOLERANCE", "RUN_SPEED_FLOOR", "RUN_SPEED_SPREADS", "database_conditions",
+           "choose_condition", "check_speeds", "check_database_pair", "fit_speed_check"]
 
 #: Largest relative distance between a recording's tacho speed and the database condition
 SPEED_TOLERANCE = 0.05
@@ -77,9 +76,6 @@ RUN_SPEED_FLOOR = 0.003
 #: ``benchmarks/monitor_lives.py``, speeds varying 1 % run to run: 3, 4, 5 and 6 leave
 #: 9, 5, 4 and 1 of 680 ordinary recordings untrusted).
 RUN_SPEED_SPREADS = 6.0
-
-#: What every reason of :func:`fit_speed_check` holds (found again in a monitor's note).
-OUTSIDE_FIT_SPEEDS = "outside the fit's recordings'"
 
 
 def database_conditions(store: str | Path, machine=None) -> tuple[list[float], list[float]]:
@@ -229,7 +225,7 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     >>> fit_speed_check(14.6, [15.0, 15.001, 14.999])   # one run: the gate's 5 %
     'ok'
     """
-    from ..monitor.trust import ONE_RUN_SPREAD
+    from ..monitor.trust import ONE_RUN_SPREAD, OUTSIDE_FIT_SPEEDS
 
     healthy = np.asarray([h for h in healthy_speeds if np.isfinite(h)], dtype=float)
     known = np.append(healthy, [] if example_speed is None or not np.isfinite(example_speed)

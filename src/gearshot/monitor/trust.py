@@ -65,6 +65,10 @@ ONE_RUN_SPREAD = 0.002
 #: :func:`untrusted_counts` finds again in a note).
 NOT_COMPARABLE = "not comparable with the fitted machine"
 
+#: What every reason of :func:`gearshot.app.conditions.fit_speed_check` holds (a
+#: recording's speed outside the fit's recordings': found again in a note).
+OUTSIDE_FIT_SPEEDS = "outside the fit's recordings'"
+
 
 def untrusted_reason(frame: pd.DataFrame, *, zero_shot: bool = False) -> str:
     """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
@@ -107,8 +111,6 @@ def untrusted_counts(notes) -> dict[str, int]:
     """How many untrusted recordings fail each kind of check, from their notes (the
     ``note`` of :func:`untrusted_reason` or of the monitor's condition and read checks),
     most frequent first; a recording failing several counts under each."""
-    from ..app.conditions import OUTSIDE_FIT_SPEEDS
-
     kinds = {"fit check": "fit check failed",
              OUTSIDE_FIT_SPEEDS: "speed outside the fit's recordings' (another load?)",
              **{c.replace("_", " "): f"{c.replace('_', ' ')} failed" for c in LABEL_CHECKS},
@@ -148,8 +150,6 @@ def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | N
         ``since`` (the time of the first recording of the run), ``recordings`` (its
         length) and ``message``; None when the latest recordings are not such a run.
     """
-    from ..app.conditions import OUTSIDE_FIT_SPEEDS
-
     run = 0
     for ok, note in zip(reversed(list(trusted)), reversed(list(notes)), strict=True):
         if ok or not any(why in str(note or "") for why in (NOT_COMPARABLE,
