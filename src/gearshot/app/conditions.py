@@ -225,7 +225,7 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     >>> fit_speed_check(14.6, [15.0, 15.001, 14.999])   # one run: the gate's 5 %
     'ok'
     """
-    from ..monitor.trust import ONE_RUN_SPREAD, OUTSIDE_FIT_SPEEDS
+    from ..monitor.trust import OUTSIDE_FIT_SPEEDS, one_run_warning
 
     healthy = np.asarray([h for h in healthy_speeds if np.isfinite(h)], dtype=float)
     known = np.append(healthy, [] if example_speed is None or not np.isfinite(example_speed)
@@ -234,7 +234,7 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
         return "ok"
     lo, hi, mean = float(known.min()), float(known.max()), float(known.mean())
     spread = float(known.std(ddof=1)) / mean if known.size > 1 else 0.0
-    one_run = healthy.size >= 3 and float(healthy.std(ddof=1) / healthy.mean()) < ONE_RUN_SPREAD
+    one_run = one_run_warning(healthy) is not None   # their speeds show no run-to-run spread
     tolerance = SPEED_TOLERANCE if one_run else max(RUN_SPEED_FLOOR, RUN_SPEED_SPREADS * spread)
     off = max(lo - speed, speed - hi, 0.0) / mean
     if off <= tolerance:

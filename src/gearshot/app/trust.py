@@ -23,10 +23,10 @@ def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
     ``frame.attrs["fit_check"]``: ``check.as_dict()``.
     """
     from ..estimator.fit_check import recording_majority, trusted_column
+    from ..estimator.trusted import comparable_at_speed
 
-    if "speed_check" in frame and "comparable" in frame:
-        frame["comparable"] = frame["comparable"].astype(bool) & (
-            frame["speed_check"].astype(str) == "ok")
+    if "comparable" in frame:
+        frame["comparable"] = comparable_at_speed(frame)
     frame["fit_check"] = check.verdict
     frame["trusted"] = trusted_column(frame) if len(frame) else pd.Series(dtype=bool)
     if "recording" in frame and len(frame):

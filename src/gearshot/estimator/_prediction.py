@@ -14,6 +14,7 @@ from .._validation import as_signal_array, check_in_range
 from ._target import target_features
 from .comparability import Comparability, ComparabilityReference
 from .fit_check import TRUST_COLUMNS, FitCheck, recording_majority, trusted_column
+from .trusted import comparable_at_speed
 from .uncertainty import conformal_quantile, holdout_interval, mixture_interval
 
 FloatArray = NDArray[np.float64]
@@ -161,8 +162,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         frame["input_check"] = "ok" if input_check is None else _per_row(
             input_check, len(arr), "input_check")
         if speed_check is not None:
-            frame["comparable"] &= pd.Series(_per_row(speed_check, len(arr), "speed_check"),
-                                             index=frame.index) == "ok"
+            frame["speed_check"] = _per_row(speed_check, len(arr), "speed_check")
+            frame["comparable"] = comparable_at_speed(frame)
         check: FitCheck | None = getattr(self, "fit_check_", None)
         frame["fit_check"] = "unchecked: fitted before the fit check existed" \
             if check is None else check.verdict

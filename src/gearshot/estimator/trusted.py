@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["trusted_column", "recording_majority", "TRUST_COLUMNS", "LABEL_CHECKS",
-           "MIN_TRUSTED_SHARE", "PASSED"]
+__all__ = ["trusted_column", "recording_majority", "comparable_at_speed", "TRUST_COLUMNS",
+           "LABEL_CHECKS", "MIN_TRUSTED_SHARE", "PASSED"]
 
 #: The verdict of a fit that passed.
 PASSED = "passed"
@@ -30,6 +30,17 @@ TRUST_COLUMNS = ("predicted", "low", "high", "comparability", "comparable", "inp
 #: The predict-table columns that hold "ok" or the failed check's label (besides
 #: ``comparable`` and ``fit_check``): what :func:`trusted_column` requires to be "ok".
 LABEL_CHECKS = ("input_check", "speed_check")
+
+
+def comparable_at_speed(frame: Any) -> Any:
+    """The ``comparable`` column of a predict table: the SA's comparability, false where
+    ``speed_check`` failed (the recording ran at a speed the fit's recordings did not
+    show: another operating condition; a table without ``speed_check`` is left as it
+    is)."""
+    comparable = frame["comparable"].astype(bool)
+    if "speed_check" in frame:
+        comparable &= frame["speed_check"].astype(str) == "ok"
+    return comparable
 
 
 def trusted_column(frame: Any) -> Any:
