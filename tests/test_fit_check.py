@@ -350,9 +350,9 @@ def test_too_short_healthy_record_is_unchecked_not_silent(spur_db):
     assert "healthy_holdout" not in set(frame["role"])
 
 
-def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
-    """est.trust: the documented columns; a Low-load fit's estimates of High-load
-    segments of the same healthy gear are not trusted."""
+def test_estimator_trust_and_a_drifting_low_fit(spur_db):
+    """est.trust: the documented columns; a Low-load fit whose healthy record drifts
+    while recorded fails its check, and nothing it reads is trusted."""
     from gearshot.app.predict_machine import machine_segments
     from gearshot.estimator import default_selection_tf
     from gearshot.sim import load_database
@@ -360,21 +360,33 @@ def test_estimator_trust_and_a_low_fit_read_at_high(spur_db):
     machine = Machine.from_toml(SPUR)
     seg = {name: machine_segments(_record(name), machine, cycles_per_segment=10)
            for name in ("spur3_30hz_Low_1.zip", "spur2_30hz_Low_1.zip",
-                        "spur3_30hz_High_1.zip")}
-    healthy, long, _ = seg["spur3_30hz_Low_1.zip"]
-    faulty = seg["spur2_30hz_Low_1.zip"][0]
-    est = OneFaultShotEstimator(mesh_order=list(machine.mesh_orders("input")),
-                                random_state=0)
+                        "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip")}
     db = load_database(spur_db, speed=machine.sim_speed(30.0), load=10.0)
-    est.fit(db, healthy, faulty[0], 0.5, long, selection_tf=default_selection_tf(0),
-            gear_teeth=32, pinion_teeth=96, holdout=0.25, example_record=faulty[1:])
+
+    def fit(load):
+        healthy, long, _ = seg[f"spur3_30hz_{load}_1.zip"]
+        faulty = seg[f"spur2_30hz_{load}_1.zip"][0]
+        est = OneFaultShotEstimator(mesh_order=list(machine.mesh_orders("input")),
+                                    random_state=0)
+        return est.fit(db, healthy, faulty[0], 0.5, long,
+                       selection_tf=default_selection_tf(0), gear_teeth=32,
+                       pinion_teeth=96, holdout=0.25, example_record=faulty[1:]), healthy
+
+    low, low_healthy = fit("Low")
+    assert low.healthy_drift_.drifting and not low.fit_check_.passed
+    assert low.fit_check_.verdict.startswith("the healthy recording drifts")
+    assert low.fit_check_.as_dict()["drift"] == low.fit_check_.verdict
+    drifting = low.trust(low_healthy[-2:])
+    assert not drifting["trusted"].any()
+    assert (drifting["fit_check"] == low.fit_check_.verdict).all()
+
+    est, healthy = fit("High")
     assert est.fit_check_.passed and est.fit_check_.n_healthy == 2
+    assert not est.healthy_drift_.drifting
     same = est.trust(healthy[-2:])
     assert list(same.columns) == ["predicted", "low", "high", "comparability", "comparable",
                                   "input_check", "fit_check", "trusted"]
     assert same["trusted"].all() and (same["low"] <= 0).all()
-    other_load = est.trust(seg["spur3_30hz_High_1.zip"][0])
-    assert not other_load["trusted"].any()
     flagged = est.trust(healthy[-2:], input_check=["ok", "dead channel"])
     assert flagged["trusted"].tolist() == [True, False]
     # given their recording, a segment passes only with most of its recording's

@@ -64,6 +64,7 @@ from ._target import fit_target_side
 from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
 from .comparability import fit_comparability
 from .detection import detection_limit, holdout_detection
+from .drift import fit_drift
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
 from .regressors import ESTIMATORS
@@ -208,6 +209,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     fit_check_ : FitCheck
         The fit's hold-outs read back against 0 and ``faulty_size`` and a ``verdict``
         (:mod:`~gearshot.estimator.fit_check`); they calibrate :meth:`predict_interval`.
+        A drifting healthy baseline fails it (``healthy_drift_``, :mod:`.drift`).
     detection_limit_, detection_threshold_ : float
         The smallest size told apart from healthy at 95 % confidence and the estimate it
         starts from: from the simulated validation rows, or from the real hold-outs when
@@ -320,8 +322,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             taken against the references of the other recordings (as a new recording's
             is) and comparability leaves whole recordings out (run-to-run).
 
-        Without hold-outs (the default) the fit is "unchecked" (``fit_check_.verdict``)
-        or fails if it misreads its own example; hold-outs calibrate :meth:`predict_interval`.
+        Without hold-outs the fit is "unchecked" or fails if it misreads its own example.
 
         Returns
         -------
@@ -344,8 +345,10 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                       faulty_example, faulty_size, healthy_long, selection_tf, orders)
         finally:
             del self._fitting_orders
+        self.healthy_drift_ = fit_drift(target_healthy, holdouts.healthy, healthy_recordings)
         self.fit_check_ = check_holdouts(self.predict, holdouts, len(self.references_) + len(
-            self.target_healthy_features_), self.faulty_size_, faulty_example)  # + the example
+            self.target_healthy_features_), self.faulty_size_, faulty_example,  # + the example
+            drift=self.healthy_drift_)
         if (limit := holdout_detection(self.fit_check_)) is not None:   # a passed check
             self.detection_limit_ = self.detection_threshold_ = limit  # from the hold-outs
         return self
@@ -359,8 +362,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                                   healthy_long, selection_tf)
         database = _select_fault_type(database, self.fault_type)
         by_grade = _database_by_grade(database, inputs.n_points)
-        reference = self._options().simulated_reference
-        if reference == "auto":
+        if (reference := self._options().simulated_reference) == "auto":
             reference = "twin" if _has_twins(database) else "first_healthy"
         twins = _database_twins(database, by_grade) if reference == "twin" else None
         grades = self._grades_in(by_grade)
@@ -376,13 +378,11 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"], twins, seeds["match_noise"])
         grade_choice = self._choose_grades(ctx, grades, twins is not None)
-        detection = detection_limit(grade_choice["setting_models_"],
-                                    [st["weight"] for st in
-                                     grade_choice["calibration_"]["settings"]])
-        comparability = fit_comparability(inputs.target_healthy, self._mesh_orders(),
-                                          faulty_example=inputs.faulty_example,
-                                          faulty_size=inputs.faulty_size,
-                                          recordings=recordings)
+        detection = detection_limit(grade_choice["setting_models_"], [
+            st["weight"] for st in grade_choice["calibration_"]["settings"]])
+        comparability = fit_comparability(
+            inputs.target_healthy, self._mesh_orders(), faulty_example=inputs.faulty_example,
+            faulty_size=inputs.faulty_size, recordings=recordings)
 
         learned = dict(
             n_points_=inputs.n_points, transfer_function_=target.transfer_function,

@@ -45,6 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range
+from .drift import Drift
 from .trusted import (  # the trust columns of a predict table, re-exported here
     LABEL_CHECKS,
     MIN_TRUSTED_SHARE,
@@ -91,6 +92,9 @@ class FitCheck:
         The limits the means were held to.
     example_self : float or None
         The fit's estimate of its own example (None: zero-shot, or not read).
+    drift : str or None
+        Why the healthy baseline is said to drift while recorded (a failed fit), or None
+        (:mod:`~gearshot.estimator.drift`).
     """
 
     verdict: str
@@ -104,6 +108,7 @@ class FitCheck:
     healthy_limit: float = HEALTHY_LIMIT
     example_limit: float = EXAMPLE_LIMIT
     example_self: float | None = None
+    drift: str | None = None
 
     @property
     def passed(self) -> bool:
@@ -255,7 +260,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
               example_note: str = "", healthy_limit: float = HEALTHY_LIMIT,
               example_limit: float = EXAMPLE_LIMIT,
               min_holdouts: int = MIN_HOLDOUTS,
-              example_self: float | None = None) -> FitCheck:
+              example_self: float | None = None, drift: str | None = None) -> FitCheck:
     """The verdict of a fit from its hold-outs' estimates.
 
     Parameters
@@ -277,6 +282,9 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         too few to check it, and is named first when they fail too (the cause: no grade
         reproduces the example). When they pass, they are the held-out evidence and the
         example's own reading is only kept.
+    drift : str, optional
+        Why the healthy baseline drifts (:meth:`~gearshot.estimator.drift.Drift.reason`):
+        a failed group, named last (hold-outs next to the references cannot show it).
 
     Returns
     -------
@@ -320,6 +328,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
     if record_off:
         failed.append(f"example record's other segments read {e_mean:.2f} against the "
                       f"declared {declared_size:g} (limit ± {example_limit:g})")
+    if drift:
+        failed.append(str(drift))
     if short:
         verdict = "unchecked: " + "; ".join(short)
         if failed:
@@ -329,12 +339,14 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
     else:
         verdict = PASSED
     return FitCheck(verdict, healthy, example, declared_size, h_mean, e_mean,
-                    len(healthy), len(example), healthy_limit, example_limit, own)
+                    len(healthy), len(example), healthy_limit, example_limit, own,
+                    str(drift) if drift else None)
 
 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                    holdouts: Holdouts, n_fit: int, declared_size: float | None,
-                   example: ArrayLike | None = None) -> FitCheck:
+                   example: ArrayLike | None = None, *, drift: Drift | None = None
+                   ) -> FitCheck:
     """The fit check of a fitted estimator: its hold-outs read by ``predict``.
 
     Parameters
@@ -349,6 +361,9 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
         The example's declared size (None: zero-shot).
     example : array_like (n_points,) or (1, n_points), optional
         The example the fit calibrated on: read back too (``example_self``).
+    drift : Drift, optional
+        The healthy baseline's drift test (:func:`~gearshot.estimator.drift.fit_drift`):
+        a drifting one fails the fit.
     """
     def read(sa: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
         return None if sa is None or not len(sa) else predict(sa)
@@ -362,4 +377,5 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     own = None if example is None or declared_size is None else \
         read(np.asarray(example, dtype=float).reshape(1, -1))
     return check_fit(read(holdouts.healthy), read(holdouts.example), declared_size,
-                     healthy_note=note, example_self=None if own is None else own[0])
+                     healthy_note=note, example_self=None if own is None else own[0],
+                     drift=None if drift is None else drift.reason())

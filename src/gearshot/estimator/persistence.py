@@ -44,6 +44,7 @@ SAFE_TYPES = (
     "gearshot.estimator.comparability.Comparability",
     "gearshot.estimator.comparability.ComparabilityReference",
     "gearshot.estimator.fit_check.FitCheck",
+    "gearshot.estimator.drift.Drift",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",
     "sklearn.neighbors._kd_tree.KDTree",
 )
