@@ -19,8 +19,8 @@ higher at the largest separation than at neighbouring segments.
 
 Chosen on the development records of the PHM09 spur subset (30 Hz, run 1 and run 2 of
 every spur case, both sensors, 10-revolution segments; ``benchmarks/healthy_drift.py``):
-every Low-load record drifts by this test (p 0.001–0.016, far/near 1.30–1.87) and no
-High-load record does (p ≥ 0.145, far/near 0.91–1.10). There the healthy gear's run 2
+every Low-load record drifts by this test (p 0.001–0.016, trend ratio 1.37–2.17) and no
+High-load record does (p ≥ 0.145, trend ratio 0.85–1.12). There the healthy gear's run 2
 read 0.21 at Low load (its run-1 hold-outs 0.08) and 0.09 at High load.
 """
 
@@ -39,7 +39,8 @@ __all__ = ["Drift", "healthy_drift", "fit_drift", "DRIFT_P", "DRIFT_RATIO", "MIN
 
 #: Largest p-value of a drifting baseline.
 DRIFT_P = 0.05
-#: Smallest ratio of the far pairs' residual energy to the neighbours' of a drifting one.
+#: Smallest trend ratio of a drifting baseline: the straight line of the pairs' residual
+#: energy on their separation, at the largest separation over at neighbours.
 DRIFT_RATIO = 1.25
 #: Fewest segments a recording needs to be tested (fewer cannot show a trend).
 MIN_DRIFT_SEGMENTS = 6
@@ -56,7 +57,8 @@ class Drift:
     p_value : float or None
         Of the time trend (None: no recording had enough segments).
     ratio : float or None
-        Residual energy of the pairs farthest apart over that of neighbouring segments.
+        The trend's size: the straight line of the pairs' residual energy on their
+        separation, at the largest separation over at neighbouring segments.
     n_recordings : int
         Recordings tested (those with at least :data:`MIN_DRIFT_SEGMENTS` segments).
     drifting : bool
@@ -111,45 +113,44 @@ def healthy_drift(healthy: ArrayLike, recordings: ArrayLike | None = None, *,
               else np.asarray(recordings).reshape(-1))
     if len(labels) != len(sa):
         raise GearshotError(f"recordings holds {len(labels)} labels for {len(sa)} SAs")
-    groups: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
+    groups: list[NDArray[np.float64]] = []   # each recording's energies ÷ their median
     for name in dict.fromkeys(labels.tolist()):
         rows = np.flatnonzero(labels == name)
         if len(rows) >= MIN_DRIFT_SEGMENTS:
             energy = _pair_energy(sa[rows])
-            i, j = np.triu_indices(len(rows), 1)
-            groups.append((energy / np.median(energy[i, j]), (j - i).astype(float)))
+            groups.append(energy / np.median(energy[np.triu_indices(len(rows), 1)]))
     if not groups:
         return Drift(None, None, 0, False)
     return _trend(groups, n_permutations, random_state)
 
 
-def _trend(groups: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
-           n_permutations: int, seed: int) -> Drift:
+def _trend(groups: Sequence[NDArray[np.float64]], n_permutations: int, seed: int) -> Drift:
     """Pooled Spearman ρ of energy against separation, permuted inside each recording."""
     from scipy.stats import rankdata
 
     rng = np.random.default_rng(seed)
-    pairs = [np.triu_indices(len(e), 1) for e, _ in groups]
-    sep = rankdata(np.concatenate([s for _, s in groups]))
+    pairs = [np.triu_indices(len(e), 1) for e in groups]
+    seps = np.concatenate([(j - i).astype(float) for i, j in pairs])
+    sep = rankdata(seps)
     sep = (sep - sep.mean()) / np.linalg.norm(sep - sep.mean())
 
-    def rho(orders: Sequence[NDArray[np.intp]]) -> float:
-        values = np.concatenate([e[np.ix_(o, o)][i, j]
-                                 for (e, _), o, (i, j) in zip(groups, orders, pairs,
-                                                              strict=True)])
+    def pooled(orders: Sequence[NDArray[np.intp]]) -> NDArray[np.float64]:
+        return np.concatenate([e[np.ix_(o, o)][i, j]
+                               for e, o, (i, j) in zip(groups, orders, pairs, strict=True)])
+
+    def rho(values: NDArray[np.float64]) -> float:
         r = rankdata(values)
         r = r - r.mean()
         return float(sep @ r / np.linalg.norm(r))
 
-    observed = rho([np.arange(len(e)) for e, _ in groups])
-    beaten = sum(rho([rng.permutation(len(e)) for e, _ in groups]) >= observed
+    energies = pooled([np.arange(len(e)) for e in groups])
+    observed = rho(energies)
+    beaten = sum(rho(pooled([rng.permutation(len(e)) for e in groups])) >= observed
                  for _ in range(n_permutations))
     p_value = (1 + beaten) / (1 + n_permutations)
     # the trend's size: a straight line of energy on separation, at the largest
     # separation against at neighbours (robust to a periodic pattern, e.g. another
     # shaft's leakage into segments that do not span its period)
-    energies = np.concatenate([e[i, j] for (e, _), (i, j) in zip(groups, pairs, strict=True)])
-    seps = np.concatenate([s for _, s in groups])
     slope, intercept = np.polyfit(seps, energies, 1)
     near = intercept + slope
     ratio = float((intercept + slope * seps.max()) / near) if near > 0 else float("inf")

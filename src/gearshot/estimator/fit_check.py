@@ -329,7 +329,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         failed.append(f"example record's other segments read {e_mean:.2f} against the "
                       f"declared {declared_size:g} (limit ± {example_limit:g})")
     if drift:
-        failed.append(str(drift))
+        failed.append(drift)
     if short:
         verdict = "unchecked: " + "; ".join(short)
         if failed:
@@ -340,7 +340,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         verdict = PASSED
     return FitCheck(verdict, healthy, example, declared_size, h_mean, e_mean,
                     len(healthy), len(example), healthy_limit, example_limit, own,
-                    str(drift) if drift else None)
+                    drift or None)
 
 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
