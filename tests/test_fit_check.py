@@ -508,6 +508,14 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
     assert fit_speed_check(15.3, one_run, example_speed=15.0) == "ok"
     assert fit_speed_check(16.0, one_run, example_speed=15.0).startswith("speed 16.00 Hz lies 6.7")
     assert fit_speed_check(15.3, one_run[:2], example_speed=15.0) != "ok"   # 2: not one run
+    # fewer than 3 healthy recordings: no spread of runs, so within 0.3 % of one of the
+    # fit's recordings (a virtual rig's healthy run 0.6 % off its one healthy recording
+    # read 0.24, comparable), not anywhere in their span
+    assert fit_speed_check(15.04, [15.0], example_speed=15.3) == "ok"
+    assert fit_speed_check(15.28, [15.0], example_speed=15.3) == "ok"
+    assert fit_speed_check(15.15, [15.0], example_speed=15.3).startswith(
+        "speed 15.15 Hz lies 0.99 % outside the fit's recordings' 15.00, 15.30 Hz")
+    assert fit_speed_check(15.15, [15.0, 15.3, 14.7]) == "ok"   # 3 runs: their spread
     frame = predict_from_machine(Machine.from_toml(SPUR), spur_db,
                                  [_record("spur3_30hz_High_1.zip")],
                                  _record("spur2_30hz_High_1.zip"), 0.5,
@@ -527,8 +535,10 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
 def test_another_load_runs_at_another_speed_and_is_not_comparable(spur_db):
     """The PHM09 motor runs about 1.5 % slower at "Low" load than at "High": under a High
     fit the chipped gear's Low record (0.6 % below the fit's recordings, its regular part
-    close to a larger fault of the High machine) is not comparable and says why; run 2 of
-    the Low condition, whose speeds the Low fit's two recordings span, stays comparable."""
+    close to a larger fault of the High machine) is not comparable and says why. Under a
+    fit on run 1 of the Low condition (one healthy recording: no spread of runs to go by),
+    run 2 of the healthy gear (0.1 % off its run 1) is at a speed the fit has seen, that of
+    the chipped gear (0.65 % off its run 1, between the fit's two speeds) is not."""
     from gearshot.app.predict_machine import predict_from_machine
 
     def fit(load, others):
@@ -547,7 +557,11 @@ def test_another_load_runs_at_another_speed_and_is_not_comparable(spur_db):
         r"\(another load\?\)$").all()
     assert (frame.loc[name == "spur2_30hz_High_2.zip", "speed_check"] == "ok").all()
     frame, name = fit("Low", ["spur2_30hz_Low_2.zip", "spur3_30hz_Low_2.zip"])
-    assert (frame.loc[name.str.endswith("_2.zip"), "speed_check"] == "ok").all()
+    assert (frame.loc[name == "spur3_30hz_Low_2.zip", "speed_check"] == "ok").all()
+    chipped = frame.loc[name == "spur2_30hz_Low_2.zip", "speed_check"]
+    assert len(chipped) and chipped.str.match(
+        r"speed 29\.\d\d Hz lies 0\.\d+ % outside the fit's recordings' "
+        r"29\.\d\d, 29\.\d\d Hz \(another load\?\)$").all()
 
 
 def test_without_a_machine_file_the_measured_speeds_are_checked_too(tmp_path):
