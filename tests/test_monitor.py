@@ -78,11 +78,11 @@ def test_model_file_carries_what_estimating_needs(machine, tmp_path):
     assert back.digest == m.digest and len(back.digest) == 16
     # each healthy recording's measured speed is kept, and the one-run warning is set from
     # them (this surrogate campaign's speeds drift 0.4 % between recordings: no warning)
-    from gearshot.monitor.trust import one_run_warning
+    from gearshot.monitor.trust import runs_warning
 
     speeds = back.extras["healthy_speeds"]
     assert len(speeds) == 4 and np.allclose(speeds, 15.0, rtol=0.02)
-    assert back.extras["fit_warning"] == one_run_warning(speeds)
+    assert back.extras["fit_warning"] == runs_warning(speeds)
     # and the faulty recording's: a later recording's speed is checked against all of them
     assert back.extras["example_speed"] == pytest.approx(15.0, rel=0.02)
     # the faulty recording gives 2 segments: the example and one other, too few for the

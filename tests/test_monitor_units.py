@@ -397,6 +397,30 @@ def test_one_run_warning_for_healthy_recordings_at_one_speed():
     assert one_run_warning([15.0, float("nan"), 15.0, 15.0]) is not None
 
 
+def test_few_runs_warning_for_one_or_two_healthy_recordings():
+    """1 or 2 healthy recordings show no spread of runs: later runs are trusted within
+    0.3 % of their speeds only, and the model says so (as the one-run warning for 3 or
+    more at one speed); from 3 recordings over runs, nothing is said."""
+    from gearshot.app.conditions import fit_speed_check
+    from gearshot.monitor.trust import (SPREAD_RECORDINGS, few_runs_warning,
+                                        one_run_warning, runs_warning)
+
+    assert SPREAD_RECORDINGS == 3
+    one = few_runs_warning([29.9])
+    assert one.startswith("fitted on 1 healthy recording(s), which show no spread of runs")
+    assert "more than 0.3 % off their speeds" in one
+    assert few_runs_warning([15.0, float("nan")]) == one     # unknown speeds do not count
+    assert "fitted on 2 healthy" in few_runs_warning([15.0, 15.1])
+    over_runs = [15.0576, 14.9999, 14.9883]
+    assert few_runs_warning(over_runs) is None and runs_warning(over_runs) is None
+    assert few_runs_warning([]) is None and few_runs_warning([float("nan")]) is None
+    one_day = [15.0, 15.001, 14.999]
+    assert runs_warning(one_day) == one_run_warning(one_day)
+    assert runs_warning([15.0, 15.1]) == few_runs_warning([15.0, 15.1])
+    # what the warning says is what the speed check does
+    assert fit_speed_check(15.04, [15.0]) == "ok" and fit_speed_check(15.06, [15.0]) != "ok"
+
+
 def test_the_fit_warning_is_printed_and_reported(tmp_path):
     from gearshot.app.monitor_report import format_monitor, monitor_report
     from gearshot.monitor.trust import one_run_warning

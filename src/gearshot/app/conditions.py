@@ -80,11 +80,6 @@ RUN_SPEED_FLOOR = 0.003
 #: 9, 5, 4 and 1 of 680 ordinary recordings untrusted).
 RUN_SPEED_SPREADS = 6.0
 
-#: Healthy recordings from which their speeds' spread bounds a later run's
-#: (:func:`fit_speed_check`); with fewer, a recording must lie within
-#: :data:`RUN_SPEED_FLOOR` of one of the fit's recordings.
-SPREAD_RECORDINGS = 3
-
 
 def database_conditions(store: str | Path, machine=None) -> tuple[list[float], list[float]]:
     """The (speeds, loads) of a database; speeds as tacho-shaft Hz with ``machine``.
@@ -221,14 +216,15 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     :data:`~gearshot.monitor.trust.ONE_RUN_SPREAD` of one speed (recorded as one run:
     the one-run warning of ``gearshot fit``), their speeds say nothing of how far a later
     run's moves, and the bound is the database gate's :data:`SPEED_TOLERANCE` instead.
-    With fewer than :data:`SPREAD_RECORDINGS` healthy recordings there is no spread of
-    runs to go by, and the recording must lie within :data:`RUN_SPEED_FLOOR` of one of
-    the fit's recordings' speeds: the target side subtracts healthy references recorded at
-    those speeds, and on the virtual rig a healthy recording of another run 0.6-1.9 %
-    off them read 0.24-0.30 on average with its regular part comparable (one-recording
-    fits, rig seeds 201-216: ``benchmarks/run_spread.py``), while within 0.3 % none read
-    above 0.10. Unknown speeds (NaN) pass. ``unit`` names the speeds' unit in the reason
-    ("Hz" of the tacho shaft with a machine file, "rev/s" without).
+    With fewer than 3 healthy recordings (:data:`~gearshot.monitor.trust.SPREAD_RECORDINGS`)
+    there is no spread of runs to go by, and the recording must lie within
+    :data:`RUN_SPEED_FLOOR` of one of the fit's recordings' speeds: the target side
+    subtracts healthy references recorded at those speeds, and on the virtual rig a
+    healthy recording of another run 0.6-1.9 % off them read 0.24-0.30 on average with
+    its regular part comparable (one-recording fits, rig seeds 201-216:
+    ``benchmarks/run_spread.py``), while within 0.3 % none read above 0.10. Unknown
+    speeds (NaN) pass. ``unit`` names the speeds' unit in the reason ("Hz" of the tacho
+    shaft with a machine file, "rev/s" without).
 
     >>> fit_speed_check(29.90, [29.92, 29.89])
     'ok'
@@ -241,7 +237,7 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     >>> fit_speed_check(15.08, [15.16], example_speed=14.98)   # between, near neither
     "speed 15.08 Hz lies 0.53 % outside the fit's recordings' 14.98, 15.16 Hz (another load?)"
     """
-    from ..monitor.trust import OUTSIDE_FIT_SPEEDS, one_run_warning
+    from ..monitor.trust import OUTSIDE_FIT_SPEEDS, SPREAD_RECORDINGS, one_run_warning
 
     healthy = np.asarray([h for h in healthy_speeds if np.isfinite(h)], dtype=float)
     known = np.append(healthy, [] if example_speed is None or not np.isfinite(example_speed)

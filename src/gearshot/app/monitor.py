@@ -76,7 +76,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
     """
     from ..monitor import MonitorModel, alarm_threshold, database_identity
     from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
-    from ..monitor.trust import one_run_warning
+    from ..monitor.trust import runs_warning
     from .predict import estimate_segments
 
     rate = FALSE_ALARM_RATE if false_alarm_rate is None else false_alarm_rate
@@ -131,7 +131,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
                 "grade": getattr(est, "grade_", None), "healthy_speeds": list(speeds),
                 "example_speed": None if not np.isfinite(example_speed) else example_speed,
-                "fit_warning": one_run_warning(speeds), "sensor_note": sensor_note})
+                "fit_warning": runs_warning(speeds), "sensor_note": sensor_note})
     result.save(model)
     return result
 

@@ -18,8 +18,9 @@ import pandas as pd
 from ..estimator.fit_check import LABEL_CHECKS, MIN_TRUSTED_SHARE, PASSED
 
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
-           "change_notice", "one_run_warning", "fit_check_warning", "model_warning",
-           "MIN_TRUSTED_SHARE", "CHANGE_RUN", "ONE_RUN_SPREAD"]
+           "change_notice", "one_run_warning", "few_runs_warning", "runs_warning",
+           "fit_check_warning", "model_warning", "MIN_TRUSTED_SHARE", "CHANGE_RUN",
+           "ONE_RUN_SPREAD", "SPREAD_RECORDINGS"]
 
 
 def row_trust(frame: pd.DataFrame) -> np.ndarray:
@@ -60,6 +61,11 @@ CHANGE_RUN = 3
 #: (seeds 1, 3, 9): recorded at one set-point, 0.04-0.05 %; over runs whose speed varies
 #: 1 %, 0.58-0.83 %.
 ONE_RUN_SPREAD = 0.002
+
+#: Healthy recordings from which their speeds' spread bounds how far a later run's may
+#: move (:func:`gearshot.app.conditions.fit_speed_check`); a fit on fewer trusts a later
+#: run only within 0.3 % of one of its recordings' speeds (:func:`few_runs_warning`).
+SPREAD_RECORDINGS = 3
 
 #: How :func:`untrusted_reason` names the segments that comparability flags (what
 #: :func:`untrusted_counts` finds again in a note).
@@ -196,6 +202,30 @@ def one_run_warning(speeds) -> str | None:
             f"speed (as one run); if the machine's speed varies more from run to run, "
             f"later runs may be flagged as not comparable or read as small faults: fit on "
             f"healthy recordings from several runs or days")
+
+
+def few_runs_warning(speeds) -> str | None:
+    """A warning for a model fitted on 1 or 2 healthy recordings (with known speeds): they
+    show no spread of runs, so a later recording is trusted only within 0.3 % of one of
+    the fit's recordings' speeds (:func:`gearshot.app.conditions.fit_speed_check`; on the
+    virtual rig a healthy run 0.6-1.9 % off a one-recording fit's speed read 0.24-0.30).
+
+    >>> few_runs_warning([15.0]) is not None, few_runs_warning([15.0, 15.1, 14.9])
+    (True, None)
+    """
+    values = np.asarray(list(speeds), dtype=float)
+    n = int(np.isfinite(values).sum())
+    if not 0 < n < SPREAD_RECORDINGS:
+        return None
+    return (f"fitted on {n} healthy recording(s), which show no spread of runs: a later "
+            f"recording more than 0.3 % off their speeds (and the example's) is not "
+            f"trusted; fit on healthy recordings of {SPREAD_RECORDINGS} or more runs or days")
+
+
+def runs_warning(speeds) -> str | None:
+    """The warning a model's healthy recordings' speeds give: :func:`one_run_warning`
+    (3 or more at one speed) or :func:`few_runs_warning` (1 or 2), else None."""
+    return one_run_warning(speeds) or few_runs_warning(speeds)
 
 
 def fit_check_warning(fit_check) -> str | None:
