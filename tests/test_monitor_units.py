@@ -402,8 +402,12 @@ def test_few_runs_warning_for_one_or_two_healthy_recordings():
     0.3 % of their speeds only, and the model says so (as the one-run warning for 3 or
     more at one speed); from 3 recordings over runs, nothing is said."""
     from gearshot.app.conditions import fit_speed_check
-    from gearshot.monitor.trust import (SPREAD_RECORDINGS, few_runs_warning,
-                                        one_run_warning, runs_warning)
+    from gearshot.monitor.trust import (
+        SPREAD_RECORDINGS,
+        few_runs_warning,
+        one_run_warning,
+        runs_warning,
+    )
 
     assert SPREAD_RECORDINGS == 3
     one = few_runs_warning([29.9])
