@@ -11,7 +11,9 @@ time the size reaches 0.6, scored against the true time:
   6–8 and 32–34 untrusted, as the rig's load change and remount;
 * **stored lives** (``--work DIR --seeds …``): the histories ``monitor_lives.py`` wrote
   (``DIR/rig{seed}/{mode}.parquet`` and the model), re-forecast with the code of
-  the checkout, no estimate recomputed.
+  the checkout, no estimate recomputed; as ``gearshot monitor`` does, with the model's
+  reading spread at the limit (:func:`gearshot.monitor.forecast.reading_spread_at` of its
+  example's size; synthetic lives have none).
 
 Each prints the forecasts within ±25 % of the true remaining time, the 90 % intervals
 holding the true time, and their median width relative to the true remaining time. For
@@ -32,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from gearshot.monitor import forecast_crossing, load_model, read_history
+from gearshot.monitor.forecast import reading_spread_at
 from gearshot.monitor.payload import current_records
 from gearshot.rig.history import first_crossing, growth_size
 
@@ -66,7 +69,8 @@ def stored(work: Path, seeds: list[int], mode: str) -> list[dict]:
         days = ((rows["time"] - rows["time"].iloc[0]) / pd.Timedelta(days=1)).to_numpy(float)
         lives.append({"days": days, "size": truth["size"].to_numpy(float),
                       "pred": rows["predicted"].to_numpy(float),
-                      "trusted": rows["trusted"].to_numpy(bool) & rows["predicted"].notna()})
+                      "trusted": rows["trusted"].to_numpy(bool) & rows["predicted"].notna(),
+                      "example": (model.faulty or {}).get("size")})
     return lives
 
 
@@ -88,7 +92,8 @@ def score(lives: list[dict], oracle: bool = False) -> str:
         t, y = life["days"][:k][use], life["pred"][:k][use]
         now, truth = life["days"][k - 1], first_crossing(life["days"], life["size"], LIMIT)
         remaining = truth - now
-        fc = forecast_crossing(t, y, LIMIT)
+        fc = forecast_crossing(t, y, LIMIT, reading_spread=reading_spread_at(
+            LIMIT, life.get("example")))   # as gearshot monitor forecasts
         if fc.time is not None:
             made += 1
             hit += abs(fc.time - truth) <= 0.25 * remaining

@@ -22,6 +22,7 @@ from gearshot.monitor import (
     row_trust,
 )
 from gearshot.monitor.alarm import MIN_THRESHOLD
+from gearshot.monitor.forecast import reading_spread_at
 from gearshot.monitor.history import HISTORY_COLUMNS
 from gearshot.rig.history import growth_size
 
@@ -103,6 +104,31 @@ def test_forecast_interval_holds_the_true_crossing_at_its_coverage():
             held += fc.low <= crossing <= fc.high
     assert made >= 34
     assert held >= 0.8 * made
+
+
+def test_forecast_interval_carries_the_reading_error_at_the_limit():
+    """An estimator off by a factor of its own on each machine (gain exp(0.15 N)) reads
+    the limit 0.6 with a systematic error of about 0.09 that no trend averages away: the
+    interval of the mixture over that reading holds the true crossing where the trend's
+    own interval misses it; the point forecast (the median at the limit) is unchanged."""
+    rng = np.random.default_rng(11)
+    plain = mixed = made = 0
+    for days, sizes, crossing in _noisy_lives(36, 0.02, seed=7):
+        read = sizes * np.exp(0.15 * rng.standard_normal())
+        a = forecast_crossing(days[:28], read[:28], 0.6)
+        b = forecast_crossing(days[:28], read[:28], 0.6, reading_spread=0.09)
+        if a.time is None:
+            assert b.time is None and b.reason == a.reason
+            continue
+        made += 1
+        assert b.time == a.time and b.law_weights == a.law_weights
+        plain += a.low <= crossing <= a.high
+        mixed += b.low <= crossing <= b.high
+    assert made >= 30 and mixed >= 0.85 * made and mixed >= plain + 0.15 * made
+    assert reading_spread_at(0.6, 0.42) == pytest.approx(0.33 * 0.18)
+    assert reading_spread_at(0.6, None) == 0.0 and reading_spread_at(0.4, 0.5) == 0.0
+    with pytest.raises(GearshotError, match="reading_spread"):
+        forecast_crossing(DAYS, DAYS / 40, 0.6, reading_spread=-0.1)
 
 
 def test_no_forecast_from_a_flat_trend_or_too_few_points():

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from .alarm import alarm_states
-from .forecast import Forecast, forecast_crossing
+from .forecast import Forecast, forecast_crossing, reading_spread_at
 from .trust import change_notice, model_warning
 
 __all__ = ["monitor_payload", "current_records", "describe_forecast", "DEFAULT_LIMIT",
@@ -86,7 +86,9 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
     ok = rows["trusted"].to_numpy(bool)
     t0 = rows["time"].iloc[0] if len(rows) else pd.Timestamp(0)
     days = ((rows["time"] - t0) / _DAY).to_numpy(float)
-    fc = forecast_crossing(days[ok], rows["predicted"].to_numpy(float)[ok], limit)
+    example = (getattr(model, "faulty", None) or {}).get("size")
+    fc = forecast_crossing(days[ok], rows["predicted"].to_numpy(float)[ok], limit,
+                           reading_spread=reading_spread_at(limit, example))
     if fc.time is not None and model.calibration == "zero_shot":
         fc = Forecast(fc.limit, None, None, None, None, ZERO_SHOT_FORECAST)
 
