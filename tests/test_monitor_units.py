@@ -127,8 +127,11 @@ def test_forecast_interval_carries_the_reading_error_at_the_limit():
     assert made >= 30 and mixed >= 0.85 * made and mixed >= plain + 0.15 * made
     assert reading_spread_at(0.6, 0.42) == pytest.approx(0.33 * 0.18)
     assert reading_spread_at(0.6, None) == 0.0 and reading_spread_at(0.4, 0.5) == 0.0
-    with pytest.raises(GearshotError, match="reading_spread"):
-        forecast_crossing(DAYS, DAYS / 40, 0.6, reading_spread=-0.1)
+    for bad in (-0.1, float("nan")):
+        with pytest.raises(GearshotError, match="reading_spread"):
+            forecast_crossing(DAYS, DAYS / 40, 0.6, reading_spread=bad)
+    with pytest.raises(GearshotError, match="reading_spread"):   # even with no forecast
+        forecast_crossing(DAYS[:3], [0.0, 0.1, 0.2], 0.6, reading_spread=-1.0)
 
 
 def test_no_forecast_from_a_flat_trend_or_too_few_points():

@@ -264,4 +264,3 @@ def fit_speed_check(speed: float, healthy_speeds: Sequence[float], *,
     hint = " (another load?)" if off < SPEED_TOLERANCE else ""
     return (f"speed {speed:.2f} {unit} lies {100 * off:.2g} % {OUTSIDE_FIT_SPEEDS} "
             f"{seen} {unit}{hint}")
-

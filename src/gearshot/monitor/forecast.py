@@ -350,6 +350,7 @@ def forecast_crossing(times: ArrayLike, sizes: ArrayLike, limit: float, *,
     limit = check_in_range(limit, "limit (--limit)", 0.0, 1.0, low_inclusive=False)
     coverage = check_in_range(coverage, "coverage", 0.0, 1.0, low_inclusive=False,
                               high_inclusive=False)
+    reading_spread = check_in_range(reading_spread, "reading_spread", 0.0, np.inf)
     t = np.asarray(times, float)
     y = np.asarray(sizes, float)
     keep = np.isfinite(t) & np.isfinite(y)
@@ -383,7 +384,6 @@ def forecast_crossing(times: ArrayLike, sizes: ArrayLike, limit: float, *,
     q = (1.0 - coverage) / 2.0
     when, spread = _crossings(grids, limit)
     low, mid, high = _mixture_quantiles(when, spread, w, [q, 0.5, 1.0 - q])
-    reading_spread = check_in_range(reading_spread, "reading_spread", 0.0, np.inf)
     if reading_spread > 0 and np.isfinite(mid):
         nodes, node_w = np.polynomial.hermite_e.hermegauss(READING_NODES)
         at = [_crossings(grids, float(np.clip(limit + reading_spread * x, 1e-6, 1.0)))
