@@ -490,6 +490,18 @@ def test_fit_check_warning_names_the_verdict_and_passes_silently():
     assert model_warning(Model()) == f"{text}; {Model.extras['fit_warning']}"
     Model.fit_check, Model.extras = {"verdict": "passed"}, {}
     assert model_warning(Model()) is None
+    # a threshold from 2 healthy estimates (a fit on one short healthy recording's 2
+    # hold-outs): its 1 % false-alarm rate is not known, and the model says so
+    from gearshot.monitor.alarm import MIN_BASELINE, baseline_warning
+
+    Model.baseline = [0.122, 0.126]
+    said = baseline_warning(Model.baseline)
+    assert said.startswith("the alarm threshold rests on 2 healthy estimate(s) (fewer than 6)")
+    assert model_warning(Model()) == said and MIN_BASELINE == 6
+    Model.baseline = [0.1, 0.2, 0.05, 0.12, 0.08, 0.11, float("nan")]
+    assert baseline_warning(Model.baseline) is None and model_warning(Model()) is None
+    Model.baseline = [0.1, 0.2, 0.05, 0.12, 0.08, float("nan")]    # 5 finite
+    assert "rests on 5 healthy" in model_warning(Model())
 
 
 def test_first_crossing_of_a_life_is_linear_between_recordings():

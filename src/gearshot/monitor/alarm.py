@@ -18,8 +18,8 @@ from scipy import stats
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 
-__all__ = ["alarm_threshold", "alarm_states", "AlarmResult", "FALSE_ALARM_RATE", "SUSTAIN",
-           "MIN_THRESHOLD"]
+__all__ = ["alarm_threshold", "alarm_states", "baseline_warning", "AlarmResult",
+           "FALSE_ALARM_RATE", "SUSTAIN", "MIN_THRESHOLD", "MIN_BASELINE"]
 
 #: Per-recording false-alarm probability the threshold is set at (chosen on the
 #: development lives, benchmarks/RESULTS.md "Monitoring").
@@ -31,6 +31,28 @@ SUSTAIN = 2
 #: the threshold at the estimator's own resolution (chosen on the development lives:
 #: 0.08 raised false alarms, 0.10–0.15 none, and 0.10 the most alarms in time).
 MIN_THRESHOLD = 0.10
+
+
+#: Healthy estimates under which the threshold's false-alarm rate is not stated as known
+#: (:func:`baseline_warning`): as few as comparability calibrates on
+#: (:data:`gearshot.estimator.comparability.MIN_HEALTHY`).
+MIN_BASELINE = 6
+
+
+def baseline_warning(baseline: ArrayLike) -> str | None:
+    """A warning for a threshold set from fewer than :data:`MIN_BASELINE` finite healthy
+    estimates: a normal law fitted to so few says little of its 1 % tail (a fit on one
+    short healthy recording holds its 2 hold-outs only).
+
+    >>> baseline_warning([0.12, 0.13]) is not None, baseline_warning([0.1] * 6)
+    (True, None)
+    """
+    n = int(np.isfinite(np.asarray(baseline, dtype=float).ravel()).sum())
+    if n >= MIN_BASELINE:
+        return None
+    return (f"the alarm threshold rests on {n} healthy estimate(s) (fewer than "
+            f"{MIN_BASELINE}): its false-alarm rate is not known; fit on longer or more "
+            f"healthy recordings")
 
 
 def alarm_threshold(baseline: ArrayLike, *, false_alarm_rate: float = FALSE_ALARM_RATE

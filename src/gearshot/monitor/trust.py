@@ -254,8 +254,13 @@ def fit_check_warning(fit_check) -> str | None:
 
 def model_warning(model) -> str | None:
     """Every warning of a model, one string (None: none): its fit check's
-    (:func:`fit_check_warning`) and the one-run warning it was saved with."""
+    (:func:`fit_check_warning`), the runs warning it was saved with (:func:`runs_warning`)
+    and its baseline's (:func:`gearshot.monitor.alarm.baseline_warning`)."""
+    from .alarm import baseline_warning
+
     extras = getattr(model, "extras", None) or {}
+    baseline = getattr(model, "baseline", None)
     found = [w for w in (fit_check_warning(getattr(model, "fit_check", None)),
-                         extras.get("fit_warning")) if w]
+                         extras.get("fit_warning"),
+                         None if baseline is None else baseline_warning(baseline)) if w]
     return "; ".join(found) or None
