@@ -557,6 +557,13 @@ def test_another_load_runs_at_another_speed_and_is_not_comparable(spur_db):
         r"\(another load\?\)$").all()
     assert (frame.loc[name == "spur2_30hz_High_2.zip", "speed_check"] == "ok").all()
     frame, name = fit("Low", ["spur2_30hz_Low_2.zip", "spur3_30hz_Low_2.zip"])
+    # one healthy recording: predict says which speeds it trusts, and prints it
+    from gearshot.app.predict import format_predictions, predictions_payload
+
+    assert frame.attrs["fit_warning"].startswith("fitted on 1 healthy recording(s), which "
+                                                 "show no spread of runs")
+    assert f"warning: {frame.attrs['fit_warning']}" in format_predictions(frame, "here")
+    assert predictions_payload(frame)["fit"]["fit_warning"] == frame.attrs["fit_warning"]
     assert (frame.loc[name == "spur3_30hz_Low_2.zip", "speed_check"] == "ok").all()
     chipped = frame.loc[name == "spur2_30hz_Low_2.zip", "speed_check"]
     assert len(chipped) and chipped.str.match(

@@ -109,7 +109,8 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
     frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy, faulty)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs.update(fit_attrs(est))
+    frame.attrs.update(fit_attrs(est, [float(fit.health.get(_key(p), {}).get("speed", np.nan))
+                                       for p in healthy]))
     return frame
 
 
@@ -250,7 +251,7 @@ def _inputs(database, healthy, faulty, faulty_size, frame, *, machine, speed, se
 #: The keys of the fit a predict JSON carries, when the frame's ``attrs`` hold them
 #: (``fit_check``: the frame's fit verdict, when a fit check ran).
 FIT_KEYS = ("grade", "calibration", "simulated_reference", "detection_limit", "fit_check",
-            "load_source", "load_choice", "sensor", "sensor_note")
+            "load_source", "load_choice", "sensor", "sensor_note", "fit_warning")
 
 
 def _summary(frame: pd.DataFrame) -> dict:
@@ -366,6 +367,8 @@ def format_predictions(frame: pd.DataFrame, where: str) -> str:
     lines = [where]
     if "fit_check" in frame or frame.attrs.get("fit_check"):
         lines.append(fit_check_line(frame))
+    if frame.attrs.get("fit_warning"):
+        lines.append(f"warning: {frame.attrs['fit_warning']}")
     lines += [table, comparable_summary(frame), input_check_summary(frame)]
     lines += [line for line in (speed_check_summary(frame), detection_summary(frame)) if line]
     if "trusted" in frame:

@@ -181,7 +181,8 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                                  params=params, speed_tolerance=speed_tolerance)
     frame = _estimates(est, seg, cond, coverage)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs.update(fit_attrs(est), sensor=seg.sensor, sensor_note=seg.sensor_note)
+    frame.attrs.update(fit_attrs(est, seg.healthy_speeds), sensor=seg.sensor,
+                       sensor_note=seg.sensor_note)
     return frame
 
 
