@@ -109,8 +109,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
     frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy, faulty)
     add_trust_columns(frame, est.fit_check_)
-    frame.attrs.update(fit_attrs(est, [float(fit.health.get(_key(p), {}).get("speed", np.nan))
-                                       for p in healthy]))
+    frame.attrs.update(fit_attrs(est, _speeds(fit.health, healthy)))
     return frame
 
 
@@ -139,13 +138,18 @@ def _fit_speed_checks(recordings: pd.Series, health: dict, healthy, faulty=None
     faulty one; unknown speeds pass)."""
     from .conditions import fit_speed_check
 
-    speed = {k: float(v.get("speed", np.nan)) for k, v in health.items()}
-    fitted = [speed.get(_key(p), np.nan) for p in healthy]
-    example = None if faulty is None else speed.get(_key(faulty), np.nan)
-    checks = {r: fit_speed_check(speed.get(_key(r), np.nan), fitted, example_speed=example,
+    fitted = _speeds(health, healthy)
+    example = None if faulty is None else _speeds(health, [faulty])[0]
+    checks = {r: fit_speed_check(_speeds(health, [r])[0], fitted, example_speed=example,
                                  unit="rev/s")
               for r in set(recordings)}
     return [checks[r] for r in recordings]
+
+
+def _speeds(health: dict, paths) -> list[float]:
+    """The measured speed (rev/s) the fit's read kept for each of ``paths`` (NaN where
+    none was measured or the file was not read)."""
+    return [float(health.get(_key(p), {}).get("speed", np.nan)) for p in paths]
 
 
 def _roles(path, n: int, fitted: set, faulty) -> list[str]:

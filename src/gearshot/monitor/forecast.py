@@ -387,7 +387,7 @@ def forecast_crossing(times: ArrayLike, sizes: ArrayLike, limit: float, *,
     if reading_spread > 0 and np.isfinite(mid):
         nodes, node_w = np.polynomial.hermite_e.hermegauss(READING_NODES)
         at = [_crossings(grids, float(np.clip(limit + reading_spread * x, 1e-6, 1.0)))
-              for x in nodes]
+              if x else (when, spread) for x in nodes]   # the middle node: the limit's
         low, high = _mixture_quantiles(
             np.concatenate([a[0] for a in at]), np.concatenate([a[1] for a in at]),
             np.concatenate([w * v for v in node_w]), [q, 1.0 - q])
