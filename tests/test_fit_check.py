@@ -99,6 +99,7 @@ def test_a_fit_that_misreads_its_own_example_fails_whatever_its_holdouts():
     (lambda: holdout_interval([0.1], [], [0.0], 0.9), "healthy and example residuals"),
     (lambda: holdout_interval([0.1], [0.1], [0.0], 1.0), "coverage"),
     (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, run_spread=-1), "run_spread"),
+    (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, scale_spread=-1), "scale_spread"),
     (lambda: holdout_interval([0.1], [0.1], [0.0], 0.9, example_size=0.4,
                               extrapolation_spread=0.7), "extrapolation_spread"),
 ])
@@ -120,20 +121,32 @@ def test_holdout_interval_is_the_conformal_bound_of_each_side():
     rng = np.random.default_rng(0)
     healthy = np.abs(rng.normal(0, 0.05, 19))       # healthy over-read, ≥ 0
     example = rng.normal(-0.1, 0.05, 19)            # the example record under-reads
-    low, high = holdout_interval([0.3], healthy, example, 0.9, run_spread=0.0)
+    none = dict(run_spread=0.0, scale_spread=0.0)
+    low, high = holdout_interval([0.3], healthy, example, 0.9, **none)
     rank = int(np.ceil(20 * 0.9)) - 1
-    over = max(np.sort(healthy)[rank], np.sort(np.maximum(example, 0))[rank])
+    over_h = np.sort(healthy)[rank]
+    over = max(over_h, np.sort(np.maximum(example, 0))[rank])
     under = np.sort(np.maximum(-example, 0))[rank]
     np.testing.assert_allclose([low[0], high[0]], [0.3 - over, 0.3 + under])
     # each hold-out's own interval holds its truth at the stated coverage
-    lo_h, _ = holdout_interval(healthy, healthy, example, 0.9, run_spread=0.0)
-    _, hi_e = holdout_interval(example + 0.5, healthy, example, 0.9, run_spread=0.0)
+    lo_h, _ = holdout_interval(healthy, healthy, example, 0.9, **none)
+    _, hi_e = holdout_interval(example + 0.5, healthy, example, 0.9, **none)
     assert (lo_h <= 0).mean() >= 0.9 and (hi_e >= 0.5).mean() >= 0.9
-    # the run-to-run spread widens both sides in quadrature
-    low2, high2 = holdout_interval([0.3], healthy, example, 0.9, run_spread=0.1)
     z = 1.6448536269514722
+    # the machine's scale widens both sides in quadrature
+    low2, high2 = holdout_interval([0.3], healthy, example, 0.9, run_spread=0.0,
+                                   scale_spread=0.1)
     np.testing.assert_allclose([0.3 - low2[0], high2[0] - 0.3],
                                [np.hypot(over, 0.1 * z), np.hypot(under, 0.1 * z)])
+    # a new run's residue adds in energy: it lowers a small reading's bound to 0 and a
+    # large one's hardly, and never touches the high side
+    pred = np.array([0.15, 0.3, 0.8])
+    low3, high3 = holdout_interval(pred, healthy, example, 0.9, run_spread=0.1,
+                                   scale_spread=0.0)
+    residue = np.sqrt(np.maximum(pred ** 2 - over_h ** 2 - (0.1 * z) ** 2, 0))
+    np.testing.assert_allclose(low3, np.minimum(residue, pred - over))
+    assert low3[0] == 0 and pred[2] - low3[2] < 0.7 * np.hypot(over, 0.1 * z)
+    np.testing.assert_allclose(high3, pred + under)
 
 
 def test_holdout_interval_widens_beyond_the_example_as_an_inverse_prediction():
@@ -584,3 +597,21 @@ def test_without_a_machine_file_the_measured_speeds_are_checked_too(tmp_path):
     assert checks[0] == "ok" and checks[3] == "ok" and checks[1] == checks[2]
     assert checks[1] == ("speed 20.00 rev/s lies 33 % outside the fit's recordings' "
                          "15.00-15.10 rev/s")
+
+
+def test_holdout_detection_is_the_smallest_estimate_whose_interval_leaves_0_out():
+    """A passed fit's limit: an estimate below it has 0 in its interval, one above not;
+    here the residue bound sets it, ``sqrt(over_h² + (z·RUN_SPREAD)²)``."""
+    from gearshot.estimator.detection import holdout_detection
+    from gearshot.estimator.uncertainty import RUN_SPREAD
+
+    check = check_fit([0.02, 0.08, 0.05, 0.04], [0.45, 0.52, 0.48, 0.50], 0.5)
+    assert check.passed
+    limit = holdout_detection(check, 0.95)
+    healthy, example = check.residuals()
+    low, _ = holdout_interval([limit - 0.002, limit + 0.002], healthy, example, 0.9,
+                              example_size=0.5)
+    assert low[0] <= 0 < low[1]
+    z = 1.6448536269514722
+    assert limit == pytest.approx(np.hypot(0.08, z * RUN_SPREAD), abs=0.0015)
+    assert holdout_detection(check_fit([0.40, 0.46], [0.5, 0.5], 0.5)) is None

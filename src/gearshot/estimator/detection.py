@@ -20,12 +20,12 @@ small size (:func:`below_detection_limit`, the ``below_detection_limit`` column 
 A fit that **passed its check** on the machine's own hold-outs
 (:mod:`~gearshot.estimator.fit_check`) knows better than the simulation what a healthy
 segment of this machine reads: :func:`holdout_detection` then sets the limit to the
-lower half-width of the hold-out-calibrated interval
+smallest estimate whose hold-out-calibrated interval
 (:func:`~gearshot.estimator.uncertainty.holdout_interval`, two-sided ``2·confidence −
-1``: the healthy hold-outs' over-reading and the run-to-run spread), so that an estimate
-is below the limit exactly when its interval reaches 0. (On the PHM09 run-2 protocol the
-simulated limit, 0.46 at 30 Hz High, put 64 % of the chipped gear's run-2 segments
-below it while every one of them read above every healthy one.)
+1``: the healthy hold-outs' over-reading and a later run's residue) leaves 0 out, so
+that an estimate is below the limit exactly when its interval reaches 0. (On the PHM09
+run-2 protocol the simulated limit, 0.46 at 30 Hz High, put 64 % of the chipped gear's
+run-2 segments below it while every one of them read above every healthy one.)
 """
 
 from __future__ import annotations
@@ -133,8 +133,9 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
 
 
 def holdout_detection(check: Any, confidence: float = DETECTION_CONFIDENCE) -> float | None:
-    """The detection limit a fit takes from its hold-outs (module docstring): the lower
-    half-width of its hold-out-calibrated interval at ``2 · confidence - 1``, when its
+    """The detection limit a fit takes from its hold-outs (module docstring): the smallest
+    estimate (on a 0.001 grid) whose hold-out-calibrated interval at ``2 · confidence -
+    1`` leaves 0 out, when its
     fit check (``fit_check_``, a :class:`~gearshot.estimator.fit_check.FitCheck`) passed
     with healthy and example hold-outs; otherwise None (the simulated limit stands).
     """
@@ -143,8 +144,11 @@ def holdout_detection(check: Any, confidence: float = DETECTION_CONFIDENCE) -> f
     if check is None or not check.passed or not check.n_healthy or not check.n_example:
         return None
     healthy, example = check.residuals()
-    low, _ = holdout_interval(np.zeros(1), healthy, example, 2 * confidence - 1)
-    return float(min(-low[0], 1.0))
+    grid = np.linspace(0.0, 1.0, 1001)
+    low, _ = holdout_interval(grid, healthy, example, 2 * confidence - 1,
+                              example_size=check.declared_size)
+    above = np.flatnonzero(low > 0)
+    return float(grid[above[0]]) if above.size else 1.0
 
 
 def below_detection_limit(estimator: Any, estimates: ArrayLike) -> NDArray[np.bool_]:
