@@ -46,6 +46,15 @@ def test_healthy_holdouts_that_read_as_fault_fail_the_fit():
     assert not check.passed and check.checked
     assert check.verdict == (f"healthy hold-outs read 0.43 on average (limit "
                              f"{HEALTHY_LIMIT:g})")
+    # below the fit's own detection limit: the verdict says the signal cannot resolve it
+    unresolved = check_fit([0.25, 0.31], [0.5, 0.5], 0.5, detection_limit=0.45)
+    assert not unresolved.passed
+    assert unresolved.verdict == (
+        f"healthy hold-outs read 0.28 on average (limit {HEALTHY_LIMIT:g}), below the "
+        "fit's detection limit 0.45: this machine's signal does not tell a healthy gear "
+        "from a fault smaller than that")
+    assert check_fit([0.40, 0.46], [0.5, 0.5], 0.5, detection_limit=0.4).verdict \
+        == check.verdict
 
 
 def test_example_record_far_from_the_declared_size_fails_the_fit():

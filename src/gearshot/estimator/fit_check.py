@@ -260,7 +260,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
               example_note: str = "", healthy_limit: float = HEALTHY_LIMIT,
               example_limit: float = EXAMPLE_LIMIT,
               min_holdouts: int = MIN_HOLDOUTS,
-              example_self: float | None = None, drift: str | None = None) -> FitCheck:
+              example_self: float | None = None, drift: str | None = None,
+              detection_limit: float | None = None) -> FitCheck:
     """The verdict of a fit from its hold-outs' estimates.
 
     Parameters
@@ -285,6 +286,10 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
     drift : str, optional
         Why the healthy baseline drifts (:meth:`~gearshot.estimator.drift.Drift.reason`):
         a failed group, named last (hold-outs next to the references cannot show it).
+    detection_limit : float, optional
+        The fit's simulated detection limit: healthy hold-outs that fail yet read below
+        it are said to lie where this machine's signal does not tell a healthy gear from
+        a smaller fault.
 
     Returns
     -------
@@ -323,8 +328,11 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
                       f"{declared_size:g} (limit ± {example_limit:g}): no simulated grade "
                       f"reproduces it")
     if h_mean is not None and h_mean > healthy_limit:
+        unresolved = "" if detection_limit is None or h_mean >= detection_limit else (
+            f", below the fit's detection limit {detection_limit:.2f}: this machine's "
+            f"signal does not tell a healthy gear from a fault smaller than that")
         failed.append(f"healthy hold-outs read {h_mean:.2f} on average (limit "
-                      f"{healthy_limit:g})")
+                      f"{healthy_limit:g}){unresolved}")
     if record_off:
         failed.append(f"example record's other segments read {e_mean:.2f} against the "
                       f"declared {declared_size:g} (limit ± {example_limit:g})")
@@ -345,8 +353,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                    holdouts: Holdouts, n_fit: int, declared_size: float | None,
-                   example: ArrayLike | None = None, *, drift: Drift | None = None
-                   ) -> FitCheck:
+                   example: ArrayLike | None = None, *, drift: Drift | None = None,
+                   detection_limit: float | None = None) -> FitCheck:
     """The fit check of a fitted estimator: its hold-outs read by ``predict``.
 
     Parameters
@@ -364,6 +372,8 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     drift : Drift, optional
         The healthy baseline's drift test (:func:`~gearshot.estimator.drift.fit_drift`):
         a drifting one fails the fit.
+    detection_limit : float, optional
+        The fit's simulated detection limit (:func:`check_fit`).
     """
     def read(sa: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
         return None if sa is None or not len(sa) else predict(sa)
@@ -378,4 +388,5 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
         read(np.asarray(example, dtype=float).reshape(1, -1))
     return check_fit(read(holdouts.healthy), read(holdouts.example), declared_size,
                      healthy_note=note, example_self=None if own is None else own[0],
-                     drift=None if drift is None else drift.reason())
+                     drift=None if drift is None else drift.reason(),
+                     detection_limit=detection_limit)
