@@ -205,6 +205,33 @@ def test_a_recording_at_a_speed_the_fit_never_saw_is_untrusted(machine, tmp_path
         "recordings' 1" in at18["note"] and at18["note"].endswith("rev/s")
 
 
+def test_a_remounted_sensor_is_untrusted_whatever_the_fault(machine, tmp_path):
+    """The sensor moved to another spot (the rig's next transfer path): its recordings,
+    healthy or with a fault larger than the example's, are untrusted for their path and
+    never alarmed; the same rig's other runs pass the path check."""
+    from gearshot.app.monitor import fit_model, monitor_history
+    from gearshot.monitor import load_model
+    from gearshot.monitor.trust import OTHER_PATH
+    from gearshot.rig import VirtualRig
+
+    fit_model(machine["db"], machine["healthy"], machine["faulty"], 0.5,
+              model=tmp_path / "m.skops", speed=15, load=10)
+    assert len(load_model(tmp_path / "m.skops").extras["healthy_paths"]) == 4
+    rig = VirtualRig(3, engine="surrogate")
+    moved = rig.with_reality(tf_index=(rig.reveal().tf_index + 1) % 8)
+    rows = []
+    for i, (source, size) in enumerate([(rig, 0.0), (moved, 0.0), (moved, 0.7), (rig, 0.7)]):
+        rec = source.record(speed=15, load=10, fault_size=size, duration=16, repetition=40 + i)
+        rec.write(tmp_path / f"r{i}.h5")
+        rows.append(f"{tmp_path / f'r{i}.h5'},2026-02-0{i + 1}T00:00:00")
+    (tmp_path / "index.csv").write_text("file,time\n" + "\n".join(rows) + "\n")
+    records = monitor_history(tmp_path / "m.skops", tmp_path / "index.csv",
+                              tmp_path / "h.parquet")["records"]
+    assert OTHER_PATH not in (records[0]["note"] or "") + (records[3]["note"] or "")
+    for rec in records[1:3]:
+        assert OTHER_PATH in rec["note"] and not rec["trusted"] and not rec["alarm"]
+
+
 @pytest.mark.slow
 def test_monitor_adds_only_the_new_then_reestimates_after_a_refit(machine, tmp_path):
     life = machine["top"] / "life"
@@ -325,6 +352,7 @@ def test_fit_and_monitor_with_a_machine_file_on_phm09(tmp_path):
     assert len(model.extras["healthy_speeds"]) == 2
     assert model.extras["fit_warning"].startswith("fitted on 2 healthy recording(s)")
     assert model.extras["example_speed"] is None                      # zero-shot: no example
+    assert [len(p) for p in model.extras["healthy_paths"]] == [200, 200]  # resonance patterns
     rows = [("spur2_30hz_High_1.zip", "2026-01-01T00:00:00", 10),
             ("spur2_30hz_High_2.zip", "2026-01-02T00:00:00", 10),
             ("spur2_30hz_Low_1.zip", "2026-01-03T00:00:00", 5)]

@@ -87,7 +87,7 @@ def test_report_says_which_recordings_failed_the_speed_check(tmp_path):
     text = report_from_any_json(tmp_path / "p.json", tmp_path / "rep").read_text()
     assert ("`speed_check`: failed for 1 recording(s) (b.zip: speed 39.90 Hz lies 33 % "
             "outside") in text
-    assert "Trusted segments: 2 of 5 (input and speed checks ok" in text
+    assert "Trusted segments: 2 of 5 (input, speed and path checks ok" in text
     # every recording ok: no speed line
     frame["speed_check"] = "ok"
     write_predictions(frame, tmp_path / "q.json")

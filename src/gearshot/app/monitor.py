@@ -107,14 +107,13 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                                                   reads=reads))
         condition = {"speed": fitted.speed, "load": fitted.load, "speed_unit": "rps",
                      **{k: int(v) for k, v in fitted.teeth.items()}}
-        toml = None
-        speeds = [float(fitted.health[Path(p).resolve()].get("speed", np.nan))
-                  for p in healthy]   # measured when the fit read them
+        read = [fitted.health[Path(p).resolve()] for p in healthy]   # what the fit's read kept
+        speeds, paths = [float(h.get("speed", np.nan)) for h in read], [h.get("path") for h in read]
         example_speed = np.nan if faulty is None else float(
             fitted.health[Path(faulty).resolve()].get("speed", np.nan))
-        sensor_note = ""
+        toml, sensor_note = None, ""
     else:
-        est, baseline, condition, speeds, example_speed, sensor_note = _fit_with_machine(
+        est, baseline, condition, speeds, example_speed, sensor_note, paths = _fit_with_machine(
             machine, database, healthy, faulty, faulty_size, speed=speed, load=load,
             coverage=coverage, cycles_per_segment=cycles_per_segment, sensor=sensor,
             holdout=holdout, seed=seed, speed_tolerance=speed_tolerance)
@@ -131,7 +130,8 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         extras={"healthy": [str(Path(p).resolve()) for p in healthy],
                 "grade": getattr(est, "grade_", None), "healthy_speeds": list(speeds),
                 "example_speed": None if not np.isfinite(example_speed) else example_speed,
-                "fit_warning": runs_warning(speeds), "sensor_note": sensor_note})
+                "fit_warning": runs_warning(speeds), "sensor_note": sensor_note,
+                "healthy_paths": [None if v is None else list(map(float, v)) for v in paths]})
     result.save(model)
     return result
 
@@ -164,9 +164,9 @@ def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, cove
 def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed, load,
                       coverage, cycles_per_segment, sensor, holdout, seed, speed_tolerance):
     """``fit_model`` with a machine file: estimator, baseline, condition, healthy speeds,
-    the faulty recording's speed (NaN without one) and why the sensor is not the
-    machine's first ("" when it is:
-    :mod:`gearshot.app.sensor_choice`)."""
+    the faulty recording's speed (NaN without one), why the sensor is not the
+    machine's first ("" when it is: :mod:`gearshot.app.sensor_choice`) and the healthy
+    recordings' resonance patterns."""
     from ..machine import Machine
     from .predict import estimate_segments
     from .predict_machine import fit_machine
@@ -189,7 +189,8 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
                  "speed_tolerance": float(speed_tolerance)}
     speeds = pd.DataFrame([(r[0], r[3]) for r in seg.rows if r[1].startswith("healthy")])
     return (est, baseline, condition, [float(v) for v in speeds.groupby(0)[1].mean()],
-            float(seg.example_speed), seg.sensor_note)
+            float(seg.example_speed), seg.sensor_note,
+            [seg.sources[f].get("path") for f in seg.healthy_files])
 
 
 def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
@@ -197,29 +198,35 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     note ("" or why the recording is not covered: with a machine file, a tacho speed
     beyond the model's speed tolerance; with or without one, a speed outside the fit's
     recordings', healthy and the faulty example:
-    :func:`gearshot.app.conditions.fit_speed_check`)."""
-    from .conditions import fit_speed_check
+    :func:`gearshot.app.conditions.fit_speed_check`, or another transfer path than the
+    healthy recordings': :func:`gearshot.app.conditions.fit_path_check`)."""
+    from .conditions import fit_path_check, fit_speed_check
 
     cond = model.condition
     extras = getattr(model, "extras", None) or {}
     seen, example = extras.get("healthy_speeds") or [], extras.get("example_speed")
+    paths = extras.get("healthy_paths") or []   # models saved before it: no path check
+    health: dict = {}
     if machine is None:
         from ..io import recording_segments
 
-        health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
                                 pinion_teeth=cond["pinion_teeth"], health=health)
         check = fit_speed_check(float(health.get("speed", np.nan)), seen,
                                 example_speed=example, unit="rev/s")
+        if check == "ok":
+            check = fit_path_check(health.get("path"), paths)
         return np.asarray(sa), "" if check == "ok" else check
     from .predict_machine import machine_segments
 
     sa, _, hz = machine_segments(path, machine, cycles_per_segment=cond["cycles_per_segment"],
-                                 sensor=cond["sensor"])
+                                 sensor=cond["sensor"], info=health)
     off = abs(hz - cond["speed"]) / cond["speed"]
     note = "" if off <= cond["speed_tolerance"] else (
         f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
     check = fit_speed_check(hz, seen, example_speed=example)   # within the gate
+    if check == "ok":
+        check = fit_path_check(health.get("path"), paths)
     return sa, note or ("" if check == "ok" else check)
 
 

@@ -108,6 +108,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     frame = pd.concat(frames, ignore_index=True)
     frame.attrs["speed"], frame.attrs["load"] = fit.speed, fit.load
     frame["speed_check"] = _fit_speed_checks(frame["recording"], fit.health, healthy, faulty)
+    frame["path_check"] = fit_path_checks(frame["recording"], fit.health, healthy)
     add_trust_columns(frame, est.fit_check_)
     frame.attrs.update(fit_attrs(est, _speeds(fit.health, healthy)))
     return frame
@@ -142,6 +143,18 @@ def _fit_speed_checks(recordings: pd.Series, health: dict, healthy, faulty=None
     example = None if faulty is None else _speeds(health, [faulty])[0]
     checks = {r: fit_speed_check(_speeds(health, [r])[0], fitted, example_speed=example,
                                  unit="rev/s")
+              for r in set(recordings)}
+    return [checks[r] for r in recordings]
+
+
+def fit_path_checks(recordings: pd.Series, health: dict, healthy) -> list[str]:
+    """Per row: :func:`gearshot.app.conditions.fit_path_check` of its recording's
+    resonance pattern against the fit's healthy recordings' (``health``: resolved path ->
+    what the read kept; unknown patterns pass)."""
+    from .conditions import fit_path_check
+
+    refs = [health.get(_key(p), {}).get("path") for p in healthy]
+    checks = {r: fit_path_check(health.get(_key(r), {}).get("path"), refs)
               for r in set(recordings)}
     return [checks[r] for r in recordings]
 
@@ -338,16 +351,17 @@ def input_check_summary(frame: pd.DataFrame) -> str:
             f"{len(failed)} ({counts}): no estimate is given for them")
 
 
-def speed_check_summary(frame: pd.DataFrame) -> str | None:
+def speed_check_summary(frame: pd.DataFrame, column: str = "speed_check") -> str | None:
     """One line naming the recordings whose ``speed_check`` failed (a tracked speed not to
-    be trusted, or a speed outside the fit's healthy recordings'); None when none did."""
-    if "speed_check" not in frame or not len(frame):
+    be trusted, or a speed outside the fit's healthy recordings'), or those whose
+    ``column`` did (``"path_check"``: another transfer path); None when none did."""
+    if column not in frame or not len(frame):
         return None
-    bad = frame.loc[frame["speed_check"] != "ok"].drop_duplicates("recording")
+    bad = frame.loc[frame[column] != "ok"].drop_duplicates("recording")
     if bad.empty:
         return None
-    first = f"{Path(str(bad['recording'].iloc[0])).name}: {bad['speed_check'].iloc[0]}"
-    return (f"speed_check: failed for {len(bad)} recording(s) ({first}"
+    first = f"{Path(str(bad['recording'].iloc[0])).name}: {bad[column].iloc[0]}"
+    return (f"{column}: failed for {len(bad)} recording(s) ({first}"
             + (", …" if len(bad) > 1 else "") + "): their estimates are not trusted")
 
 
@@ -374,7 +388,9 @@ def format_predictions(frame: pd.DataFrame, where: str) -> str:
     if frame.attrs.get("fit_warning"):
         lines.append(f"warning: {frame.attrs['fit_warning']}")
     lines += [table, comparable_summary(frame), input_check_summary(frame)]
-    lines += [line for line in (speed_check_summary(frame), detection_summary(frame)) if line]
+    lines += [line for line in (speed_check_summary(frame),
+                                speed_check_summary(frame, "path_check"),
+                                detection_summary(frame)) if line]
     if "trusted" in frame:
         lines.append(trust_summary(frame))
     return "\n".join(lines)

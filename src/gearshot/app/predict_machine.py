@@ -13,18 +13,20 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 from ..estimator.fit_check import typical_segment
-from ..io.input_health import check_input, check_segments, input_check_column, mark_rows, require_ok
-from ..machine.signal_check import speed_check, verify_machine
+from ..io.input_health import input_check_column, mark_rows, require_ok
+from ..machine.signal_check import verify_machine
 from .conditions import (
     SPEED_TOLERANCE,
     check_database_pair,
     check_speeds,
     choose_condition,
     database_conditions,
+    fit_path_check,
     fit_speed_check,
 )
 from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
+from .machine_read import machine_segments
 from .predict_fit import recording_labels
 from .trust import add_trust_columns
 
@@ -39,50 +41,6 @@ def machine_database_path(machine_file: str | Path, *, n_healthy: int, n_faulty:
 
     return default_database_path(f"machine-{Path(machine_file).stem}-h{n_healthy}-"
                                  f"f{n_faulty}-s{seed}" + ("-paired" if paired else ""))
-
-
-def machine_segments(path: str | Path, machine, *, cycles_per_segment: int,
-                     sensor: str | None = None, info: dict | None = None, rec=None
-                     ) -> tuple[np.ndarray, np.ndarray, float]:
-    """SA segments of the monitored gear's shaft for one recording file (``rec``: the file
-    already read with ``machine``; default: read now).
-
-    ``info``, when given, receives ``speed_source`` (``"tacho"`` or ``"vibration"``),
-    ``speed_uncertainty_hz`` (rev/s; ``None`` with a tacho), ``speed_check``
-    (:func:`gearshot.machine.signal_check.speed_check`) and the sensor's input checks
-    ``recording`` and ``segments``.
-
-    Returns ``sa`` (n_segments, samples_per_cycle), ``x`` (the whole angle-domain signal,
-    n_cycles * samples_per_cycle) and ``speed`` (the tacho shaft's, rev/s).
-    """
-    from ..io import Recording
-
-    if machine.monitored is None:
-        raise GearshotError(f"machine {machine.name!r} names no [monitored] gear")
-    rec = Recording.read(path, machine=machine) if rec is None else rec
-    name = machine.sensor(sensor).name
-    spc = machine.samples_per_cycle
-    x = rec.angle_domain(shaft=machine.monitored.shaft, sensor=name, samples_per_cycle=spc,
-                         antialias=machine.antialias)
-    n_cycles = x.size // spc
-    n_seg = n_cycles // cycles_per_segment
-    if n_seg < 1:
-        raise GearshotError(f"{str(path)!r} holds {n_cycles} revolution(s) of shaft "
-                            f"{machine.monitored.shaft!r}; --cycles-per-segment="
-                            f"{cycles_per_segment} is too many")
-    blocks = x[: n_seg * cycles_per_segment * spc].reshape(n_seg, cycles_per_segment, spc)
-    if info is not None:
-        info.update(speed_source=rec.speed_source, speed_uncertainty_hz=rec.speed_uncertainty,
-                    speed_check=speed_check(machine, rec))
-        info.update(_input_health(rec.channel(name).acceleration, blocks.mean(axis=1),
-                                 machine.sensor(name).unit))
-    return blocks.mean(axis=1), x, rec.shaft_speed()
-
-
-def _input_health(raw, sas, unit) -> dict:
-    """The input checks of one sensor of a recording: its raw samples and its SA
-    segments (:mod:`gearshot.io.input_health`)."""
-    return dict(recording=check_input(raw, units=unit), segments=check_segments(sas, units=unit))
 
 
 def _require_fit_input(info: dict, path, role: str) -> None:
@@ -270,6 +228,7 @@ class _Segments:
     example: np.ndarray | None = None           # the faulty example's SA
     speeds: dict = field(default_factory=dict)  # file -> tacho speed, Hz
     healthy_speeds: list = field(default_factory=list)
+    healthy_files: list = field(default_factory=list)   # str paths of the healthy recordings
     example_speed: float = float("nan")          # the faulty recording's tacho speed, Hz
     sources: dict = field(default_factory=dict)  # file -> speed_source, uncertainty
     sensor: str = ""                             # the sensor the SAs are of
@@ -300,6 +259,7 @@ def _segment_recordings(machine, healthy, faulty, recordings, *, cps, sensor, ho
         sa, x, sp = cut(p)
         _require_fit_input(seg.sources[str(p)], p, "healthy")
         seg.healthy_speeds.append(sp)
+        seg.healthy_files.append(str(p))
         n_fit = sa.shape[0] - int(np.floor(holdout * sa.shape[0]))
         if n_fit < 1:
             raise GearshotError(f"{str(p)!r}: no segment left for the fit after holdout="
@@ -396,4 +356,7 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
         checks[r] = c if c != "ok" else fit_speed_check(
             seg.speeds[r], seg.healthy_speeds, example_speed=seg.example_speed)
     frame["speed_check"] = frame["recording"].map(checks)
+    refs = [seg.sources[f].get("path") for f in seg.healthy_files]
+    frame["path_check"] = frame["recording"].map(
+        {r: fit_path_check(seg.sources[r].get("path"), refs) for r in set(frame["recording"])})
     return frame

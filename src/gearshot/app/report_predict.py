@@ -49,12 +49,12 @@ def predict_report(payload, out: Path, source: Path) -> Path:
     if "comparable" in frame:
         lines += [f"Comparable segments: {int(frame['comparable'].astype(bool).sum())} of "
                   f"{len(frame)}.", ""]
-    speed = speed_check_summary(frame)
-    if speed:
-        lines += ["`" + speed.replace(": ", "`: ", 1) + ".", ""]
+    for column in ("speed_check", "path_check"):
+        if line := speed_check_summary(frame, column):
+            lines += ["`" + line.replace(": ", "`: ", 1) + ".", ""]
     if "trusted" in frame:
         lines += [f"Trusted segments: {int(frame['trusted'].astype(bool).sum())} of "
-                  f"{len(frame)} (input and speed checks ok, comparable, fit check passed, "
+                  f"{len(frame)} (input, speed and path checks ok, comparable, fit check passed, "
                   "in a recording most of whose segments pass); the figure draws the "
                   "untrusted ones as hollow grey markers.", ""]
     lines += _md_table(table)

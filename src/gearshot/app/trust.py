@@ -13,9 +13,10 @@ def add_trust_columns(frame: pd.DataFrame, check) -> pd.DataFrame:
 
     ``comparable``: false too where ``speed_check`` failed (the recording's speed lies
     outside what the fit's recordings showed: another operating condition,
-    :func:`gearshot.app.conditions.fit_speed_check`; ``comparability``, the p-value of its
-    SA, is left as it is); ``fit_check``: ``check.verdict`` in every row ("passed" or the
-    reason); ``trusted``:
+    :func:`gearshot.app.conditions.fit_speed_check`) or ``path_check`` did (another
+    transfer path: :func:`gearshot.app.conditions.fit_path_check`; ``comparability``, the
+    p-value of its SA, is left as it is); ``fit_check``: ``check.verdict`` in every row
+    ("passed" or the reason); ``trusted``:
     :func:`gearshot.estimator.trusted_column` (input check "ok" — a table without
     ``input_check`` counts as "ok" —, comparable and the fit check passed; with a
     ``recording`` column, only in a recording more than half of whose segments pass:
@@ -66,5 +67,5 @@ def trust_summary(frame: pd.DataFrame) -> str:
     if "trusted" not in frame or not len(frame):
         return "trusted: no segment estimated"
     n_yes = int(frame["trusted"].astype(bool).sum())
-    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input and speed checks ok, "
+    return (f"trusted: {n_yes} of {len(frame)} segment(s) (input, speed and path checks ok, "
             f"comparable and fit check passed, in a recording most of whose segments pass)")

@@ -348,7 +348,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         self.healthy_drift_ = fit_drift(target_healthy, holdouts.healthy, healthy_recordings)
         self.fit_check_ = check_holdouts(self.predict, holdouts, len(self.references_) + len(
             self.target_healthy_features_), self.faulty_size_, faulty_example,  # + the example
-            drift=self.healthy_drift_, detection_limit=self.detection_limit_)
+            drift=self.healthy_drift_, detection_limit=self.__dict__["detection_limit_"])
         if (limit := holdout_detection(self.fit_check_)) is not None:   # a passed check
             self.detection_limit_ = self.detection_threshold_ = limit  # from the hold-outs
         return self

@@ -29,23 +29,24 @@ TRUST_COLUMNS = ("predicted", "low", "high", "comparability", "comparable", "inp
 
 #: The predict-table columns that hold "ok" or the failed check's label (besides
 #: ``comparable`` and ``fit_check``): what :func:`trusted_column` requires to be "ok".
-LABEL_CHECKS = ("input_check", "speed_check")
+LABEL_CHECKS = ("input_check", "speed_check", "path_check")
 
 
 def comparable_at_speed(frame: Any) -> Any:
     """The ``comparable`` column of a predict table: the SA's comparability, false where
     ``speed_check`` failed (the recording ran at a speed the fit's recordings did not
-    show: another operating condition; a table without ``speed_check`` is left as it
-    is)."""
+    show: another operating condition) or ``path_check`` did (it was heard through
+    another transfer path); a table without either column is left as it is."""
     comparable = frame["comparable"].astype(bool)
-    if "speed_check" in frame:
-        comparable &= frame["speed_check"].astype(str) == "ok"
+    for check in ("speed_check", "path_check"):
+        if check in frame:
+            comparable &= frame[check].astype(str) == "ok"
     return comparable
 
 
 def trusted_column(frame: Any) -> Any:
-    """The ``trusted`` column of a predict table: ``input_check == "ok"`` and
-    ``speed_check == "ok"`` (a table without either column counts as "ok"),
+    """The ``trusted`` column of a predict table: ``input_check``, ``speed_check`` and
+    ``path_check`` "ok" (a table without such a column counts as "ok"),
     ``comparable`` and ``fit_check == "passed"`` (a table without ``fit_check`` is not
     trusted)."""
     import pandas as pd

@@ -33,16 +33,21 @@ def recording_segments(path: str | Path, *, gear_teeth: int = GEAR_TEETH,
 
     ``health``, when given, receives the input checks
     (:mod:`gearshot.io.input_health`): ``"recording"`` (the raw samples') and
-    ``"segments"`` (one per SA segment), and ``"speed"``: the recording's mean shaft
-    speed (:meth:`Recording.shaft_speed`; NaN when it cannot be measured).
+    ``"segments"`` (one per SA segment), ``"speed"``: the recording's mean shaft
+    speed (:meth:`Recording.shaft_speed`; NaN when it cannot be measured), and
+    ``"path"``: its transfer path's resonance pattern
+    (:func:`gearshot.signal.path_pattern.path_pattern`).
     """
+    from ..signal.path_pattern import path_pattern
+
     rec = Recording.read(path)
     sa = rec.to_sa_segments(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,
                             cycles_per_segment=cycles_per_segment,
                             samples_per_cycle=samples_per_cycle)
     if health is not None:
         health.update(recording=check_input(rec.acceleration, units=rec.units),
-                      segments=check_segments(sa, units=rec.units), speed=_speed(rec))
+                      segments=check_segments(sa, units=rec.units), speed=_speed(rec),
+                      path=path_pattern(rec.acceleration, rec.fs))
     if not long:
         return sa
     x = rec.angle_domain(gear_teeth=gear_teeth, pinion_teeth=pinion_teeth,

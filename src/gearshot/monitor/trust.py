@@ -20,7 +20,7 @@ from ..estimator.fit_check import LABEL_CHECKS, MIN_TRUSTED_SHARE, PASSED
 __all__ = ["untrusted_reason", "untrusted_counts", "row_trust", "recording_trust",
            "change_notice", "one_run_warning", "few_runs_warning", "runs_warning",
            "fit_check_warning", "model_warning", "MIN_TRUSTED_SHARE", "CHANGE_RUN",
-           "ONE_RUN_SPREAD", "SPREAD_RECORDINGS"]
+           "ONE_RUN_SPREAD", "SPREAD_RECORDINGS", "OTHER_PATH"]
 
 
 def row_trust(frame: pd.DataFrame) -> np.ndarray:
@@ -75,6 +75,11 @@ NOT_COMPARABLE = "not comparable with the fitted machine"
 #: recording's speed outside the fit's recordings': found again in a note).
 OUTSIDE_FIT_SPEEDS = "outside the fit's recordings'"
 
+#: What every failing reason of :func:`gearshot.app.conditions.fit_path_check` holds (a
+#: recording whose resonance pattern is not the fit's healthy recordings': found again
+#: in a note).
+OTHER_PATH = "another transfer path"
+
 
 def untrusted_reason(frame: pd.DataFrame, *, zero_shot: bool = False) -> str:
     """Why a recording (the rows of its segments) is not trusted, in one line ("" when it
@@ -119,6 +124,7 @@ def untrusted_counts(notes) -> dict[str, int]:
     most frequent first; a recording failing several counts under each."""
     kinds = {"fit check": "fit check failed",
              OUTSIDE_FIT_SPEEDS: "speed outside the fit's recordings' (another load?)",
+             OTHER_PATH: "another transfer path (sensor moved?)",
              **{c.replace("_", " "): f"{c.replace('_', ' ')} failed" for c in LABEL_CHECKS},
              NOT_COMPARABLE: NOT_COMPARABLE,
              "outside the fitted": "outside the fitted condition (index speed or load)",
@@ -138,9 +144,10 @@ def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | N
     """Whether the machine has stopped looking like the fitted one: the latest
     :data:`CHANGE_RUN` or more recordings in a row untrusted because their segments are
     not comparable with the fitted machine (another load, speed, sensor or path, or a
-    fault beyond the example's) or because they ran at a speed outside the fit's
+    fault beyond the example's), because they ran at a speed outside the fit's
     recordings' (:func:`gearshot.app.conditions.fit_speed_check`: another load or speed,
-    which makes a predict row not comparable too). Such recordings never raise an alarm,
+    which makes a predict row not comparable too) or through another transfer path
+    (:func:`gearshot.app.conditions.fit_path_check`). Such recordings never raise an alarm,
     so a machine that changed, or a fault that outgrew the fit, would otherwise go quiet.
 
     Parameters
@@ -159,7 +166,7 @@ def change_notice(times, trusted, notes, *, zero_shot: bool = False) -> dict | N
     run = 0
     for ok, note in zip(reversed(list(trusted)), reversed(list(notes)), strict=True):
         if ok or not any(why in str(note or "") for why in (NOT_COMPARABLE,
-                                                            OUTSIDE_FIT_SPEEDS)):
+                                                            OUTSIDE_FIT_SPEEDS, OTHER_PATH)):
             break
         run += 1
     if run < CHANGE_RUN:
