@@ -421,6 +421,12 @@ def test_estimator_trust_and_a_drifting_low_fit(spur_db):
     slow = est.trust(healthy[-2:], speed_check=["ok", "speed 29.10 Hz lies 1.1 % outside …"])
     assert slow["comparable"].tolist() == [True, False]
     assert slow["trusted"].tolist() == [True, False]
+    # nor one heard through another transfer path
+    moved = est.trust(healthy[-2:], path_check=["another transfer path (…)", "ok"])
+    assert moved["comparable"].tolist() == [False, True]
+    assert moved["trusted"].tolist() == [False, True]
+    with pytest.raises(GearshotError, match="path_check holds 3 value"):
+        est.trust(healthy[-2:], path_check=["ok"] * 3)
     with pytest.raises(GearshotError, match="input_check holds 1 value"):
         est.trust(healthy[-2:], input_check=["ok"])
     with pytest.raises(GearshotError, match="speed_check holds 3 value"):

@@ -116,7 +116,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         return reference.evaluate(sa, false_alarm_rate)
 
     def trust(self, sa: ArrayLike, input_check: Any = None, *,
-              coverage: float = 0.9, recording: Any = None, speed_check: Any = None) -> Any:
+              coverage: float = 0.9, recording: Any = None, speed_check: Any = None,
+              path_check: Any = None) -> Any:
         """Every estimate with the checks it passed or failed (issue #29).
 
         Parameters
@@ -138,6 +139,11 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             :func:`gearshot.app.conditions.fit_speed_check` of its speed against the fit's
             recordings'): a segment that fails it is not comparable, as in ``gearshot
             predict``'s tables. None: "ok".
+        path_check : str or sequence of str, optional
+            Whether each SA's recording was heard through the fit's transfer path ("ok"
+            or why not; e.g. :func:`gearshot.app.conditions.fit_path_check` of its
+            :func:`~gearshot.signal.path_pattern.path_pattern` against the fit's
+            healthy recordings'): as ``speed_check``. None: "ok".
 
         Returns
         -------
@@ -161,9 +167,10 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
                                   comparability=comp.p_value, comparable=comp.comparable))
         frame["input_check"] = "ok" if input_check is None else _per_row(
             input_check, len(arr), "input_check")
-        if speed_check is not None:
-            frame["speed_check"] = _per_row(speed_check, len(arr), "speed_check")
-            frame["comparable"] = comparable_at_speed(frame)
+        for name, value in (("speed_check", speed_check), ("path_check", path_check)):
+            if value is not None:
+                frame[name] = _per_row(value, len(arr), name)
+        frame["comparable"] = comparable_at_speed(frame)
         check: FitCheck | None = getattr(self, "fit_check_", None)
         frame["fit_check"] = "unchecked: fitted before the fit check existed" \
             if check is None else check.verdict
