@@ -38,9 +38,12 @@ PHM09 fits in the 30 Hz cells (both loads, both sensors) and rig seed 701. Held-
 
 Rates are per segment (``comparable``) and per recording (``record_comparable``: the
 record's median score, all its segments judged together). ``with_speed`` is what a predict
-table's ``comparable`` holds: the SA's comparability and the recording's speed within what
-the fit's recordings showed (:func:`gearshot.app.conditions.fit_speed_check` on the tacho
-speeds; the rigs record at their set-point speeds).
+table's ``comparable`` held before the path check: the SA's comparability and the
+recording's speed within what the fit's recordings showed
+(:func:`gearshot.app.conditions.fit_speed_check` on the tacho speeds; the rigs record at
+their set-point speeds); ``with_path`` is what it holds now: that and the recording heard
+through the fit's transfer path (:func:`gearshot.app.conditions.fit_path_check` of its
+resonance pattern against the fit's healthy recordings').
 
     GEARSHOT_DATA=... PYTHONPATH=src python benchmarks/comparability_matrix.py --part dev
     GEARSHOT_DATA=... PYTHONPATH=src python benchmarks/comparability_matrix.py --part held-out
@@ -56,9 +59,10 @@ import numpy as np
 import pandas as pd
 
 from gearshot import Machine
-from gearshot.app.conditions import fit_speed_check
+from gearshot.app.conditions import fit_path_check, fit_speed_check
 from gearshot.estimator.comparability import fit_comparability
 from gearshot.estimator.fit_check import typical_segment
+from gearshot.signal.path_pattern import path_pattern
 
 ROOT = Path(__file__).resolve().parents[1]
 PARTS = {"dev": dict(speeds=(30,), rig_seeds=(701,)),
@@ -79,12 +83,15 @@ class _Phm:
         self._read = machine_segments
         self._cache: dict[tuple[str, str], np.ndarray] = {}
         self.speed: dict[str, float] = {}    # record name -> tacho speed, Hz
+        self.pattern: dict[tuple[str, str], np.ndarray] = {}   # resonance pattern
 
     def __call__(self, name: str, sensor: str) -> np.ndarray:
         if (name, sensor) not in self._cache:
+            info: dict = {}
             sa, _, speed = self._read(self.data / f"{name}.zip", self.machine,
-                                      cycles_per_segment=10, sensor=sensor)
+                                      cycles_per_segment=10, sensor=sensor, info=info)
             self._cache[name, sensor], self.speed[name] = sa, float(speed)
+            self.pattern[name, sensor] = info["path"]
         return self._cache[name, sensor]
 
 
@@ -94,11 +101,13 @@ def _fit_part(sa: np.ndarray) -> int:
 
 
 def _score(rows: list[dict], ref, setting: str, kind: str, record: str,
-           sa: np.ndarray, speed_check: str = "ok") -> None:
+           sa: np.ndarray, speed_check: str = "ok", path_check: str = "ok") -> None:
     res = ref.evaluate(sa)
     rows.extend(dict(setting=setting, kind=kind, record=record, score=s, p_value=p,
                      comparable=bool(c), record_comparable=res.record_comparable,
-                     speed_check=speed_check, with_speed=bool(c) and speed_check == "ok")
+                     speed_check=speed_check, with_speed=bool(c) and speed_check == "ok",
+                     path_check=path_check,
+                     with_path=bool(c) and speed_check == "ok" and path_check == "ok")
                 for s, p, c in zip(res.score, res.p_value, res.comparable))
 
 
@@ -119,11 +128,16 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
                 setting = f"phm09 {sp}hz_{ld} {se}"
                 fit_speeds = ([phm.speed[f"spur3_{sp}hz_{ld}_1"]],
                               phm.speed[f"spur2_{sp}hz_{ld}_1"])
+                fit_paths = [phm.pattern[f"spur3_{sp}hz_{ld}_1", se]]
 
-                def add(kind, record, sa, ref=ref, setting=setting, fit_speeds=fit_speeds):
-                    speed = phm.speed[record.split()[0]]
+                def add(kind, record, sa, ref=ref, setting=setting, fit_speeds=fit_speeds,
+                        fit_paths=fit_paths, se=se):
+                    name = record.split()[0]
+                    sensor = record.split()[1] if record.split()[-1] in SENSORS else se
                     _score(rows, ref, setting, kind, record, sa,
-                           fit_speed_check(speed, fit_speeds[0], example_speed=fit_speeds[1]))
+                           fit_speed_check(phm.speed[name], fit_speeds[0],
+                                           example_speed=fit_speeds[1]),
+                           fit_path_check(phm.pattern[name, sensor], fit_paths))
                 add("same machine", f"spur3_{sp}hz_{ld}_1 hold-out", healthy[n_fit:])
                 add("same machine", f"spur2_{sp}hz_{ld}_1 rest", np.delete(example, k, 0))
                 for case in ("spur3", "spur2"):
@@ -147,36 +161,49 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
                                     faulty_example=ex[typical_segment(ex)],
                                     faulty_size=size)
             fit_speeds = [phm.speed[f"{c}_{sp}hz_High_1"] for c in ("spur1", "spur3")]
+            fit_paths = [phm.pattern[f"{c}_{sp}hz_High_1", se] for c in ("spur1", "spur3")]
             for case in ("spur1", "spur2", "spur3"):
                 name = f"{case}_{sp}hz_Low_1"
                 sa = phm(name, se)
                 _score(rows, ref, f"phm09 {sp}hz journey {se}", "another load", name, sa,
                        fit_speed_check(phm.speed[name], fit_speeds,
-                                       example_speed=phm.speed[f"spur2_{sp}hz_High_1"]))
+                                       example_speed=phm.speed[f"spur2_{sp}hz_High_1"]),
+                       fit_path_check(phm.pattern[name, se], fit_paths))
     return rows
 
 
-def rig_rows(seed: int) -> list[dict]:
-    from rig_comparability import _sa as _rig_sa  # the rig records of the first matrix
+def _rig_record(rig, *, speed=15.0, load=10.0, size=0.0, rep=0, segments=4):
+    """A rig recording's 50-cycle SA segments (as ``rig_comparability._sa``, the records
+    of the first matrix) and its resonance pattern."""
+    duration = 1.02 * (segments * 50 + 1) / (speed * 17 / 38)
+    rec = rig.record(speed=speed, load=load, fault_size=size, duration=duration,
+                     repetition=rep)
+    return (rec.to_sa_segments(gear_teeth=38, pinion_teeth=17, cycles_per_segment=50,
+                               samples_per_cycle=2048), path_pattern(rec.acceleration, rec.fs))
 
+
+def rig_rows(seed: int) -> list[dict]:
     from gearshot.rig import VirtualRig
 
     rig = VirtualRig(seed=seed)
     truth = rig.reveal()
-    healthy = np.vstack([_rig_sa(rig, rep=r) for r in range(5)])
-    example = _rig_sa(rig, size=0.6, rep=0)
+    records = [_rig_record(rig, rep=r) for r in range(5)]
+    healthy = np.vstack([sa for sa, _ in records])
+    fit_paths = [p for _, p in records]
+    example, example_path = _rig_record(rig, size=0.6, rep=0)
     k = typical_segment(example)
     ref = fit_comparability(healthy, 38, faulty_example=example[k], faulty_size=0.6)
     setting = f"rig {seed}"
     rows: list[dict] = []
 
-    def add(kind, record, sa, speed=15.0):   # the rigs record at their set-points
-        _score(rows, ref, setting, kind, record, sa,
-               fit_speed_check(speed, [15.0] * 5, example_speed=15.0))
-    add("same machine", "healthy rep 5", _rig_sa(rig, rep=5))
-    add("same machine", "size 0.6 rep 0 rest", np.delete(example, k, 0))
+    def add(kind, record, sa_path, speed=15.0):   # the rigs record at their set-points
+        _score(rows, ref, setting, kind, record, sa_path[0],
+               fit_speed_check(speed, [15.0] * 5, example_speed=15.0),
+               fit_path_check(sa_path[1], fit_paths))
+    add("same machine", "healthy rep 5", _rig_record(rig, rep=5))
+    add("same machine", "size 0.6 rep 0 rest", (np.delete(example, k, 0), example_path))
     for size, rep in ((0.3, 0), (0.3, 1), (0.6, 1)):
-        add("same machine", f"size {size} rep {rep}", _rig_sa(rig, size=size, rep=rep))
+        add("same machine", f"size {size} rep {rep}", _rig_record(rig, size=size, rep=rep))
     atten = truth.attenuation_db + (6.0 if truth.attenuation_db <= 24 else -6.0)
     others = {
         ("another load", "5 N m"): (rig, dict(load=5.0)),
@@ -190,7 +217,7 @@ def rig_rows(seed: int) -> list[dict]:
     }
     for (kind, what), (other, kw) in others.items():
         for size in (0.0, 0.6):
-            add(kind, f"{what}, size {size}", _rig_sa(other, size=size, rep=0, **kw),
+            add(kind, f"{what}, size {size}", _rig_record(other, size=size, rep=0, **kw),
                 speed=kw.get("speed", 15.0))
     return rows
 
@@ -203,7 +230,8 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
         segments=("comparable", "size"), records=("pair", "nunique"),
         flagged=("comparable", lambda c: 1 - c.mean()),
         record_flagged=("record_comparable", lambda c: 1 - c.mean()),
-        with_speed=("with_speed", lambda c: 1 - c.mean()))
+        with_speed=("with_speed", lambda c: 1 - c.mean()),
+        with_path=("with_path", lambda c: 1 - c.mean()))
     return out.reset_index()
 
 
@@ -226,10 +254,10 @@ def main() -> None:
     out.parent.mkdir(parents=True, exist_ok=True)
     table.to_csv(out, index=False, float_format="%.4g")
     fmt = {"flagged": "{:.1%}".format, "record_flagged": "{:.1%}".format,
-           "with_speed": "{:.1%}".format}
+           "with_speed": "{:.1%}".format, "with_path": "{:.1%}".format}
     print(f"part: {args.part}")
     print(summary(table).to_string(index=False, formatters=fmt))
-    for column in ("comparable", "with_speed"):
+    for column in ("comparable", "with_speed", "with_path"):
         per = table.groupby(["setting", "kind"], sort=False)[column].agg(
             n="size", flagged=lambda c: 1 - c.mean()).unstack("kind")["flagged"]
         print(f"flagged per fit ({column}):")
