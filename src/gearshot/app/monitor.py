@@ -206,28 +206,32 @@ def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
     extras = getattr(model, "extras", None) or {}
     seen, example = extras.get("healthy_speeds") or [], extras.get("example_speed")
     paths = extras.get("healthy_paths") or []   # models saved before it: no path check
-    health: dict = {}
     if machine is None:
         from ..io import recording_segments
 
+        health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
                                 pinion_teeth=cond["pinion_teeth"], health=health)
+        note, pattern = "", health.get("path")
         check = fit_speed_check(float(health.get("speed", np.nan)), seen,
                                 example_speed=example, unit="rev/s")
-        if check == "ok":
-            check = fit_path_check(health.get("path"), paths)
-        return np.asarray(sa), "" if check == "ok" else check
-    from .predict_machine import machine_segments
+    else:
+        from ..io import Recording
+        from ..signal.path_pattern import path_pattern
+        from .predict_machine import machine_segments
 
-    sa, _, hz = machine_segments(path, machine, cycles_per_segment=cond["cycles_per_segment"],
-                                 sensor=cond["sensor"], info=health)
-    off = abs(hz - cond["speed"]) / cond["speed"]
-    note = "" if off <= cond["speed_tolerance"] else (
-        f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
-    check = fit_speed_check(hz, seen, example_speed=example)   # within the gate
+        rec = Recording.read(path, machine=machine)
+        sa, _, hz = machine_segments(path, machine, rec=rec, sensor=cond["sensor"],
+                                     cycles_per_segment=cond["cycles_per_segment"])
+        heard = rec.channel(machine.sensor(cond["sensor"]).name)
+        pattern = path_pattern(heard.acceleration, heard.fs)
+        off = abs(hz - cond["speed"]) / cond["speed"]
+        note = "" if off <= cond["speed_tolerance"] else (
+            f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
+        check = fit_speed_check(hz, seen, example_speed=example)   # within the gate
     if check == "ok":
-        check = fit_path_check(health.get("path"), paths)
-    return sa, note or ("" if check == "ok" else check)
+        check = fit_path_check(pattern, paths)
+    return np.asarray(sa), note or ("" if check == "ok" else check)
 
 
 def estimate_recordings(model, recordings: pd.DataFrame, *,

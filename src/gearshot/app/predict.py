@@ -351,10 +351,9 @@ def input_check_summary(frame: pd.DataFrame) -> str:
             f"{len(failed)} ({counts}): no estimate is given for them")
 
 
-def speed_check_summary(frame: pd.DataFrame, column: str = "speed_check") -> str | None:
-    """One line naming the recordings whose ``speed_check`` failed (a tracked speed not to
-    be trusted, or a speed outside the fit's healthy recordings'), or those whose
-    ``column`` did (``"path_check"``: another transfer path); None when none did."""
+def failed_check_summary(frame: pd.DataFrame, column: str) -> str | None:
+    """One line naming the recordings whose ``column`` check failed (``"speed_check"``,
+    ``"path_check"``); None when none did."""
     if column not in frame or not len(frame):
         return None
     bad = frame.loc[frame[column] != "ok"].drop_duplicates("recording")
@@ -363,6 +362,11 @@ def speed_check_summary(frame: pd.DataFrame, column: str = "speed_check") -> str
     first = f"{Path(str(bad['recording'].iloc[0])).name}: {bad[column].iloc[0]}"
     return (f"{column}: failed for {len(bad)} recording(s) ({first}"
             + (", …" if len(bad) > 1 else "") + "): their estimates are not trusted")
+
+
+def speed_check_summary(frame: pd.DataFrame) -> str | None:
+    """:func:`failed_check_summary` of ``speed_check``."""
+    return failed_check_summary(frame, "speed_check")
 
 
 def detection_summary(frame: pd.DataFrame) -> str | None:
@@ -388,8 +392,8 @@ def format_predictions(frame: pd.DataFrame, where: str) -> str:
     if frame.attrs.get("fit_warning"):
         lines.append(f"warning: {frame.attrs['fit_warning']}")
     lines += [table, comparable_summary(frame), input_check_summary(frame)]
-    lines += [line for line in (speed_check_summary(frame),
-                                speed_check_summary(frame, "path_check"),
+    lines += [line for line in (failed_check_summary(frame, "speed_check"),
+                                failed_check_summary(frame, "path_check"),
                                 detection_summary(frame)) if line]
     if "trusted" in frame:
         lines.append(trust_summary(frame))

@@ -32,7 +32,7 @@ def short_value(value: Any) -> str:
 def predict_report(payload, out: Path, source: Path) -> Path:
     import pandas as pd
 
-    from .predict import speed_check_summary, summary_table
+    from .predict import failed_check_summary, summary_table
 
     frame = pd.DataFrame(predict_rows(payload))
     table = summary_table(frame)
@@ -50,7 +50,7 @@ def predict_report(payload, out: Path, source: Path) -> Path:
         lines += [f"Comparable segments: {int(frame['comparable'].astype(bool).sum())} of "
                   f"{len(frame)}.", ""]
     for column in ("speed_check", "path_check"):
-        if line := speed_check_summary(frame, column):
+        if line := failed_check_summary(frame, column):
             lines += ["`" + line.replace(": ", "`: ", 1) + ".", ""]
     if "trusted" in frame:
         lines += [f"Trusted segments: {int(frame['trusted'].astype(bool).sum())} of "
