@@ -39,7 +39,7 @@ class FittedFiles:
 def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
                    coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
                    selection_tf=None, recordings=(), holdout=0.25, holdout_files=(),
-                   reads=None):
+                   reads=None, params=None):
     """Fit the estimator from recording files (the fit of ``gearshot predict`` and
     ``gearshot fit`` without ``--machine``), its hold-outs checking it.
 
@@ -52,7 +52,8 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     segmented before the fit: a bad file fails now, not after minutes of fitting.
     ``reads``, a dict kept by the caller across fits on the same files, holds the database
     slice and every file's segments, so that each is read once (``gearshot fit``'s
-    cross-fits).
+    cross-fits). ``params``: other :class:`~gearshot.estimator.OneFaultShotEstimator`
+    parameters (the library defaults when None).
 
     Returns
     -------
@@ -89,10 +90,11 @@ def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
     checks = dict(holdout=holdout, healthy_recordings=labels, healthy_holdout=np.vstack(
         [sa for _, sa, _ in held] + [sa for p, sa in targets if _key(p) in whole]))
     if faulty is None:
-        est = OneFaultShotEstimator(random_state=seed, calibration="zero_shot")
+        est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed,
+                                       "calibration": "zero_shot"})
         est.fit(db, healthy_sa, None, None, long, selection_tf=selection_tf, **checks, **kw)
     else:
-        est = OneFaultShotEstimator(random_state=seed)
+        est = OneFaultShotEstimator(**{**(params or {}), "random_state": seed})
         est.fit(db, healthy_sa, example, faulty_size, long, selection_tf=selection_tf,
                 example_record=rest, **checks, **kw)
     return est, FittedFiles(float(speed), float(load), kw, targets, held, rest, health)
