@@ -579,3 +579,25 @@ def test_help_shows_flags_as_flags(sub, monkeypatch, capsys):
         paired = next(ln for ln in out.splitlines() if "--paired" in ln)
         assert "--no-paired" in paired and "<" not in paired
         assert "<list[float]>" in next(ln for ln in out.splitlines() if "--speed " in ln)
+
+
+@pytest.mark.parametrize("option, value", [("--false-alarm-rate", "0.7"),
+                                           ("--false-alarm-rate", "0"), ("--sustain", "0")])
+def test_fit_refuses_a_bad_alarm_option_before_fitting(tmp_path, monkeypatch, capsys, option,
+                                                       value):
+    """``gearshot fit --false-alarm-rate/--sustain`` out of range: one line naming the
+    option, before the database or any recording is read."""
+    import gearshot.app.predict_fit as predict_fit
+
+    def never(*args, **kwargs):
+        raise LongWork("the fit started")
+
+    monkeypatch.setattr(predict_fit, "fit_from_files", never)
+    healthy = [tmp_path / f"h{k}.h5" for k in range(2)]
+    for path in healthy:
+        path.write_bytes(b"")
+    code, _, err = gearshot(monkeypatch, capsys, "fit", "--database", tmp_path / "db",
+                            "--speed", "15", "--healthy", *healthy,
+                            "--model", tmp_path / "m.skops", option, value)
+    one_line(code, err, option)
+    assert not (tmp_path / "m.skops").exists()

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .._errors import GearshotError
-from .._validation import check_in_range
+from .._validation import check_in_range, check_int
 
 __all__ = ["fit_model", "estimate_recordings", "monitor_history", "monitor_fleet",
            "write_monitor_outputs", "LOAD_TOLERANCE"]
@@ -75,16 +75,14 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
         Saved at ``model``.
     """
     from ..monitor import MonitorModel, alarm_threshold, database_identity
-    from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
     from ..monitor.trust import runs_warning
     from .predict import estimate_segments
 
-    rate = FALSE_ALARM_RATE if false_alarm_rate is None else false_alarm_rate
-    sustain = SUSTAIN if sustain is None else sustain
     if (faulty is None) != (faulty_size is None):
         raise GearshotError("--faulty and --faulty-size go together (neither: zero-shot)")
     check_in_range(holdout, "holdout (--holdout)", 0.0, 1.0, low_inclusive=False,
                    high_inclusive=False)
+    rate, sustain = _alarm_options(false_alarm_rate, sustain)
     identity = database_identity(database)
     if machine is None:
         if speed is None:
@@ -134,6 +132,17 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
                 "healthy_paths": [None if v is None else list(map(float, v)) for v in paths]})
     result.save(model)
     return result
+
+
+def _alarm_options(false_alarm_rate: float | None, sustain: int | None) -> tuple[float, int]:
+    """The alarm's false-alarm rate and sustain, defaults filled in and checked."""
+    from ..monitor.alarm import FALSE_ALARM_RATE, SUSTAIN
+
+    rate = check_in_range(FALSE_ALARM_RATE if false_alarm_rate is None else false_alarm_rate,
+                          "false_alarm_rate (--false-alarm-rate)", 0.0, 0.5,
+                          low_inclusive=False, high_inclusive=False)
+    return rate, check_int(SUSTAIN if sustain is None else sustain, "sustain (--sustain)",
+                           minimum=1)
 
 
 def _cross_fitted(database, fit_files, faulty, faulty_size, *, speed, load, coverage, seed,

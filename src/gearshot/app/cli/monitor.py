@@ -41,6 +41,12 @@ def fit(
                                                      help=_HELP["cycles"]),
     sensor: str | None = typer.Option(None, "--sensor", help=_HELP["sensor"]),
     speed_tolerance: float = typer.Option(0.05, "--speed-tolerance", help=_HELP["tolerance"]),
+    false_alarm_rate: float | None = typer.Option(
+        None, "--false-alarm-rate", help="Probability that a healthy recording exceeds the "
+        "alarm threshold, in (0, 0.5) (default 0.02: gearshot.monitor.FALSE_ALARM_RATE)."),
+    sustain: int | None = typer.Option(
+        None, "--sustain", help="Consecutive trusted recordings over the threshold that "
+        "raise the alarm (and under it that clear it), at least 1 (default 2)."),
 ) -> None:
     """Fit once and write a model file for gearshot monitor (zero-shot without --faulty)."""
     check_seed(seed)
@@ -58,7 +64,8 @@ def fit(
                        machine=machine, speed=speed, load=load, coverage=coverage,
                        gear_teeth=gear_teeth, pinion_teeth=pinion_teeth, seed=seed,
                        cycles_per_segment=cycles_per_segment, sensor=sensor,
-                       speed_tolerance=speed_tolerance)
+                       speed_tolerance=speed_tolerance, false_alarm_rate=false_alarm_rate,
+                       sustain=sustain)
     from ...monitor.trust import model_warning
 
     typer.echo(result.describe())
