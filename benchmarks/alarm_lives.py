@@ -24,12 +24,10 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-def judge(rig: Path, mode: str, rate: float, sustain: int, floor: float | None) -> dict | None:
+def judge(rig: Path, mode: str, rate: float, sustain: int) -> dict | None:
     from monitor_lives import fault_alarm_start
-    from scipy import stats
 
-    from gearshot.monitor import alarm_states, load_model
-    from gearshot.monitor.alarm import MIN_THRESHOLD
+    from gearshot.monitor import alarm_states, alarm_threshold, load_model
 
     mpath, hpath = rig / f"{mode}.skops", rig / f"{mode}.parquet"
     if not (mpath.is_file() and hpath.is_file()):
@@ -40,10 +38,7 @@ def judge(rig: Path, mode: str, rate: float, sustain: int, floor: float | None) 
     truth = pd.read_csv(rig / "life" / "index.csv", keep_default_na=False)
     hist = hist.assign(file=[Path(r).name for r in hist["recording"]])
     recs = truth.merge(hist[["file", "predicted", "trusted"]], on="file", how="left")
-    base = np.asarray(model.baseline, dtype=float)
-    base = base[np.isfinite(base)]
-    raw = base.mean() + stats.norm.isf(rate) * base.std(ddof=1)   # alarm_threshold's law
-    thr = max(float(raw), MIN_THRESHOLD if floor is None else floor)
+    thr = alarm_threshold(model.baseline, false_alarm_rate=rate)
     ok = recs["trusted"].fillna(False).to_numpy(bool)
     res = alarm_states(recs["predicted"].to_numpy(float), ok, thr, sustain=sustain)
     size = recs["size"].to_numpy(float)
@@ -63,7 +58,6 @@ def main() -> None:
     parser.add_argument("--seeds", nargs="*", type=int, default=None)
     parser.add_argument("--rates", nargs="+", type=float, default=[0.01])
     parser.add_argument("--sustains", nargs="+", type=int, default=[2])
-    parser.add_argument("--floors", nargs="+", type=float, default=[None])
     parser.add_argument("--modes", nargs="+", default=["one_fault_shot", "zero_shot"])
     parser.add_argument("--out", type=Path, default=None, help="per-life CSV")
     args = parser.parse_args()
@@ -79,22 +73,21 @@ def main() -> None:
     rows = []
     for rate in args.rates:
         for sustain in args.sustains:
-            for floor in args.floors:
-                for mode in args.modes:
-                    got = [j for r in unique if (j := judge(r, mode, rate, sustain, floor))]
-                    part = pd.DataFrame(got)
-                    if part.empty:
-                        continue
-                    part = part.assign(rate=rate, sustain=sustain, floor=floor)
-                    rows.append(part)
-                    d = part["delay"]
-                    ok = int((d.notna() & (d <= 3)).sum())
-                    fa = part["false_alarms"].sum()
-                    print(f"rate {rate:g} sustain {sustain} floor {floor} {mode}: in time "
-                          f"{ok}/{len(part)}, false alarms {fa} in {part['healthy'].sum()} "
-                          f"({100 * fa / max(part['healthy'].sum(), 1):.2f} per 100), events "
-                          f"alarmed {part['events_alarmed'].sum()}, median threshold "
-                          f"{part['threshold'].median():.3f}", flush=True)
+            for mode in args.modes:
+                got = [j for r in unique if (j := judge(r, mode, rate, sustain))]
+                part = pd.DataFrame(got)
+                if part.empty:
+                    continue
+                part = part.assign(rate=rate, sustain=sustain)
+                rows.append(part)
+                d = part["delay"]
+                ok = int((d.notna() & (d <= 3)).sum())
+                fa = part["false_alarms"].sum()
+                print(f"rate {rate:g} sustain {sustain} {mode}: in time {ok}/{len(part)}, "
+                      f"false alarms {fa} in {part['healthy'].sum()} "
+                      f"({100 * fa / max(part['healthy'].sum(), 1):.2f} per 100), events "
+                      f"alarmed {part['events_alarmed'].sum()}, median threshold "
+                      f"{part['threshold'].median():.3f}", flush=True)
     if args.out is not None and rows:
         pd.concat(rows).to_csv(args.out, index=False)
 
