@@ -20,6 +20,7 @@ from gearshot.estimator import (
     EstimatorOptions,
     NotFittedError,
     OneFaultShotEstimator,
+    regressors,
     steps,
 )
 from gearshot.estimator._params import validate_params
@@ -274,8 +275,8 @@ def test_options_change_what_they_name(data, tfs, fitted):
     coarser delay grid changes the target features, the defaults repeat the default fit."""
     same = _fit(OneFaultShotEstimator(**{**FAST, "options": EstimatorOptions()}), data, tfs)
     assert_array_equal(same.predict(data[3]), fitted.predict(data[3]))
-    few = _fit(OneFaultShotEstimator(**{**FAST, "options": {"n_neighbors": [1, 2]}}),
-               data, tfs)
+    few = _fit(OneFaultShotEstimator(**{**FAST, "estimator": "paper",  # the KNN's K
+                                        "options": {"n_neighbors": [1, 2]}}), data, tfs)
     assert few.n_neighbors_ in (1, 2) and few.model_.validation_mae.size == 2
     coarse = _fit(OneFaultShotEstimator(**{**FAST, "options": {"upsample": 1}}), data, tfs)
     assert not np.array_equal(coarse.features_of(data[3]), fitted.features_of(data[3]))
@@ -311,11 +312,13 @@ def test_failed_fit_leaves_no_state(data, tfs, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("step 8 failed")
 
-    est = OneFaultShotEstimator(**FAST)
-    monkeypatch.setattr(steps, "fit_knn", broken)
-    with pytest.raises(RuntimeError, match="step 8"):
-        _fit(est, data, tfs)
-    assert set(vars(est)) == set(est.get_params())
+    for name, module, function in (("paper", steps, "fit_knn"),
+                                   ("boosting", regressors, "_learner")):
+        est = OneFaultShotEstimator(**FAST, estimator=name)
+        monkeypatch.setattr(module, function, broken)
+        with pytest.raises(RuntimeError, match="step 8"):
+            _fit(est, data, tfs)
+        assert set(vars(est)) == set(est.get_params())
 
 
 def test_failed_refit_keeps_the_previous_model(data, tfs, fitted):

@@ -333,9 +333,12 @@ def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
     frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur2_30hz_High_1.zip", 0.95)
     verdict = frame.attrs["fit_check"]["verdict"]
     assert verdict != "passed" and "against the declared 0.95" in verdict
-    # the example itself is read back too (0.80 here: within the limit, not named)
+    # the example itself is read back too, and named exactly when it reads outside the
+    # limit (0.58 here with the boosted trees, which do not reach past the database's
+    # largest rows of this grade; 0.80 with the paper's KNN)
     own = frame.attrs["fit_check"]["example_self"]
-    assert 0.5 < own < 0.95 and "the example itself" not in verdict
+    assert 0.5 < own < 0.95
+    assert ("the example itself" in verdict) == (abs(own - 0.95) > 0.15)
     assert (frame["fit_check"] == verdict).all() and not frame["trusted"].any()
     # a failed fit keeps the limit of its simulated validation rows
     assert frame.attrs["detection_limit"] > 0.3

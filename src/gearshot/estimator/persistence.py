@@ -47,6 +47,7 @@ SAFE_TYPES = (
     "gearshot.estimator.drift.Drift",
     "sklearn.metrics._dist_metrics.EuclideanDistance64",
     "sklearn.neighbors._kd_tree.KDTree",
+    "sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor",
 )
 
 
