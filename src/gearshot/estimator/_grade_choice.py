@@ -199,7 +199,8 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         opts = self._options()
         return fit_regressor(getattr(self, "estimator", "paper"), X, labels,
                              n_neighbors=opts.n_neighbors,
-                             validation_fraction=opts.validation_fraction, random_state=seed)
+                             validation_fraction=opts.validation_fraction, random_state=seed,
+                             n_own=len(target.healthy_features))
 
     # ------------------------------------------------------------------ fit: grade choice
     def _choose_grades(self, ctx: _FitContext, grades: Sequence[int], paired: bool

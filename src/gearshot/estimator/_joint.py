@@ -146,4 +146,5 @@ class _JointCalibration(BaseEstimator):  # type: ignore[misc,unused-ignore]
         return fit_regressor(getattr(self, "estimator", "paper"), X, labels,
                              n_neighbors=opts.n_neighbors,
                              validation_fraction=opts.validation_fraction,
-                             random_state=ctx.knn_seed)
+                             random_state=ctx.knn_seed,
+                             n_own=len(ctx.target.healthy_features))

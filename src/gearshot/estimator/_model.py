@@ -377,9 +377,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         ctx = self._fit_context(by_grade, grades, nominal, target, inputs, names, cols,
                                 seeds["fit_knn"], twins, seeds["match_noise"])
         grade_choice = self._choose_grades(ctx, grades, twins is not None)
-        pairs = list(zip(grade_choice["calibration_"]["settings"], grade_choice["setting_models_"]))
-        detection = detection_limit([m for _, m in pairs], [st["weight"] for st, _ in pairs],
-            own_rows=[m.validation_indices >= len(by_grade[st["grade"]][1]) for st, m in pairs])
+        detection = detection_limit(grade_choice["setting_models_"], [
+            st["weight"] for st in grade_choice["calibration_"]["settings"]])
         comparability = fit_comparability(
             inputs.target_healthy, self._mesh_orders(), faulty_example=inputs.faulty_example,
             faulty_size=inputs.faulty_size, recordings=recordings)

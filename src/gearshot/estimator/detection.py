@@ -7,14 +7,14 @@ machine's noise and grade; its faulty rows how the estimate grows with the size:
 
 * **threshold**: the ``confidence`` quantile (default 95 %) of the healthy rows'
   estimates, pooled over the models with their weights: a healthy segment reads below it
-  with that probability; and at least the largest estimate of the machine's **own**
-  healthy rows in any weighted model's validation split (``own_rows``). The simulated
-  healthy rows carry the target's matched noise but not what a new recording of the
-  machine adds; the machine's own rows, read by a model that did not train on them, do.
-  (A learner that reads its simulated healthy rows at exactly 0, as boosted trees with an
-  absolute-error loss do, otherwise states a limit of 0.005–0.09 on smooth rigs that the
-  machine's next healthy recording reads above: development rigs 100–123, boosting, 85 %
-  of the healthy test segments below the limit without this bound, benchmarks/RESULTS.md.)
+  with that probability; and, for learners that read them (``own_prediction``: boosted
+  trees), at least the same quantile of the machine's own healthy segments as models
+  that never trained on them read them (weighted over the models, as ``predict``
+  combines them). The simulated healthy rows carry the target's matched noise but not
+  what another recording of the machine adds; boosted trees read them at 0 and, without
+  this bound, stated limits of 0.005–0.09 on smooth development rigs whose next healthy
+  recording read above them (85 % of the healthy test segments below the limit against
+  the 95 % stated; benchmarks/RESULTS.md);
 * **size-to-estimate curve**: the weighted isotonic (increasing) fit of the validation
   estimates on the true sizes;
 * **limit**: the smallest size whose curve reaches the threshold (where an estimate of a
@@ -80,10 +80,20 @@ def _weighted_quantile(values: FloatArray, weights: FloatArray, q: float) -> flo
     return float(values[order][min(int(np.searchsorted(cum, q * cum[-1])), len(cum) - 1)])
 
 
+def _own_quantile(models: Sequence[Any], weights: FloatArray, confidence: float) -> float:
+    """The ``confidence`` quantile of the machine's own healthy rows as the weighted
+    models that never trained on them read them (0 when no model read them)."""
+    own = [(wt, np.asarray(m.own_prediction, dtype=float)) for m, wt in zip(models, weights)
+           if wt > 0 and getattr(m, "own_prediction", None) is not None]
+    if not own or len({p.shape for _, p in own}) != 1 or own[0][1].size == 0:
+        return 0.0
+    reading = sum(wt * p for wt, p in own) / sum(wt for wt, _ in own)
+    return float(np.quantile(reading, confidence, method="higher"))
+
+
 def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
                     confidence: float = DETECTION_CONFIDENCE,
-                    n_grid: int = 201,
-                    own_rows: Sequence[ArrayLike] | None = None) -> DetectionLimit:
+                    n_grid: int = 201) -> DetectionLimit:
     """The detection limit of weighted step-8 models from their validation splits.
 
     Parameters
@@ -95,10 +105,6 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
     confidence : float in (0, 1), default 0.95
     n_grid : int, default 201
         Sizes on [0, 1] where the curve is read.
-    own_rows : sequence of boolean arrays, optional
-        One per model, aligned with its validation rows: True where the row is one of the
-        machine's own healthy segments (not simulated). The threshold is at least their
-        largest estimate.
 
     Returns
     -------
@@ -117,11 +123,8 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
             or w.sum() <= 0:
         raise GearshotError(f"weights must hold one finite weight >= 0 per model "
                             f"({len(models)}), not all 0; got {list(w)!r}")
-    if own_rows is not None and len(own_rows) != len(models):
-        raise GearshotError(f"own_rows must hold one mask per model ({len(models)}); got "
-                            f"{len(own_rows)}")
-    ys, preds, row_w, own_max = [], [], [], 0.0
-    for i, (model, weight) in enumerate(zip(models, w)):
+    ys, preds, row_w = [], [], []
+    for model, weight in zip(models, w):
         pred = getattr(model, "validation_prediction", None)
         if pred is None or weight == 0:
             continue
@@ -129,13 +132,6 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
         ys.append(y)
         preds.append(np.asarray(pred, dtype=float))
         row_w.append(np.full(y.size, weight / y.size))
-        if own_rows is not None:
-            own = np.asarray(own_rows[i], dtype=bool) & (y == 0)
-            if own.shape != y.shape:
-                raise GearshotError(f"own_rows[{i}] must hold one flag per validation row "
-                                    f"({y.size}); got shape {own.shape}")
-            if own.any():
-                own_max = max(own_max, float(preds[-1][own].max()))
     if not ys:
         raise GearshotError("detection_limit needs models with validation estimates "
                             "(fitted by this version of gearshot)")
@@ -144,7 +140,8 @@ def detection_limit(models: Sequence[Any], weights: Sequence[float], *,
     if not healthy.any() or healthy.all():
         raise GearshotError(f"detection_limit needs healthy and faulty validation rows; got "
                             f"{int(healthy.sum())} healthy of {y.size}")
-    threshold = max(_weighted_quantile(pred[healthy], rw[healthy], confidence), own_max)
+    threshold = max(_weighted_quantile(pred[healthy], rw[healthy], confidence),
+                    _own_quantile(models, w, confidence))
     curve = IsotonicRegression(increasing=True, out_of_bounds="clip").fit(
         y, pred, sample_weight=rw)
     grid = np.linspace(0.0, 1.0, n_grid)

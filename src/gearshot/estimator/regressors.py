@@ -15,7 +15,11 @@ returns an object with :class:`~gearshot.estimator.knn.KnnModel`'s interface (``
 
 The non-KNN learners hold out the same validation split as the KNN (a ``ShuffleSplit``
 seeded alike), keep its residuals for the intervals, and refit on every row. Their
-``n_neighbors`` is 1 and ``validation_mae`` holds one value: the validation MAE.
+``n_neighbors`` is 1 and ``validation_mae`` holds one value: the validation MAE. When
+the last ``n_own`` rows are the machine's own healthy segments, the validation probe
+trains on none of them and reads them all (``own_prediction``): how a model of the
+simulation reads this machine's healthy segments, which the detection limit needs
+(:mod:`~gearshot.estimator.detection`).
 """
 
 from __future__ import annotations
@@ -102,6 +106,9 @@ class LearnedModel:
     validation_indices : ndarray of int
     validation_prediction : ndarray
         ``ŷ`` on the validation split.
+    own_prediction : ndarray or None
+        ``ŷ`` of the validation probe, which trained on none of them, on the machine's own
+        healthy rows (None when the fit named none).
     """
 
     learner: Any
@@ -111,6 +118,7 @@ class LearnedModel:
     validation_y: FloatArray
     validation_indices: NDArray[np.intp]
     validation_prediction: FloatArray | None = None
+    own_prediction: FloatArray | None = None
 
     def predict(self, X: ArrayLike) -> FloatArray:
         """Fault sizes of feature rows ``X`` (n_samples, n_features), clipped to [0, 1]."""
@@ -125,7 +133,7 @@ StepModel = KnnModel | LearnedModel
 def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
                   n_neighbors: Iterable[int] = range(1, 101),
                   validation_fraction: float = 0.3,
-                  random_state: RandomStateLike = None) -> StepModel:
+                  random_state: RandomStateLike = None, n_own: int = 0) -> StepModel:
     """Step 8 with the regressor ``name`` (one of :data:`ESTIMATORS`).
 
     Parameters
@@ -139,6 +147,9 @@ def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
         Share of rows in the validation split.
     random_state : int, RandomState or None
         Seeds the split (and the learner): the same split as :func:`fit_knn`'s.
+    n_own : int >= 0, default 0
+        The last ``n_own`` rows are the machine's own healthy segments (not "paper"):
+        the validation probe leaves them out of its training and reads them.
 
     Returns
     -------
@@ -162,11 +173,16 @@ def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
                             f"{X.shape[0]}")
     seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
     split = ShuffleSplit(n_splits=1, test_size=validation_fraction, random_state=seed)
+    if not 0 <= n_own < X.shape[0]:
+        raise GearshotError(f"n_own must lie in [0, {X.shape[0]}); got {n_own!r}")
     train, val = next(split.split(X))
+    first_own = X.shape[0] - n_own
     with sklearn.config_context(assume_finite=True):
-        probe = _learner(name, seed).fit(X[train], y[train])
+        probe = _learner(name, seed).fit(X[train[train < first_own]], y[train[train < first_own]])
         estimate = np.clip(probe.predict(X[val]), 0, 1)
+        own = np.clip(probe.predict(X[first_own:]), 0, 1) if n_own else None
         residuals = np.abs(estimate - y[val])
         final = _learner(name, seed).fit(X, y)
     return LearnedModel(final, 1, np.array([residuals.mean()]), residuals, y[val],
-                        np.asarray(val, dtype=np.intp), np.asarray(estimate, np.float64))
+                        np.asarray(val, dtype=np.intp), np.asarray(estimate, np.float64),
+                        None if own is None else np.asarray(own, np.float64))
