@@ -133,3 +133,50 @@ def test_detection_limit_from_validation_rows():
         detection_limit([model], [-1.0])
     with pytest.raises(GearshotError, match="confidence"):
         detection_limit([model], [1.0], confidence=1.5)
+
+
+def test_own_healthy_rows_raise_the_threshold_as_models_that_never_saw_them_read_them():
+    """Boosted trees read their simulated healthy rows at 0; the machine's own healthy
+    segments, read by the probes that never trained on them, set the threshold when they
+    read higher: the 95 % quantile taken at the higher order statistic, weighted over the
+    models as predict combines them."""
+    from types import SimpleNamespace
+
+    from gearshot.estimator.detection import detection_limit
+
+    y = np.r_[np.zeros(100), np.linspace(0.01, 1, 400)]
+    pred = np.where(y == 0, 0.0, y)
+    own = np.linspace(0.0, 0.19, 20)   # 20 own rows read 0 … 0.19
+    plain = SimpleNamespace(validation_y=y, validation_prediction=pred)
+    assert detection_limit([plain], [1.0]).threshold == 0.0
+    first = SimpleNamespace(validation_y=y, validation_prediction=pred, own_prediction=own)
+    found = detection_limit([first], [1.0])
+    assert found.threshold == pytest.approx(0.19)   # higher of 0.95 · 19 = 18.05 → the max
+    assert found.limit == pytest.approx(0.19, abs=0.01)
+    # a second model reading the same rows at 3× and weighted 1:3 → 0.25·own + 0.75·3·own
+    second = SimpleNamespace(validation_y=y, validation_prediction=pred,
+                             own_prediction=3 * own)
+    assert detection_limit([first, second], [1.0, 3.0]).threshold == pytest.approx(
+        0.19 * 2.5)
+    # an unweighted model does not count
+    assert detection_limit([first, second], [1.0, 0.0]).threshold == pytest.approx(0.19)
+
+
+def test_boosting_probe_reads_the_own_rows_without_training_on_them():
+    """fit_regressor(..., n_own=k): the last k rows are the machine's own healthy rows.
+    Placed where the simulated rows say size 1, the probe that never trained on them reads
+    them near 1, while the final model, trained on every row, reads them near 0."""
+    from gearshot.estimator.regressors import fit_regressor
+
+    rng = np.random.default_rng(0)
+    x_sim = rng.uniform(0, 1, (400, 2))
+    y_sim = x_sim[:, 0].copy()
+    x_own = np.column_stack([rng.uniform(0.95, 1.0, 40), rng.uniform(0, 1, 40)])
+    X, y = np.vstack([x_sim, x_own]), np.r_[y_sim, np.zeros(40)]
+    model = fit_regressor("boosting", X, y, random_state=0, n_own=40)
+    assert model.own_prediction is not None and model.own_prediction.shape == (40,)
+    assert model.own_prediction.mean() > 0.8
+    assert model.predict(x_own).mean() < 0.2
+    assert fit_regressor("boosting", X, y, random_state=0).own_prediction is None
+    with pytest.raises(GearshotError, match="n_own"):
+        fit_regressor("boosting", X, y, random_state=0, n_own=len(y))
