@@ -28,6 +28,9 @@ bin's signal-to-noise ratio as it is, so the identity path stands for all paths.
 * **paper**: step 7's four features of the noisy differences, centred on the healthy
   training rows, KNN with K chosen on a 70/30 split of the training rows (step 8): the
   paper's estimator with no domain gap (its simulated floor).
+* **default**: the library's default regressor (``estimator="boosting"``: boosted trees,
+  :func:`gearshot.estimator.regressors.fit_regressor`) on the same features: the
+  default's simulated floor.
 * ``--candidates``: regressors and features beyond the paper (development screen): KNN on
   the 10 indicators (``knn_10``), on those and the 8 band RMS (``knn_18``), on ``rms_diff``
   alone; isotonic on ``rms_diff``; gradient boosting (absolute error) on the paper's four,
@@ -77,6 +80,7 @@ def grade_rows(db, grade, noise_scale, seed, candidates, *, tf=None, power=None,
     from gearshot.estimator import steps
     from gearshot.estimator._simulated import residue_noise_spectrum
     from gearshot.estimator.oracle import fit_template_oracle
+    from gearshot.estimator.regressors import fit_regressor
     from gearshot.features import PAPER_FEATURES, spectrum_features
     from gearshot.transfer.estimation import one_sided_response
 
@@ -109,7 +113,11 @@ def grade_rows(db, grade, noise_scale, seed, candidates, *, tf=None, power=None,
         return model.predict(X[test])
 
     X4 = centred(PAPER_FEATURES)
-    out["paper"] = knn(X4 if paper_features is None else centred(paper_features))
+    X_sel = X4 if paper_features is None else centred(paper_features)
+    out["paper"] = knn(X_sel)
+    # the library's default regressor (boosted trees) on the same selected features
+    out["default"] = fit_regressor("boosting", X_sel[train], y[train],
+                                   random_state=seed).predict(X_sel[test])
     if candidates:
         from sklearn.ensemble import HistGradientBoostingRegressor
         from sklearn.isotonic import IsotonicRegression
