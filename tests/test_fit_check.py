@@ -520,7 +520,7 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
     ``speed_tolerance=0.5``: estimated, but none trusted, and ``speed_check`` says why (the
     healthy gear's 40 Hz run-2 record read 0.77 with most of its segments comparable)."""
     from gearshot.app.conditions import fit_speed_check
-    from gearshot.app.predict import speed_check_summary
+    from gearshot.app.predict import failed_check_summary
     from gearshot.app.predict_machine import predict_from_machine
 
     # beyond the range of the fit's speeds by more than 6 relative standard deviations of
@@ -560,7 +560,7 @@ def test_a_speed_outside_the_fit_s_healthy_recordings_is_not_trusted(spur_db):
     assert at40["speed_check"].str.match(r"speed 39\.\d\d Hz lies 3\d % outside").all()
     assert (frame.loc[name == "spur3_30hz_High_2.zip", "speed_check"] == "ok").all()
     assert "speed_check: failed for 1 recording(s) (spur3_40hz_High_2.zip: speed" in \
-        speed_check_summary(frame)
+        failed_check_summary(frame, "speed_check")
 
 
 def test_another_load_runs_at_another_speed_and_is_not_comparable(spur_db):

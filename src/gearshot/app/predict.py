@@ -364,11 +364,6 @@ def failed_check_summary(frame: pd.DataFrame, column: str) -> str | None:
             + (", …" if len(bad) > 1 else "") + "): their estimates are not trusted")
 
 
-def speed_check_summary(frame: pd.DataFrame) -> str | None:
-    """:func:`failed_check_summary` of ``speed_check``."""
-    return failed_check_summary(frame, "speed_check")
-
-
 def detection_summary(frame: pd.DataFrame) -> str | None:
     """One line counting the segments below the fit's detection limit (issue #30): their
     estimates say "no fault resolved", not a small size. None without the column."""
