@@ -10,7 +10,7 @@ returns an object with :class:`~gearshot.estimator.knn.KnnModel`'s interface (``
 ``"isotonic"``    a monotone map of one learned score: the least-squares linear score of
                   the standardised features, then isotonic regression of the size on it
 ``"boosting"``    gradient-boosted trees (``HistGradientBoostingRegressor``, absolute
-                  error loss)
+                  error loss; the default of ``OneFaultShotEstimator``)
 ================  =====================================================================
 
 The non-KNN learners hold out the same validation split as the KNN (a ``ShuffleSplit``
