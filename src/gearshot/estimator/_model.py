@@ -149,7 +149,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         intervals. There is no upper bound (intervals are clipped to [0, 1]).
     estimator : {"boosting", "paper", "isotonic"}, default "boosting"
         Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): boosted
-        trees (10.93 % against the paper's KNN's 11.31 % on the development rigs), the
+        trees (10.96 % against the paper's KNN's 11.31 % on the development rigs), the
         paper's KNN (its sweep and the demo's ablations pass ``"paper"``), or an isotonic
         map of a linear score (benchmarks/RESULTS.md "Estimator: ... new default").
     random_state : int >= 0, numpy RandomState or Generator, or None

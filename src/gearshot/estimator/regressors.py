@@ -76,7 +76,7 @@ class ScoreIsotonic:
 
 #: Trees and step of ``"boosting"`` (their product, 6, sets how far the fit moves from the
 #: median; 30 trees at 0.2 scored 10.93 % on the development rigs against 11.11 % for 60
-#: at 0.1, at 0.63 s of CPU per fit and predict against 0.99 s; benchmarks/RESULTS.md).
+#: at 0.1, in about two thirds of the CPU time; benchmarks/RESULTS.md).
 BOOSTING_TREES = 30
 BOOSTING_STEP = 0.2
 
