@@ -151,3 +151,26 @@ def test_small_builds_run_in_process_large_ones_on_a_cluster(monkeypatch, tmp_pa
     assert 12 <= IN_PROCESS_BLOCKS
     service.simulate_database(tmp_path / "b", speeds=[10.0, 15.0], grades=range(1, 13), **kw)
     assert asked == [False, True] and given == [None, "client"]
+
+
+def test_the_paper_s_rig_experiment_fits_the_paper_s_estimator(monkeypatch, tmp_path):
+    """`gearshot experiment rig` reproduces Fig. 14: its variants fit the paper's KNN, as
+    the demo's ablation table does, unless --param names another estimator."""
+    from typer.testing import CliRunner
+
+    from gearshot.app import experiment_runs
+    from gearshot.app.cli import app
+
+    seen = []
+
+    def capture(*args, params, **kwargs):
+        seen.append(params)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(experiment_runs, "run_rig_experiment", capture)
+    runner = CliRunner()
+    runner.invoke(app, ["experiment", "rig", "--store", str(tmp_path / "db")])
+    runner.invoke(app, ["experiment", "rig", "--store", str(tmp_path / "db"),
+                        "--param", 'estimator="boosting"', "--param", "model_discrepancy=0.1"])
+    assert seen == [{"estimator": "paper"},
+                    {"estimator": "boosting", "model_discrepancy": 0.1}]
