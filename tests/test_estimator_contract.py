@@ -315,9 +315,10 @@ def test_failed_fit_leaves_no_state(data, tfs, monkeypatch):
     for name, module, function in (("paper", steps, "fit_knn"),
                                    ("boosting", regressors, "_learner")):
         est = OneFaultShotEstimator(**FAST, estimator=name)
-        monkeypatch.setattr(module, function, broken)
-        with pytest.raises(RuntimeError, match="step 8"):
-            _fit(est, data, tfs)
+        with monkeypatch.context() as patch:   # one regressor broken at a time
+            patch.setattr(module, function, broken)
+            with pytest.raises(RuntimeError, match="step 8"):
+                _fit(est, data, tfs)
         assert set(vars(est)) == set(est.get_params())
 
 

@@ -277,8 +277,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             healthy_long: ArrayLike | None = None, *, selection_tf: Any = None,
             gear_teeth: int | None = None, pinion_teeth: int | None = None,
             holdout: float = 0.0, healthy_holdout: ArrayLike | None = None,
-            example_record: ArrayLike | None = None, healthy_recordings: ArrayLike | None = None
-            ) -> Self:
+            example_record: ArrayLike | None = None,
+            healthy_recordings: ArrayLike | None = None) -> Self:
         """Fit on a simulated database, target healthy SAs and one faulty example.
 
         Parameters

@@ -177,8 +177,9 @@ def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
         raise GearshotError(f"n_own must lie in [0, {X.shape[0]}); got {n_own!r}")
     train, val = next(split.split(X))
     first_own = X.shape[0] - n_own
+    simulated = train[train < first_own]   # the probe trains on no row of the machine's own
     with sklearn.config_context(assume_finite=True):
-        probe = _learner(name, seed).fit(X[train[train < first_own]], y[train[train < first_own]])
+        probe = _learner(name, seed).fit(X[simulated], y[simulated])
         estimate = np.clip(probe.predict(X[val]), 0, 1)
         own = np.clip(probe.predict(X[first_own:]), 0, 1) if n_own else None
         residuals = np.abs(estimate - y[val])
