@@ -85,7 +85,7 @@ def _own_quantile(models: Sequence[Any], weights: FloatArray, confidence: float)
     models that never trained on them read them (0 when no model read them)."""
     own = [(wt, np.asarray(m.own_prediction, dtype=float)) for m, wt in zip(models, weights)
            if wt > 0 and getattr(m, "own_prediction", None) is not None]
-    if not own or len({p.shape for _, p in own}) != 1 or own[0][1].size == 0:
+    if not own:
         return 0.0
     reading = sum(wt * p for wt, p in own) / sum(wt for wt, _ in own)
     return float(np.quantile(reading, confidence, method="higher"))
