@@ -116,6 +116,29 @@ def test_detection_limit_exists_and_grows_with_noise():
     assert limits[0] < limits[1] < limits[2]
 
 
+def test_an_estimate_below_the_limit_has_0_in_its_interval():
+    """A fit without hold-outs (its intervals from the simulation): every estimate below
+    ``detection_limit_`` gets a 90 % interval reaching 0 (it is not told apart from
+    healthy), every other bound is the simulated one; a 50 % interval keeps its bounds."""
+    from gearshot.estimator.detection import reach_zero_below_limit
+
+    est, faulty, y = _fit_with_noise(2.0)
+    assert getattr(est, "fit_check_", None) is None or not est.fit_check_.checked
+    pred = est.predict(faulty)
+    est.detection_limit_ = 0.0          # nothing below: the simulated intervals alone
+    sim_low, sim_high = est.predict_interval(faulty, coverage=0.9)
+    est.detection_limit_ = limit = 0.6  # a machine that resolves less
+    below = pred < limit
+    assert np.any(sim_low[below] > 0) and (~below).any()
+    low, high = est.predict_interval(faulty, coverage=0.9)
+    np.testing.assert_array_equal(low, np.where(below, 0.0, sim_low))
+    np.testing.assert_array_equal(high, sim_high)
+    plain = np.full(pred.size, 0.05)
+    np.testing.assert_array_equal(reach_zero_below_limit(est, pred, plain, 0.9),
+                                  np.where(below, 0.0, 0.05))
+    np.testing.assert_array_equal(reach_zero_below_limit(est, pred, plain, 0.5), plain)
+
+
 def test_detection_limit_from_validation_rows():
     from types import SimpleNamespace
 

@@ -404,6 +404,12 @@ def test_estimator_trust_and_a_drifting_low_fit(spur_db):
     drifting = low.trust(low_healthy[-2:])
     assert not drifting["trusted"].any()
     assert (drifting["fit_check"] == low.fit_check_.verdict).all()
+    # the healthy gear recorded again reads as a small fault under the refused fit; below
+    # the fit's detection limit its interval reaches 0 (not told apart from healthy)
+    again = machine_segments(_record("spur3_30hz_Low_2.zip"), machine, cycles_per_segment=10)
+    run2 = low.trust(again[0])
+    below = run2["predicted"] < low.detection_limit_
+    assert below.mean() >= 0.9 and (run2.loc[below, "low"] == 0).all()
 
     est, healthy = fit("High")
     assert est.fit_check_.passed and est.fit_check_.n_healthy == 2

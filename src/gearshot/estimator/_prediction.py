@@ -13,6 +13,7 @@ from .._errors import GearshotError, NotFittedError
 from .._validation import as_signal_array, check_in_range
 from ._target import target_features
 from .comparability import Comparability, ComparabilityReference
+from .detection import reach_zero_below_limit
 from .fit_check import TRUST_COLUMNS, FitCheck, recording_majority, trusted_column
 from .trusted import comparable_at_speed
 from .uncertainty import conformal_quantile, holdout_interval, mixture_interval
@@ -204,6 +205,11 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         sa : array_like (n_signals, n_points) or (n_points,)
         coverage : float in (0, 1), default 0.9
 
+        An estimate below ``detection_limit_`` is not told apart from healthy at the
+        limit's confidence (95 %, one-sided): at ``coverage`` ≥ 0.9 its interval reaches
+        0 (:func:`~gearshot.estimator.detection.reach_zero_below_limit`), whatever the
+        fit check says.
+
         Returns
         -------
         low, high : ndarray (n_signals,)
@@ -215,8 +221,10 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         check: FitCheck | None = getattr(self, "fit_check_", None)
         if check is not None and check.checked and check.n_healthy and check.n_example:
             healthy, example = check.residuals()
-            low, high = holdout_interval(self.predict(sa), healthy, example, coverage,
+            pred = self.predict(sa)
+            low, high = holdout_interval(pred, healthy, example, coverage,
                                          example_size=check.declared_size)
+            low = reach_zero_below_limit(self, pred, low, coverage)
             return np.clip(low, 0, 1), np.clip(high, 0, 1)
         X = self.features_of(sa)
         discrepancy = float(self.model_discrepancy)
@@ -230,6 +238,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             {i: st["weight"] for i, st in enumerate(settings)},
             {i: m.validation_residuals for i, m in enumerate(models)},
             coverage, discrepancy=discrepancy)
+        low = reach_zero_below_limit(self, self.predict(sa), low, coverage)
         return np.clip(low, 0, 1), np.clip(high, 0, 1)
 
     def score(self, X: ArrayLike, y: ArrayLike,

@@ -48,7 +48,7 @@ from sklearn.isotonic import IsotonicRegression
 from .._errors import GearshotError, NotFittedError
 
 __all__ = ["DETECTION_CONFIDENCE", "DetectionLimit", "below_detection_limit",
-           "detection_limit", "holdout_detection"]
+           "detection_limit", "holdout_detection", "reach_zero_below_limit"]
 
 FloatArray = NDArray[np.float64]
 
@@ -194,3 +194,37 @@ def below_detection_limit(estimator: Any, estimates: ArrayLike) -> NDArray[np.bo
     if limit is None:
         return np.zeros(values.shape, dtype=bool)
     return np.asarray(values < float(limit), dtype=bool)
+
+
+def reach_zero_below_limit(estimator: Any, estimates: ArrayLike, low: ArrayLike,
+                           coverage: float,
+                           confidence: float = DETECTION_CONFIDENCE) -> FloatArray:
+    """Lower interval bounds that reach 0 where the estimate lies below the detection limit.
+
+    An estimate below ``detection_limit_`` is not told apart from healthy at
+    ``confidence`` (one-sided): an interval of at least that confidence (``coverage ≥ 2 ·
+    confidence − 1``, two-sided) that left 0 out would state a fault the fit cannot
+    resolve. Below it the lower bound is 0; elsewhere, and for narrower intervals, ``low``
+    is returned as it is. For a fit that passed its check the two already agree (its limit
+    is the smallest estimate whose interval leaves 0 out, :func:`holdout_detection`); a
+    fit that refused itself or has no hold-outs keeps its simulated limit, and its
+    intervals otherwise follow the simulation or hold-outs that the check found wanting.
+
+    Parameters
+    ----------
+    estimator : OneFaultShotEstimator
+        Fitted.
+    estimates, low : array_like (n,)
+        Its estimates and the interval's lower bounds.
+    coverage : float in (0, 1)
+    confidence : float in (0, 1), default :data:`DETECTION_CONFIDENCE`
+
+    Returns
+    -------
+    ndarray (n,)
+    """
+    bounds = np.asarray(low, dtype=float)
+    if coverage < 2 * confidence - 1 - 1e-12:
+        return bounds
+    below = below_detection_limit(estimator, estimates)
+    return np.asarray(np.where(below, 0.0, bounds), dtype=np.float64)
