@@ -167,6 +167,71 @@ def test_alarm_needs_sustained_trusted_crossings_and_untrusted_never_raise_or_cl
     assert quiet.first_index is None and not quiet.alarm.any()
 
 
+def test_the_history_s_first_trusted_recordings_lower_a_high_fit_threshold_only():
+    """After COMMISSIONING trusted recordings the threshold is the lower of the fit's and
+    the one those recordings set by the same law; untrusted ones do not count; a history
+    that starts faulty sets a higher one, which is not used (it cannot mask the fault)."""
+    from gearshot.monitor.alarm import COMMISSIONING, history_thresholds
+
+    rng = np.random.default_rng(0)
+    quiet = np.abs(0.04 + 0.01 * rng.standard_normal(COMMISSIONING + 1))
+    y = np.r_[0.9, quiet, 0.25, 0.26, 0.27]        # the first recording is untrusted
+    ok = np.r_[False, np.ones(y.size - 1, bool)]
+    got = history_thresholds(y, ok, 0.35)
+    own = alarm_threshold(quiet[:COMMISSIONING])
+    assert got.own == pytest.approx(own) and got.fit == 0.35
+    assert got.from_index == COMMISSIONING + 1      # after the 10th trusted recording
+    assert np.all(got.per_recording[:COMMISSIONING + 1] == 0.35)
+    assert np.all(got.per_recording[COMMISSIONING + 1:] == pytest.approx(MIN_THRESHOLD))
+    # judged against the fit's threshold alone, the growing fault at 0.25-0.27 raises
+    # nothing; against the history's own threshold it does, at its second recording
+    assert alarm_states(y, ok, 0.35).first_index is None
+    assert alarm_states(y, ok, got.per_recording).first_index == y.size - 2
+    # a history that starts faulty: its own threshold is higher and not used
+    faulty = history_thresholds(np.linspace(0.2, 0.6, 14), np.ones(14, bool), 0.15)
+    assert faulty.own > 0.15 and np.all(faulty.per_recording == 0.15)
+    # too few trusted recordings: the fit's threshold throughout
+    few = history_thresholds(y[:6], ok[:6], 0.35)
+    assert few.own is None and few.from_index is None
+    with pytest.raises(GearshotError, match="one per recording"):
+        alarm_states(y, ok, np.full(3, 0.3))
+    with pytest.raises(GearshotError, match="commissioning"):
+        history_thresholds(y, ok, 0.3, commissioning=1)
+
+
+def test_payload_states_the_threshold_in_force_and_where_it_comes_from():
+    from types import SimpleNamespace
+
+    from gearshot.app.monitor_report import check_monitor, format_monitor
+    from gearshot.monitor import monitor_payload
+
+    t0 = pd.Timestamp("2026-01-01")
+    sizes = np.r_[np.full(12, 0.03), 0.03 + 0.01 * np.arange(12) ** 1.5]
+    history = pd.DataFrame({
+        "recording": [f"r{i:02d}.h5" for i in range(sizes.size)],
+        "time": [t0 + pd.Timedelta(days=i) for i in range(sizes.size)],
+        "predicted": sizes, "low": 0.0, "high": sizes + 0.1, "segments": 2,
+        "trusted_segments": 2, "trusted": True, "model": "abc",
+        "calibration": "one_fault_shot", "estimated_at": t0, "note": ""})
+    model = SimpleNamespace(digest="abc", threshold=0.40, sustain=2,
+                            calibration="one_fault_shot", describe=lambda: "a model",
+                            database={}, fit_check="passed", condition={},
+                            false_alarm_rate=0.02, faulty={"size": 0.42})
+    payload = monitor_payload(history, model, limit=0.6)
+    al = payload["alarm"]
+    assert al["fit_threshold"] == 0.40 and al["threshold"] == MIN_THRESHOLD
+    assert al["commissioning"] == {"recordings": 10, "threshold": MIN_THRESHOLD,
+                                   "used": True, "from_time": (t0 + pd.Timedelta(
+                                       days=10)).isoformat()}
+    assert [r["threshold"] for r in payload["records"][:10]] == [0.40] * 10
+    first = pd.Timestamp(al["first_time"])
+    assert first == t0 + pd.Timedelta(days=int(np.flatnonzero(sizes > 0.1)[1]))
+    check_monitor(payload, "payload")
+    payload["new"] = 0
+    assert "set by the first 10 trusted recordings" in format_monitor(payload)
+    assert "the fit's 0.400" in format_monitor(payload)
+
+
 def test_row_trust_prefers_trusted_then_comparable_and_input_check():
     frame = pd.DataFrame({"comparable": [True, True, False],
                           "input_check": ["ok", "clipped", "ok"]})

@@ -10,7 +10,7 @@ from .markdown import md_table, write_markdown
 from .report_schema import Field, check_fields, check_rows
 
 __all__ = ["is_monitor_payload", "monitor_report", "check_monitor", "format_monitor",
-           "MONITOR_RECORD"]
+           "threshold_source", "MONITOR_RECORD"]
 
 #: One record of ``gearshot monitor --json`` (more keys are allowed).
 MONITOR_RECORD = {
@@ -76,7 +76,7 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
               f"not used)"
               + (f"; index: {payload['index_source']}" if payload.get("index_source") else "")
               + ".", "",
-              f"Alarm threshold {al['threshold']:.3f}: "
+              f"Alarm threshold {al['threshold']:.3f}{threshold_source(al)}: "
               + (f"first raised {al['first_time']}." if al["first_time"] else "not raised."),
               ""]
     sentence = describe_forecast(fc, recs["time"].iloc[-1] if len(recs) else None)
@@ -92,6 +92,16 @@ def monitor_report(payload: dict, out: Path, source: Path) -> Path:
             cols.append("note")
         lines += ["## Latest recordings", "", *md_table(last[cols])]
     return write_markdown(out, lines)
+
+
+def threshold_source(alarm: dict) -> str:
+    """Where the alarm's threshold in force comes from, when the history's own first
+    trusted recordings set it (``alarm.commissioning``), else ""."""
+    own = alarm.get("commissioning") or {}
+    if not own.get("used"):
+        return ""
+    return (f", set by the first {own['recordings']} trusted recordings, in force since "
+            f"{own['from_time']}; the fit's {alarm.get('fit_threshold', float('nan')):.3f}")
 
 
 def format_monitor(payload: dict) -> str:
@@ -121,7 +131,7 @@ def format_monitor(payload: dict) -> str:
                          f"[{last['low']:.3f}, {last['high']:.3f}]"
                          + ("" if last["trusted"] else
                             f" (untrusted: {last.get('note') or 'see the history'})"))
-    lines.append(f"alarm (threshold {al['threshold']:.3f}): "
+    lines.append(f"alarm (threshold {al['threshold']:.3f}{threshold_source(al)}): "
                  + (f"raised {al['first_time']}" + (", active" if al["active"] else
                                                       ", cleared since")
                     if al["first_time"] else "not raised"))

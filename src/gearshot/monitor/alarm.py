@@ -5,6 +5,14 @@ of this machine exceeds with probability ``false_alarm_rate`` (:func:`alarm_thre
 from the healthy estimates the model file carries), and an alarm is believed only when
 ``sustain`` consecutive trusted recordings exceed it (:func:`alarm_states`). Untrusted
 recordings neither raise nor clear an alarm: they are skipped.
+
+Once the history holds :data:`COMMISSIONING` trusted recordings, their estimates set a
+threshold of their own by the same law, and from the next recording on the threshold is
+the lower of the two (:func:`history_thresholds`): the fit's healthy baseline is a few
+recordings of one campaign, cross-fitted, and may read higher than the machine's later
+runs do; the first recordings of the watched machine say how it reads. The lower of the
+two only: a history that starts with a fault already present raises its own threshold,
+which is then not used, so it cannot mask the fault.
 """
 
 from __future__ import annotations
@@ -18,8 +26,9 @@ from scipy import stats
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 
-__all__ = ["alarm_threshold", "alarm_states", "baseline_warning", "AlarmResult",
-           "FALSE_ALARM_RATE", "SUSTAIN", "MIN_THRESHOLD", "MIN_BASELINE"]
+__all__ = ["alarm_threshold", "alarm_states", "baseline_warning", "history_thresholds",
+           "AlarmResult", "Thresholds", "FALSE_ALARM_RATE", "SUSTAIN", "MIN_THRESHOLD",
+           "MIN_BASELINE", "COMMISSIONING"]
 
 #: Per-recording false-alarm probability the threshold is set at (chosen on the
 #: development lives, benchmarks/RESULTS.md "Monitoring": 0.02, with ``SUSTAIN`` 2, raised
@@ -34,6 +43,12 @@ SUSTAIN = 2
 #: 0.08 raised false alarms, 0.10–0.15 none, and 0.10 the most alarms in time).
 MIN_THRESHOLD = 0.10
 
+
+#: Trusted recordings at the start of a history whose estimates also set a threshold
+#: (:func:`history_thresholds`). Chosen on the development lives 1–10, 51–60
+#: (benchmarks/RESULTS.md "Monitoring"): 7 to 12 gave the same alarms in time, 6 and
+#: fewer false alarms; 10 is the largest with the most zero-shot alarms in time.
+COMMISSIONING = 10
 
 #: Healthy estimates under which the threshold's false-alarm rate is not stated as known
 #: (:func:`baseline_warning`): as few as comparability calibrates on
@@ -88,6 +103,59 @@ def alarm_threshold(baseline: ArrayLike, *, false_alarm_rate: float = FALSE_ALAR
 
 
 @dataclass(frozen=True)
+class Thresholds:
+    """The alarm threshold of each recording of a history.
+
+    Attributes
+    ----------
+    per_recording : ndarray (n,)
+        The threshold each recording is judged against.
+    fit : float
+        The fit's threshold (from the model's healthy baseline).
+    own : float or None
+        The threshold of the history's first :data:`COMMISSIONING` trusted recordings
+        (None: the history holds fewer).
+    from_index : int or None
+        The first recording judged against ``min(fit, own)`` (None: none yet).
+    """
+
+    per_recording: np.ndarray
+    fit: float
+    own: float | None
+    from_index: int | None
+
+
+def history_thresholds(predicted: ArrayLike, trusted: ArrayLike, fit_threshold: float, *,
+                       false_alarm_rate: float = FALSE_ALARM_RATE,
+                       commissioning: int = COMMISSIONING) -> Thresholds:
+    """The threshold of each recording of a history, in time order (module docstring).
+
+    Up to the ``commissioning``-th trusted recording every recording is judged against
+    ``fit_threshold``; after it against the lower of ``fit_threshold`` and
+    :func:`alarm_threshold` of those ``commissioning`` recordings' estimates.
+
+    >>> t = history_thresholds([0.05, 0.06, 0.04, 0.3], [True] * 4, 0.35, commissioning=3)
+    >>> [round(float(v), 2) for v in t.per_recording], t.from_index
+    ([0.35, 0.35, 0.35, 0.1], 3)
+    """
+    commissioning = check_int(commissioning, "commissioning", minimum=2)
+    y = np.asarray(predicted, dtype=float)
+    ok = np.asarray(trusted, dtype=bool)
+    if y.shape != ok.shape or y.ndim != 1:
+        raise GearshotError(f"predicted and trusted must be one value per recording; got "
+                            f"shapes {y.shape} and {ok.shape}")
+    fit = float(fit_threshold)
+    per = np.full(y.size, fit)
+    usable = np.flatnonzero(ok & np.isfinite(y))
+    if usable.size < commissioning:
+        return Thresholds(per, fit, None, None)
+    own = alarm_threshold(y[usable[:commissioning]], false_alarm_rate=false_alarm_rate)
+    start = int(usable[commissioning - 1]) + 1
+    per[start:] = min(fit, own)
+    return Thresholds(per, fit, own, start if start < y.size else None)
+
+
+@dataclass(frozen=True)
 class AlarmResult:
     """Alarm state per recording and when it was first raised.
 
@@ -103,25 +171,31 @@ class AlarmResult:
     first_index: int | None
 
 
-def alarm_states(predicted: ArrayLike, trusted: ArrayLike, threshold: float, *,
+def alarm_states(predicted: ArrayLike, trusted: ArrayLike, threshold: float | ArrayLike, *,
                  sustain: int = SUSTAIN) -> AlarmResult:
     """Run the alarm over recordings in time order.
 
     The alarm is raised at the ``sustain``-th consecutive trusted recording over
-    ``threshold`` and cleared at the ``sustain``-th consecutive trusted one at or under it;
-    untrusted recordings are skipped (they neither count nor break a run).
+    ``threshold`` (one value, or one per recording: :func:`history_thresholds`) and
+    cleared at the ``sustain``-th consecutive trusted one at or under it; untrusted
+    recordings are skipped (they neither count nor break a run).
     """
     sustain = check_int(sustain, "sustain", minimum=1)
     y = np.asarray(predicted, dtype=float)
     ok = np.asarray(trusted, dtype=bool)
     if y.shape != ok.shape:
         raise GearshotError(f"predicted and trusted differ in shape: {y.shape} vs {ok.shape}")
+    limits = np.asarray(threshold, dtype=float)
+    if limits.ndim and limits.shape != y.shape:
+        raise GearshotError(f"threshold must be one value or one per recording ({y.size}); "
+                            f"got shape {limits.shape}")
+    limits = np.broadcast_to(limits, y.shape)
     alarm = np.zeros(y.size, dtype=bool)
     state, run, first = False, 0, None
     for i in range(y.size):
         if not ok[i] or not np.isfinite(y[i]):
             continue
-        crossing = bool(y[i] > threshold) != state
+        crossing = bool(y[i] > limits[i]) != state
         run = run + 1 if crossing else 0
         if run >= sustain:
             state, run = not state, 0

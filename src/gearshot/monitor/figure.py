@@ -50,8 +50,13 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
             ax.plot(t[alarm], recs["predicted"][alarm], "o", mfc="none", mec="tab:red",
                     ms=8, label="in alarm")
     al = payload["alarm"]
-    ax.axhline(al["threshold"], color="tab:orange", ls="--",
-               label=f"alarm threshold {al['threshold']:.2f}")
+    label = f"alarm threshold {al['threshold']:.2f}"
+    if len(recs) and "threshold" in recs and recs["threshold"].nunique() > 1:
+        # the history's own threshold took over after its commissioning recordings
+        ax.step(pd.to_datetime(recs["time"], format="ISO8601"), recs["threshold"],
+                where="post", color="tab:orange", ls="--", label=label)
+    else:
+        ax.axhline(al["threshold"], color="tab:orange", ls="--", label=label)
     fc = payload["forecast"]
     ax.axhline(fc["limit"], color="tab:red", ls=":", label=f"limit {fc['limit']:g}")
     lines = _draw_forecast(ax, fc, recs)

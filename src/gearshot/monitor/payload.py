@@ -3,8 +3,10 @@
 :func:`monitor_payload` turns a history (:mod:`gearshot.monitor.history`) and the model in
 use into the JSON of ``gearshot monitor --json``: ``records`` (per recording, the current
 model's estimate: ``recording``, ``time``, ``predicted``, ``low``, ``high``, ``trusted``,
-``alarm``; times in UTC; the estimate null for a recording that could not be
-estimated, with its ``note``), ``alarm`` (``threshold``, ``first_time``) and
+``alarm``, ``threshold``; times in UTC; the estimate null for a recording that could not
+be estimated, with its ``note``), ``alarm`` (``threshold``: the one in force at the
+latest recording, ``first_time``; ``fit_threshold`` and ``commissioning``: the model's
+and the history's own, :func:`gearshot.monitor.alarm.history_thresholds`) and
 ``forecast`` (``limit``, ``time``, ``low``, ``high``, ``law``; the last four null with a
 ``reason`` when no forecast is made), ``notice`` (:func:`gearshot.monitor.trust.change_notice`:
 the latest recordings no longer look like the fitted machine; null otherwise) and the
@@ -16,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .alarm import alarm_states
+from .alarm import COMMISSIONING, AlarmResult, Thresholds, alarm_states, history_thresholds
 from .forecast import Forecast, forecast_crossing, reading_spread_at
 from .trust import change_notice, model_warning
 
@@ -72,17 +74,21 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
     """
     digest = model.digest
     rows = current_records(history, digest)
+    limits = history_thresholds(rows["predicted"].to_numpy(float),
+                                rows["trusted"].to_numpy(bool), model.threshold,
+                                false_alarm_rate=model.false_alarm_rate)
     state = alarm_states(rows["predicted"].to_numpy(float),
-                         rows["trusted"].to_numpy(bool), model.threshold,
+                         rows["trusted"].to_numpy(bool), limits.per_recording,
                          sustain=model.sustain)
     records = [{"recording": r.recording, "time": _iso(r.time),
                 "predicted": _num(r.predicted), "low": _num(r.low), "high": _num(r.high),
-                "trusted": bool(r.trusted), "alarm": bool(a), "model": r.model,
+                "trusted": bool(r.trusted), "alarm": bool(a), "threshold": float(t),
+                "model": r.model,
                 "calibration": r.calibration, "segments": int(r.segments),
                 "trusted_segments": int(r.trusted_segments),
                 "note": str(getattr(r, "note", "") or "")}
-               for r, a in zip(rows.itertuples(index=False), state.alarm, strict=True)]
-    first = None if state.first_index is None else _iso(rows["time"].iloc[state.first_index])
+               for r, a, t in zip(rows.itertuples(index=False), state.alarm,
+                                  limits.per_recording, strict=True)]
     ok = rows["trusted"].to_numpy(bool)
     t0 = rows["time"].iloc[0] if len(rows) else pd.Timestamp(0)
     days = ((rows["time"] - t0) / _DAY).to_numpy(float)
@@ -112,10 +118,7 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                   "warning": model_warning(model)},
         "calibration": model.calibration,
         "records": records,
-        "alarm": {"threshold": float(model.threshold), "first_time": first,
-                  "active": bool(state.alarm[ok][-1]) if ok.any() else False,
-                  "false_alarm_rate": float(model.false_alarm_rate),
-                  "sustain": int(model.sustain)},
+        "alarm": _alarm(model, limits, state, rows),
         "forecast": forecast,
         "notice": change_notice([r["time"] for r in records], [r["trusted"] for r in records],
                                 [r["note"] for r in records],
@@ -126,6 +129,26 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
              "model": r.model, "calibration": r.calibration}
             for r in earlier.itertuples(index=False)],
     }
+
+
+def _alarm(model, limits: Thresholds, state: AlarmResult, rows: pd.DataFrame) -> dict:
+    """The payload's ``alarm``: the threshold in force at the latest recording, when the
+    alarm was first raised, and the fit's and the history's own thresholds
+    (``commissioning``: null until the history holds its commissioning recordings)."""
+    ok = rows["trusted"].to_numpy(bool)
+    first = None if state.first_index is None else _iso(rows["time"].iloc[state.first_index])
+    own = None
+    if limits.own is not None:
+        start = limits.from_index
+        own = {"recordings": COMMISSIONING, "threshold": float(limits.own),
+               "used": bool(limits.own < limits.fit),
+               "from_time": None if start is None else _iso(rows["time"].iloc[start])}
+    return {"threshold": float(limits.per_recording[-1]) if len(rows)
+            else float(model.threshold), "first_time": first,
+            "active": bool(state.alarm[ok][-1]) if ok.any() else False,
+            "false_alarm_rate": float(model.false_alarm_rate),
+            "sustain": int(model.sustain), "fit_threshold": float(model.threshold),
+            "commissioning": own}
 
 
 def describe_forecast(forecast: dict, latest: str | None = None) -> str:
