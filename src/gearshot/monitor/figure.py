@@ -54,7 +54,9 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
     if len(recs) and "threshold" in recs and recs["threshold"].nunique() > 1:
         # the history's own threshold took over after its commissioning recordings
         ax.step(pd.to_datetime(recs["time"], format="ISO8601"), recs["threshold"],
-                where="post", color="tab:orange", ls="--", label=label)
+                where="post", color="tab:orange", ls="--",
+                label=f"alarm threshold {recs['threshold'].iloc[0]:.2f} (the fit's) → "
+                      f"{al['threshold']:.2f} (the history's own)")
     else:
         ax.axhline(al["threshold"], color="tab:orange", ls="--", label=label)
     fc = payload["forecast"]
