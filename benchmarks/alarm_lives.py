@@ -9,7 +9,7 @@ per 100 healthy recordings and event recordings in alarm (the criteria of
 ``monitor_lives.py``).
 
     PYTHONPATH=src python benchmarks/alarm_lives.py --lives DIR [DIR ...] \
-        [--seeds 1 2 ...] --rates 0.01 0.05 --sustains 2 3 --commissioning 0 10
+        [--seeds 1 2 ...] --rates 0.01 0.05 --sustains 2 3 --commissioning 0 10 --young 0 1
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 def judge(rig: Path, mode: str, rate: float, sustain: int,
-          commissioning: int = 0) -> dict | None:
+          commissioning: int = 0, young: int = 0) -> dict | None:
     from monitor_lives import fault_alarm_start
 
     from gearshot.monitor import alarm_states, alarm_threshold, load_model
-    from gearshot.monitor.alarm import history_thresholds
+    from gearshot.monitor.alarm import history_sustain, history_thresholds
 
     mpath, hpath = rig / f"{mode}.skops", rig / f"{mode}.parquet"
     if not (mpath.is_file() and hpath.is_file()):
@@ -43,13 +43,13 @@ def judge(rig: Path, mode: str, rate: float, sustain: int,
     recs = truth.merge(hist[["file", "predicted", "trusted"]], on="file", how="left")
     thr = alarm_threshold(model.baseline, false_alarm_rate=rate)
     ok = recs["trusted"].fillna(False).to_numpy(bool)
-    limits = np.full(len(recs), thr)
+    limits, runs = np.full(len(recs), thr), np.full(len(recs), sustain)
     if commissioning:   # the history's own first trusted recordings set a threshold too
-        limits = history_thresholds(recs["predicted"].to_numpy(float), ok, thr,
-                                    false_alarm_rate=rate,
-                                    commissioning=commissioning).per_recording
-        thr = float(limits[-1])   # the threshold in force at the end
-    res = alarm_states(recs["predicted"].to_numpy(float), ok, limits, sustain=sustain)
+        got = history_thresholds(recs["predicted"].to_numpy(float), ok, thr,
+                                 false_alarm_rate=rate, commissioning=commissioning)
+        limits, thr = got.per_recording, float(got.per_recording[-1])   # in force at the end
+        runs = history_sustain(got, sustain, extra=young)   # more while the history is young
+    res = alarm_states(recs["predicted"].to_numpy(float), ok, limits, sustain=runs)
     size = recs["size"].to_numpy(float)
     cross = int(np.nonzero(size > 0.2)[0][0])
     first = fault_alarm_start(res.alarm, ok, cross)
@@ -70,6 +70,9 @@ def main() -> None:
     parser.add_argument("--commissioning", nargs="+", type=int, default=[0],
                         help="trusted recordings at a history's start that also set a "
                              "threshold (0: the fit's threshold alone)")
+    parser.add_argument("--young", nargs="+", type=int, default=[0],
+                        help="recordings beyond the sustain a history needs before it "
+                             "holds its commissioning recordings (with --commissioning)")
     parser.add_argument("--modes", nargs="+", default=["one_fault_shot", "zero_shot"])
     parser.add_argument("--out", type=Path, default=None, help="per-life CSV")
     args = parser.parse_args()
@@ -83,18 +86,18 @@ def main() -> None:
             seen.add(int(r.name[3:]))
             unique.append(r)
     rows = []
-    for rate, sustain, k, mode in itertools.product(args.rates, args.sustains,
-                                                    args.commissioning, args.modes):
-        got = [j for r in unique if (j := judge(r, mode, rate, sustain, k))]
+    for rate, sustain, k, young, mode in itertools.product(
+            args.rates, args.sustains, args.commissioning, args.young, args.modes):
+        got = [j for r in unique if (j := judge(r, mode, rate, sustain, k, young))]
         part = pd.DataFrame(got)
         if part.empty:
             continue
-        part = part.assign(rate=rate, sustain=sustain, commissioning=k)
+        part = part.assign(rate=rate, sustain=sustain, commissioning=k, young=young)
         rows.append(part)
         d = part["delay"]
         ok = int((d.notna() & (d <= 3)).sum())
         fa = part["false_alarms"].sum()
-        print(f"rate {rate:g} sustain {sustain} commissioning {k} {mode}: in time "
+        print(f"rate {rate:g} sustain {sustain} commissioning {k} young {young} {mode}: in time "
               f"{ok}/{len(part)}, "
               f"false alarms {fa} in {part['healthy'].sum()} "
               f"({100 * fa / max(part['healthy'].sum(), 1):.2f} per 100), events "

@@ -199,6 +199,37 @@ def test_the_history_s_first_trusted_recordings_lower_a_high_fit_threshold_only(
         history_thresholds(y, ok, 0.3, commissioning=1)
 
 
+def test_a_young_history_needs_one_more_recording_over_the_threshold():
+    """Until the history holds its commissioning recordings, raising (and clearing) the
+    alarm takes sustain + YOUNG_EXTRA consecutive trusted recordings: two healthy runs
+    reading high at the start of a life raise nothing; the same two later do."""
+    from gearshot.monitor.alarm import (
+        COMMISSIONING,
+        YOUNG_EXTRA,
+        history_sustain,
+        history_thresholds,
+    )
+
+    assert YOUNG_EXTRA == 1
+    y = np.r_[0.05, 0.34, 0.45, np.full(COMMISSIONING, 0.05), 0.30, 0.31, 0.05]
+    ok = np.ones(y.size, bool)
+    limits = history_thresholds(y, ok, 0.16)
+    runs = history_sustain(limits, 2)
+    assert limits.young == COMMISSIONING and limits.own > 0.16    # not used: higher
+    assert runs[:COMMISSIONING].tolist() == [3] * COMMISSIONING
+    assert runs[COMMISSIONING:].tolist() == [2] * (y.size - COMMISSIONING)
+    res = alarm_states(y, ok, limits.per_recording, sustain=runs)
+    assert res.first_index == y.size - 2                  # the later pair, not the first
+    assert alarm_states(y, ok, 0.16, sustain=2).first_index == 2
+    # too few trusted recordings: young throughout
+    short = history_thresholds(y[:5], ok[:5], 0.16)
+    assert short.young == 5 and history_sustain(short, 2).tolist() == [3] * 5
+    with pytest.raises(GearshotError, match="sustain"):
+        alarm_states(y, ok, 0.16, sustain=np.zeros(y.size, int))
+    with pytest.raises(GearshotError, match="sustain"):
+        alarm_states(y, ok, 0.16, sustain=[2, 2])
+
+
 def test_payload_states_the_threshold_in_force_and_where_it_comes_from():
     from types import SimpleNamespace
 
@@ -228,8 +259,14 @@ def test_payload_states_the_threshold_in_force_and_where_it_comes_from():
     assert first == t0 + pd.Timedelta(days=int(np.flatnonzero(sizes > 0.1)[1]))
     check_monitor(payload, "payload")
     payload["new"] = 0
+    assert al["young_sustain"] == 3
     assert "set by the first 10 trusted recordings" in format_monitor(payload)
     assert "the fit's 0.400" in format_monitor(payload)
+    young = monitor_payload(history.iloc[:5], model, limit=0.6)
+    assert young["alarm"]["commissioning"] is None and young["alarm"]["threshold"] == 0.40
+    young["new"] = 0
+    assert ("3 consecutive recordings over it raise the alarm until the history holds 10 "
+            "trusted ones") in format_monitor(young)
 
 
 def test_row_trust_prefers_trusted_then_comparable_and_input_check():

@@ -12,7 +12,10 @@ the lower of the two (:func:`history_thresholds`): the fit's healthy baseline is
 recordings of one campaign, cross-fitted, and may read higher than the machine's later
 runs do; the first recordings of the watched machine say how it reads. The lower of the
 two only: a history that starts with a fault already present raises its own threshold,
-which is then not used, so it cannot mask the fault.
+which is then not used, so it cannot mask the fault. Until then the history is young:
+the threshold rests on the fit's campaign alone, whose runs may vary less than the
+machine's, and one more consecutive recording over it (:data:`YOUNG_EXTRA`) is needed
+to raise or clear the alarm (:func:`history_sustain`).
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from .._validation import check_in_range, check_int
 
 __all__ = ["alarm_threshold", "alarm_states", "baseline_warning", "history_thresholds",
            "AlarmResult", "Thresholds", "FALSE_ALARM_RATE", "SUSTAIN", "MIN_THRESHOLD",
-           "MIN_BASELINE", "COMMISSIONING"]
+           "MIN_BASELINE", "COMMISSIONING", "YOUNG_EXTRA", "history_sustain"]
 
 #: Per-recording false-alarm probability the threshold is set at (chosen on the
 #: development lives, benchmarks/RESULTS.md "Monitoring": 0.02, with ``SUSTAIN`` 2, raised
@@ -49,6 +52,14 @@ MIN_THRESHOLD = 0.10
 #: (benchmarks/RESULTS.md "Monitoring"): 7 to 12 gave the same alarms in time, 6 and
 #: fewer false alarms; 10 is the largest with the most zero-shot alarms in time.
 COMMISSIONING = 10
+
+#: Consecutive recordings a young history (fewer than :data:`COMMISSIONING` trusted
+#: recordings so far) needs beyond ``sustain`` (:func:`history_sustain`). Chosen on the
+#: development lives 1–10, 51–60 and the lives 243–274 (benchmarks/RESULTS.md
+#: "Monitoring"): their false alarms came from healthy runs reading high within a
+#: history's first recordings (8 in 624 healthy recordings with 0, none with 1, and the
+#: same alarms in time but for one zero-shot life).
+YOUNG_EXTRA = 1
 
 #: Healthy estimates under which the threshold's false-alarm rate is not stated as known
 #: (:func:`baseline_warning`): as few as comparability calibrates on
@@ -117,12 +128,16 @@ class Thresholds:
         (None: the history holds fewer).
     from_index : int or None
         The first recording judged against ``min(fit, own)`` (None: none yet).
+    young : int
+        Recordings before the history holds its commissioning recordings (all of them
+        while it holds fewer): the young history of :func:`history_sustain`.
     """
 
     per_recording: np.ndarray
     fit: float
     own: float | None
     from_index: int | None
+    young: int
 
 
 def history_thresholds(predicted: ArrayLike, trusted: ArrayLike, fit_threshold: float, *,
@@ -148,11 +163,28 @@ def history_thresholds(predicted: ArrayLike, trusted: ArrayLike, fit_threshold: 
     per = np.full(y.size, fit)
     usable = np.flatnonzero(ok & np.isfinite(y))
     if usable.size < commissioning:
-        return Thresholds(per, fit, None, None)
+        return Thresholds(per, fit, None, None, int(y.size))
     own = alarm_threshold(y[usable[:commissioning]], false_alarm_rate=false_alarm_rate)
     start = int(usable[commissioning - 1]) + 1
     per[start:] = min(fit, own)
-    return Thresholds(per, fit, own, start if start < y.size else None)
+    return Thresholds(per, fit, own, start if start < y.size else None, start)
+
+
+def history_sustain(thresholds: Thresholds, sustain: int = SUSTAIN, *,
+                    extra: int = YOUNG_EXTRA) -> np.ndarray:
+    """The consecutive trusted recordings that raise or clear the alarm, per recording:
+    ``sustain + extra`` while the history is young (``thresholds.young``), ``sustain``
+    after.
+
+    >>> t = history_thresholds([0.05] * 4, [True] * 4, 0.35, commissioning=2)
+    >>> history_sustain(t, 2).tolist()
+    [3, 3, 2, 2]
+    """
+    sustain = check_int(sustain, "sustain", minimum=1)
+    extra = check_int(extra, "extra", minimum=0)
+    per = np.full(thresholds.per_recording.size, sustain)
+    per[:thresholds.young] += extra
+    return per
 
 
 @dataclass(frozen=True)
@@ -172,16 +204,24 @@ class AlarmResult:
 
 
 def alarm_states(predicted: ArrayLike, trusted: ArrayLike, threshold: float | ArrayLike, *,
-                 sustain: int = SUSTAIN) -> AlarmResult:
+                 sustain: int | ArrayLike = SUSTAIN) -> AlarmResult:
     """Run the alarm over recordings in time order.
 
     The alarm is raised at the ``sustain``-th consecutive trusted recording over
     ``threshold`` (one value, or one per recording: :func:`history_thresholds`) and
-    cleared at the ``sustain``-th consecutive trusted one at or under it; untrusted
-    recordings are skipped (they neither count nor break a run).
+    cleared at the ``sustain``-th consecutive trusted one at or under it (``sustain``:
+    one count, or the count in force at each recording: :func:`history_sustain`);
+    untrusted recordings are skipped (they neither count nor break a run).
     """
-    sustain = check_int(sustain, "sustain", minimum=1)
     y = np.asarray(predicted, dtype=float)
+    if np.ndim(sustain) == 0:
+        runs = np.full(y.shape, check_int(sustain, "sustain", minimum=1))
+    else:
+        runs = np.asarray(sustain)
+        if runs.shape != y.shape or not np.issubdtype(runs.dtype, np.integer) \
+                or np.any(runs < 1):
+            raise GearshotError(f"sustain must be one count >= 1 or one per recording "
+                                f"({y.size}); got {sustain!r}")
     ok = np.asarray(trusted, dtype=bool)
     if y.shape != ok.shape:
         raise GearshotError(f"predicted and trusted differ in shape: {y.shape} vs {ok.shape}")
@@ -197,7 +237,7 @@ def alarm_states(predicted: ArrayLike, trusted: ArrayLike, threshold: float | Ar
             continue
         crossing = bool(y[i] > limits[i]) != state
         run = run + 1 if crossing else 0
-        if run >= sustain:
+        if run >= runs[i]:
             state, run = not state, 0
             if state and first is None:
                 first = i

@@ -18,7 +18,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .alarm import COMMISSIONING, AlarmResult, Thresholds, alarm_states, history_thresholds
+from .alarm import (
+    COMMISSIONING,
+    YOUNG_EXTRA,
+    AlarmResult,
+    Thresholds,
+    alarm_states,
+    history_sustain,
+    history_thresholds,
+)
 from .forecast import Forecast, forecast_crossing, reading_spread_at
 from .trust import change_notice, model_warning
 
@@ -79,7 +87,7 @@ def monitor_payload(history: pd.DataFrame, model, *, limit: float = DEFAULT_LIMI
                                 false_alarm_rate=model.false_alarm_rate)
     state = alarm_states(rows["predicted"].to_numpy(float),
                          rows["trusted"].to_numpy(bool), limits.per_recording,
-                         sustain=model.sustain)
+                         sustain=history_sustain(limits, model.sustain))
     records = [{"recording": r.recording, "time": _iso(r.time),
                 "predicted": _num(r.predicted), "low": _num(r.low), "high": _num(r.high),
                 "trusted": bool(r.trusted), "alarm": bool(a), "threshold": float(t),
@@ -147,7 +155,8 @@ def _alarm(model, limits: Thresholds, state: AlarmResult, rows: pd.DataFrame) ->
             else float(model.threshold), "first_time": first,
             "active": bool(state.alarm[ok][-1]) if ok.any() else False,
             "false_alarm_rate": float(model.false_alarm_rate),
-            "sustain": int(model.sustain), "fit_threshold": float(model.threshold),
+            "sustain": int(model.sustain), "young_sustain": int(model.sustain) + YOUNG_EXTRA,
+            "fit_threshold": float(model.threshold),
             "commissioning": own}
 
 
