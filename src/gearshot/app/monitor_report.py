@@ -100,11 +100,11 @@ def threshold_source(alarm: dict) -> str:
     to raise the alarm (``alarm.young_sustain``), else ""."""
     from ..monitor.alarm import COMMISSIONING
 
-    own = alarm.get("commissioning")
-    if own is None and alarm.get("young_sustain"):
+    own = alarm.get("commissioning") or {}
+    if not own and alarm.get("young_sustain"):
         return (f"; {alarm['young_sustain']} consecutive recordings over it raise the alarm "
                 f"until the history holds {COMMISSIONING} trusted ones")
-    if not (own or {}).get("used"):
+    if not own.get("used"):
         return ""
     return (f", set by the first {own['recordings']} trusted recordings, in force since "
             f"{own['from_time']}; the fit's {alarm.get('fit_threshold', float('nan')):.3f}")
