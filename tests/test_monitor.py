@@ -182,6 +182,28 @@ def test_an_unreadable_recording_is_kept_untrusted_with_its_reason(machine, tmp_
     json.dumps(payload, allow_nan=False)       # strict JSON: no NaN
 
 
+def test_a_clipped_recording_is_untrusted_by_its_raw_samples(machine, tmp_path):
+    """A run whose sensor saturated (flat tops at half its peak): the synchronous averages
+    smooth the flat tops away, so only the raw samples show it; the monitor checks them as
+    predict does and keeps the recording untrusted, with the check in its note."""
+    import dataclasses
+
+    from gearshot.app.monitor import monitor_history
+    from gearshot.rig import VirtualRig
+
+    rec = VirtualRig(3, engine="surrogate").record(speed=15, load=10, fault_size=0.0,
+                                                   duration=16, repetition=60)
+    rail = 0.5 * np.abs(rec.acceleration).max()
+    clipped = dataclasses.replace(rec, acceleration=np.clip(rec.acceleration, -rail, rail))
+    clipped.write(tmp_path / "clipped.h5")
+    (tmp_path / "index.csv").write_text(f"file,time\n{tmp_path / 'clipped.h5'},"
+                                        f"2026-03-01T00:00:00\n")
+    (record,) = monitor_history(machine["top"] / "zero.skops", tmp_path / "index.csv",
+                                tmp_path / "h.parquet")["records"]
+    assert not record["trusted"] and not record["alarm"]
+    assert "input check" in record["note"] and "clipped" in record["note"]
+
+
 def test_a_recording_at_a_speed_the_fit_never_saw_is_untrusted(machine, tmp_path):
     """The same rig run 20 % faster (a recording's own measured speed, no index speed):
     estimated, kept untrusted with the reason; a run at the fitted speed is not flagged

@@ -62,7 +62,8 @@ from .._errors import GearshotError
 
 __all__ = ["SPEED_TOLERANCE", "RUN_SPEED_FLOOR", "RUN_SPEED_SPREADS", "PATH_MIN_CORRELATION",
            "fit_path_check", "database_conditions",
-           "choose_condition", "check_speeds", "check_database_pair", "fit_speed_check"]
+           "choose_condition", "check_speeds", "check_database_pair", "fit_speed_check",
+           "fit_recording_checks"]
 
 #: Largest relative distance between a recording's tacho speed and the database condition
 SPEED_TOLERANCE = 0.05
@@ -308,3 +309,22 @@ def fit_path_check(pattern, healthy_patterns: Sequence) -> str:
     return (f"resonance pattern correlates {r:.2f} with the fit's healthy recordings' (at "
             f"least {PATH_MIN_CORRELATION:g}): {OTHER_PATH} (sensor moved, another sensor "
             f"or gearbox?)")
+
+
+def fit_recording_checks(speed: float, pattern: object, healthy_speeds: Sequence[float],
+                         healthy_patterns: Sequence, *, example_speed: float | None = None,
+                         unit: str = "Hz", tracked: str = "ok") -> tuple[str, str]:
+    """One recording's ``speed_check`` and ``path_check`` against a fit's recordings:
+    ``tracked`` (the check of a speed tracked from the vibration,
+    :func:`gearshot.machine.signal_check.speed_check`) when it failed, else
+    :func:`fit_speed_check` of ``speed``; and :func:`fit_path_check` of ``pattern``
+    (``gearshot predict --machine`` writes both columns, ``gearshot monitor`` the first
+    that fails in the recording's note).
+
+    >>> fit_recording_checks(30.0, None, [29.9, 30.0], [])
+    ('ok', 'ok')
+    """
+    if tracked == "ok":
+        tracked = fit_speed_check(speed, healthy_speeds, example_speed=example_speed,
+                                  unit=unit)
+    return tracked, fit_path_check(pattern, healthy_patterns)

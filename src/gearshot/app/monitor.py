@@ -202,45 +202,44 @@ def _fit_with_machine(machine, database, healthy, faulty, faulty_size, *, speed,
             [seg.sources[f].get("path") for f in seg.healthy_files])
 
 
-def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str]:
-    """SA segments of one recording as the model's fit segmented its recordings, and a
-    note ("" or why the recording is not covered: with a machine file, a tacho speed
-    beyond the model's speed tolerance; with or without one, a speed outside the fit's
-    recordings', healthy and the faulty example:
-    :func:`gearshot.app.conditions.fit_speed_check`, or another transfer path than the
-    healthy recordings': :func:`gearshot.app.conditions.fit_path_check`)."""
-    from .conditions import fit_path_check, fit_speed_check
+def _segments_of(model, path: Path, machine) -> tuple[np.ndarray, str, list[str]]:
+    """SA segments of one recording as the model's fit segmented its recordings, a note
+    ("" or why the recording is not covered: with a machine file, a tacho speed beyond
+    the model's speed tolerance; with or without one, the speed and path checks of
+    :func:`gearshot.app.conditions.fit_recording_checks` against the fit's recordings,
+    healthy and the faulty example) and each segment's ``input_check`` (the recording's
+    raw samples and its segments, :func:`gearshot.io.input_health.input_check_column`,
+    as ``gearshot predict`` checks them)."""
+    from ..io.input_health import input_check_column
+    from .conditions import fit_recording_checks
 
     cond = model.condition
     extras = getattr(model, "extras", None) or {}
-    seen, example = extras.get("healthy_speeds") or [], extras.get("example_speed")
-    paths = extras.get("healthy_paths") or []   # models saved before it: no path check
+    health: dict = {}
+    note, unit = "", "rev/s"
     if machine is None:
         from ..io import recording_segments
 
-        health: dict = {}
         sa = recording_segments(path, gear_teeth=cond["gear_teeth"],
                                 pinion_teeth=cond["pinion_teeth"], health=health)
-        note, pattern = "", health.get("path")
-        check = fit_speed_check(float(health.get("speed", np.nan)), seen,
-                                example_speed=example, unit="rev/s")
+        speed = float(health.get("speed", np.nan))
     else:
-        from ..io import Recording
-        from ..signal.path_pattern import path_pattern
         from .predict_machine import machine_segments
 
-        rec = Recording.read(path, machine=machine)
-        sa, _, hz = machine_segments(path, machine, rec=rec, sensor=cond["sensor"],
-                                     cycles_per_segment=cond["cycles_per_segment"])
-        heard = rec.channel(machine.sensor(cond["sensor"]).name)
-        pattern = path_pattern(heard.acceleration, heard.fs)
-        off = abs(hz - cond["speed"]) / cond["speed"]
+        sa, _, speed = machine_segments(path, machine, sensor=cond["sensor"],
+                                        cycles_per_segment=cond["cycles_per_segment"],
+                                        info=health)
+        off = abs(speed - cond["speed"]) / cond["speed"]
         note = "" if off <= cond["speed_tolerance"] else (
-            f"tacho {hz:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
-        check = fit_speed_check(hz, seen, example_speed=example)   # within the gate
-    if check == "ok":
-        check = fit_path_check(pattern, paths)
-    return np.asarray(sa), note or ("" if check == "ok" else check)
+            f"tacho {speed:.4g} Hz is {100 * off:.0f} % from the fitted {cond['speed']:.4g} Hz")
+        unit = "Hz"
+    checks = fit_recording_checks(speed, health.get("path"), extras.get("healthy_speeds") or [],
+                                  extras.get("healthy_paths") or [],   # older models: none
+                                  example_speed=extras.get("example_speed"), unit=unit,
+                                  tracked=health.get("speed_check", "ok"))
+    failed = next((c for c in checks if c != "ok"), "")
+    inputs = input_check_column(health["recording"], health["segments"])
+    return np.asarray(sa), note or failed, inputs
 
 
 def estimate_recordings(model, recordings: pd.DataFrame, *,
@@ -277,8 +276,9 @@ def estimate_recordings(model, recordings: pd.DataFrame, *,
         row = {"recording": rec.recording, "time": pd.Timestamp(rec.time), "model": digest,
                "calibration": model.calibration, "estimated_at": now}
         try:
-            sa, note = _segments_of(model, Path(rec.recording), machine)
-            frame = estimate_segments(model.estimator, sa, coverage=model.coverage)
+            sa, note, inputs = _segments_of(model, Path(rec.recording), machine)
+            frame = estimate_segments(model.estimator, sa, coverage=model.coverage,
+                                      input_check=inputs)
             row.update(combine_segments(frame))
             note = (note or _condition_note(model, rec)
                     or untrusted_reason(frame, zero_shot=model.calibration == "zero_shot"))

@@ -21,8 +21,7 @@ from .conditions import (
     check_speeds,
     choose_condition,
     database_conditions,
-    fit_path_check,
-    fit_speed_check,
+    fit_recording_checks,
 )
 from .fit_summary import fit_attrs
 from .load_choice import LoadChoice, choose_load
@@ -351,12 +350,11 @@ def _estimates(est, seg: _Segments, cond: _Condition, coverage: float) -> pd.Dat
     frame["speed_source"] = [seg.sources[r]["speed_source"] for r in frame["recording"]]
     frame["speed_uncertainty_hz"] = [seg.sources[r]["speed_uncertainty_hz"]
                                      for r in frame["recording"]]
-    checks = {r: seg.sources[r]["speed_check"] for r in set(frame["recording"])}
-    for r, c in checks.items():   # a tracked speed's check first, else the fit's speeds
-        checks[r] = c if c != "ok" else fit_speed_check(
-            seg.speeds[r], seg.healthy_speeds, example_speed=seg.example_speed)
-    frame["speed_check"] = frame["recording"].map(checks)
     refs = [seg.sources[f].get("path") for f in seg.healthy_files]
-    frame["path_check"] = frame["recording"].map(
-        {r: fit_path_check(seg.sources[r].get("path"), refs) for r in set(frame["recording"])})
+    checks = {r: fit_recording_checks(seg.speeds[r], seg.sources[r].get("path"),
+                                      seg.healthy_speeds, refs, example_speed=seg.example_speed,
+                                      tracked=seg.sources[r]["speed_check"])
+              for r in set(frame["recording"])}
+    frame["speed_check"] = frame["recording"].map({r: c[0] for r, c in checks.items()})
+    frame["path_check"] = frame["recording"].map({r: c[1] for r, c in checks.items()})
     return frame
