@@ -76,9 +76,12 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         """
         self._check_fitted("predict")
         X = self.features_of(sa)
-        return sum((st["weight"] * m.predict(X) for st, m in
-                    zip(self.calibration_["settings"], self.setting_models_)),
-                   np.zeros(len(X)))
+        return self._combined([m.predict(X) for m in self.setting_models_], len(X))
+
+    def _combined(self, per_model: list[FloatArray], n: int) -> FloatArray:
+        """The estimate: the models' estimates weighted as the calibration weighs them."""
+        return sum((st["weight"] * p for st, p in zip(self.calibration_["settings"],
+                                                       per_model)), np.zeros(n))
 
     def comparability(self, sa: ArrayLike, false_alarm_rate: float | None = None
                       ) -> Comparability:
@@ -208,7 +211,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         An estimate below ``detection_limit_`` is not told apart from healthy at the
         limit's confidence (95 %, one-sided): at ``coverage`` ≥ 0.9 its interval reaches
         0 (:func:`~gearshot.estimator.detection.reach_zero_below_limit`), whatever the
-        fit check says.
+        fit check says; the plain split-conformal interval (one model,
+        ``model_discrepancy=0``) is left as it is.
 
         Returns
         -------
@@ -229,16 +233,17 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
         X = self.features_of(sa)
         discrepancy = float(self.model_discrepancy)
         settings, models = self.calibration_["settings"], self.setting_models_
+        per_model = [m.predict(X) for m in models]
         if len(models) == 1 and discrepancy == 0:
-            pred = models[0].predict(X)
+            pred = per_model[0]
             q = conformal_quantile(models[0].validation_residuals, coverage)
             return np.clip(pred - q, 0, 1), np.clip(pred + q, 0, 1)
         low, high = mixture_interval(
-            {i: m.predict(X) for i, m in enumerate(models)},
+            dict(enumerate(per_model)),
             {i: st["weight"] for i, st in enumerate(settings)},
             {i: m.validation_residuals for i, m in enumerate(models)},
             coverage, discrepancy=discrepancy)
-        low = reach_zero_below_limit(self, self.predict(sa), low, coverage)
+        low = reach_zero_below_limit(self, self._combined(per_model, len(X)), low, coverage)
         return np.clip(low, 0, 1), np.clip(high, 0, 1)
 
     def score(self, X: ArrayLike, y: ArrayLike,
