@@ -126,8 +126,6 @@ class Thresholds:
     own : float or None
         The threshold of the history's first :data:`COMMISSIONING` trusted recordings
         (None: the history holds fewer).
-    from_index : int or None
-        The first recording judged against ``min(fit, own)`` (None: none yet).
     young : int
         Recordings before the history holds its commissioning recordings (all of them
         while it holds fewer): the young history of :func:`history_sustain`.
@@ -136,8 +134,13 @@ class Thresholds:
     per_recording: np.ndarray
     fit: float
     own: float | None
-    from_index: int | None
     young: int
+
+    @property
+    def from_index(self) -> int | None:
+        """The first recording judged against ``min(fit, own)`` (None: none yet)."""
+        return self.young if self.own is not None and self.young < self.per_recording.size \
+            else None
 
 
 def history_thresholds(predicted: ArrayLike, trusted: ArrayLike, fit_threshold: float, *,
@@ -163,11 +166,11 @@ def history_thresholds(predicted: ArrayLike, trusted: ArrayLike, fit_threshold: 
     per = np.full(y.size, fit)
     usable = np.flatnonzero(ok & np.isfinite(y))
     if usable.size < commissioning:
-        return Thresholds(per, fit, None, None, int(y.size))
+        return Thresholds(per, fit, None, int(y.size))
     own = alarm_threshold(y[usable[:commissioning]], false_alarm_rate=false_alarm_rate)
     start = int(usable[commissioning - 1]) + 1
     per[start:] = min(fit, own)
-    return Thresholds(per, fit, own, start if start < y.size else None, start)
+    return Thresholds(per, fit, own, start)
 
 
 def history_sustain(thresholds: Thresholds, sustain: int = SUSTAIN, *,

@@ -50,7 +50,6 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
             ax.plot(t[alarm], recs["predicted"][alarm], "o", mfc="none", mec="tab:red",
                     ms=8, label="in alarm")
     al = payload["alarm"]
-    label = f"alarm threshold {al['threshold']:.2f}"
     if len(recs) and "threshold" in recs and recs["threshold"].nunique() > 1:
         # the history's own threshold took over after its commissioning recordings
         ax.step(pd.to_datetime(recs["time"], format="ISO8601"), recs["threshold"],
@@ -58,7 +57,8 @@ def trend_figure(payload: dict, path: str | Path, *, title: str | None = None) -
                 label=f"alarm threshold {recs['threshold'].iloc[0]:.2f} (the fit's) → "
                       f"{al['threshold']:.2f} (the history's own)")
     else:
-        ax.axhline(al["threshold"], color="tab:orange", ls="--", label=label)
+        ax.axhline(al["threshold"], color="tab:orange", ls="--",
+                   label=f"alarm threshold {al['threshold']:.2f}")
     fc = payload["forecast"]
     ax.axhline(fc["limit"], color="tab:red", ls=":", label=f"limit {fc['limit']:g}")
     lines = _draw_forecast(ax, fc, recs)
