@@ -171,7 +171,8 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
 
         def example_features() -> FloatArray:
             feats = target_features(self, inputs.faulty_example, target.scale,
-                                    target.references, target.healthy_mean, names)
+                                    target.references, target.healthy_mean, names,
+                                    target.weights)
             return feats[:, cols]
 
         return _FitContext(by_grade, grades, nominal, target, inputs, example_features,
@@ -190,7 +191,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         sa, y = grade_data
         selected = [names[c] for c in cols]   # the unselected features are not computed
         X_sim = steps.simulated_features(
-            sa, y == 0, target.transfer_function, mesh_order=self._mesh_orders(),
+            sa, y == 0, target.simulated_tf, mesh_order=self._mesh_orders(),
             names=selected,
             rms_normalization=self.rms_normalization, twins=twins,
             noise_spectrum=noise_spectrum, kept=kept)

@@ -60,7 +60,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             raise GearshotError(f"sa has {arr.shape[-1]} points per cycle; the estimator was "
                                 f"fitted on {self.n_points_}")
         feats = target_features(self, arr, self.target_scale_, self.references_,
-                                self.target_healthy_mean_, self.candidate_features_)
+                                self.target_healthy_mean_, self.candidate_features_,
+                                getattr(self, "residue_weights_", None))
         return feats[:, self.selected_columns_]
 
     def predict(self, sa: ArrayLike) -> FloatArray:

@@ -12,6 +12,8 @@ from ..signal.alignment import subtract_with_lags
 from . import steps
 from ._inputs import _FitInputs, _on_grid
 from ._shared_work import keep, kept, shared, sharing
+from .calibration import resolve_calibration
+from .whitening import residue_weights, two_sided, weight_differences
 from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
@@ -54,6 +56,8 @@ class _TargetSide:
     healthy_features: FloatArray
     residue_power: FloatArray
     residue_ms: float
+    weights: FloatArray | None = None          # residue whitening of the differences
+    simulated_tf: ComplexArray | None = None   # what the simulated side goes through
 
 
 def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
@@ -77,12 +81,40 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         sub_h = suppressed_target(train_h, references, upsample, unscaled)
     else:
         sub_h = cross_run(train_h, references, recordings, upsample, unscaled)
-    feats_h, mean_h = steps.centred_features(sub_h, mesh_order=est._mesh_orders(),
+    weights, sim_tf = whitening(est, inputs, sub_h, scale, tf)
+    sub_w = sub_h
+    if weights is not None:   # step 6 again on the filtered SAs (their own lags)
+        w_train, w_refs = (weight_differences(a, weights) for a in (train_h, references))
+        sub_w = (suppressed_target(w_train, w_refs, upsample) if recordings is None
+                 else cross_run(w_train, w_refs, recordings, upsample))
+    feats_h, mean_h = steps.centred_features(sub_w, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
     return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
-                       steps.residue_power(sub_h),
-                       residue_mean_square(sub_h, est._mesh_orders()))
+                       steps.residue_power(sub_w),
+                       residue_mean_square(sub_h, est._mesh_orders()), weights, sim_tf)
+
+
+def whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,
+              tf: ComplexArray | None) -> tuple[FloatArray | None, ComplexArray | None]:
+    """The target differences' weights and the simulated side's transfer function
+    (:mod:`.whitening`; ``(None, tf)`` when the estimator does not whiten).
+
+    Step 5 then divides each side by its own healthy RMS *after* the weights: the target's
+    weights carry the ratio of the raw to the filtered scale (its differences are formed
+    on the raw scale), the simulated side filters before its scale is taken."""
+    mode = est._options().residue_whitening
+    if mode == "off" or (mode == "auto" and getattr(est, "estimator", "paper") == "paper") \
+            or resolve_calibration(est.calibration) is not None:   # joint: not whitened
+        return None, tf
+    healthy, n = inputs.target_healthy, inputs.n_points
+    base = residue_weights(differences)
+    weights = base
+    if est.rms_normalization:
+        weights = base * (scale / steps.rms_scale(weight_differences(healthy, base),
+                                                  name="target_healthy"))
+    sim_tf = two_sided(base, n).astype(np.complex128)
+    return weights, sim_tf if tf is None else sim_tf * np.asarray(tf)
 
 
 def cross_run(train: FloatArray, references: FloatArray, recordings: NDArray[Any],
@@ -121,9 +153,10 @@ def target_tf(est: Any, healthy_long: FloatArray | None,
 
 
 def target_features(est: Any, sa: ArrayLike | None, scale: float, references: FloatArray,
-                    healthy_mean: FloatArray, names: tuple[str, ...]) -> FloatArray:
-    """Steps 5–7 on target SAs with the target side's scale, references and mean
-    (shared inside a :func:`shared_target_work` block)."""
+                    healthy_mean: FloatArray, names: tuple[str, ...],
+                    weights: FloatArray | None = None) -> FloatArray:
+    """Steps 5–7 on target SAs with the target side's scale, references, mean and
+    residue weights (shared inside a :func:`shared_target_work` block)."""
     x = np.atleast_2d(np.asarray(sa, dtype=float))
     upsample, orders = est._options().upsample, est._mesh_orders()
 
@@ -133,10 +166,15 @@ def target_features(est: Any, sa: ArrayLike | None, scale: float, references: Fl
             y = steps.normalize_rms(x, scale=scale)
             raw_refs = kept("unscaled references", (references, float(scale)))
             unscaled = None if raw_refs is None else (x, raw_refs)
-        sub = suppressed_target(y, references, upsample, unscaled)
+        if weights is None:
+            sub = suppressed_target(y, references, upsample, unscaled)
+        else:   # filtered SAs and references, their own lags
+            sub = suppressed_target(weight_differences(y, weights),
+                                    weight_differences(references, weights), upsample)
         feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
         return feats
 
     return shared("features", (x, bool(est.rms_normalization), float(scale), references,
                                 np.asarray(healthy_mean, dtype=float), tuple(names),
-                                orders, int(upsample)), compute)
+                                orders, int(upsample),
+                                None if weights is None else np.asarray(weights)), compute)

@@ -74,6 +74,11 @@ class EstimatorOptions:
         Candidate K of step 8.
     validation_fraction : float in (0, 1), default 0.3
         Share of step 8's training rows in the split that chooses K (the paper's 70/30).
+    residue_whitening : {"auto", "on", "off"}, default "auto"
+        Weight the difference signals of both sides, order by order, by the inverse of
+        the target's healthy residue (:mod:`gearshot.estimator.whitening`). "auto": on,
+        except for the paper's estimator (``estimator="paper"``), which keeps its literal
+        pipeline. Chosen on the rig family's development range (RESULTS, "Estimator").
 
     Examples
     --------
@@ -96,6 +101,7 @@ class EstimatorOptions:
     upsample: int = 100
     n_neighbors: Iterable[int] = range(1, 101)
     validation_fraction: float = 0.3
+    residue_whitening: str = "auto"
 
     def __post_init__(self) -> None:
         validate_params({f.name: getattr(self, f.name) for f in fields(self)},
@@ -117,6 +123,7 @@ OPTION_CONSTRAINTS: dict[str, list[Constraint]] = {
     "upsample": [Interval(int, 1, None)],
     "n_neighbors": [IntegerSequence(1, None)],
     "validation_fraction": [Interval(float, 0, 1, closed="neither")],
+    "residue_whitening": [Options(("auto", "on", "off"))],
 }
 
 
