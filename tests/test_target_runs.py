@@ -66,16 +66,69 @@ def test_new_runs_read_healthy_when_the_fit_differences_cross_runs(monkeypatch):
     new_healthy = propagate(_runs(6, 2, seed=5).reshape(-1, N), path)
     new_faulty = propagate(_runs(6, 1, seed=6, fault=0.5).reshape(-1, N), path)
 
-    def fit():
-        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0)
+    def fit(whitening="auto"):
+        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                    options={"residue_whitening": whitening})
         return est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
                        healthy_recordings=labels)
 
-    by_run = fit()
-    assert by_run.predict(new_healthy).mean() <= 0.15
-    assert abs(np.median(by_run.predict(new_faulty)) - 0.5) <= 0.2
+    for whitening in ("auto", "off"):   # 4 runs: the default whitens
+        by_run = fit(whitening)
+        assert (by_run.residue_weights_ is None) == (whitening == "off")
+        assert by_run.predict(new_healthy).mean() <= 0.15
+        assert abs(np.median(by_run.predict(new_faulty)) - 0.5) <= 0.2
+    # the residue's power, compared unweighted
     monkeypatch.setattr(target, "cross_run", lambda train, refs, rec, up, unscaled=None:
                         target.suppressed_target(train, refs, up, unscaled))
-    within_run = fit()
+    within_run = fit("off")
     assert by_run.target_residue_power_.sum() > 50 * within_run.target_residue_power_.sum()
     assert within_run.predict(new_healthy).mean() >= 0.3
+
+
+def _band_runs(n_runs: int, per_run: int, *, seed: int, fault: float = 0.0) -> np.ndarray:
+    """Runs whose change sits in one band of orders (what a drifting speed leaves near a
+    resonance), far louder there than the fault."""
+    rng = np.random.default_rng(seed)
+    gear = synthetic_sa([fault], 6, np.random.default_rng(7), same_gear=True)[0]
+    out = []
+    for _ in range(n_runs):
+        spec = np.zeros(N // 2 + 1, complex)
+        band = np.arange(150, 200)
+        spec[band] = rng.normal(size=band.size) + 1j * rng.normal(size=band.size)
+        change = np.fft.irfft(spec, n=N)
+        change *= 20 / change.std()
+        out.append([gear + change + 0.3 * rng.normal(size=N) for _ in range(per_run)])
+    return np.array(out)
+
+
+def test_residue_whitening_reads_new_runs_of_a_band_limited_change_closer_to_truth():
+    """The fit's 4 runs show where a new run's residue lies; weighting those orders down
+    reads new healthy runs nearer 0 and new faulty ones nearer their size than the
+    unweighted differences do. One run gives no weights (``MIN_RUNS``)."""
+    path, held_out = tf_pair()
+    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
+    fit_runs = propagate(_band_runs(4, 6, seed=2).reshape(-1, N), path)
+    labels = np.repeat(np.arange(4), 6)
+    long = propagate(_band_runs(1, 40, seed=3).reshape(-1, N), path).ravel()
+    example = propagate(_band_runs(1, 1, seed=4, fault=0.5)[0, 0], path)
+    new_healthy = propagate(_band_runs(6, 2, seed=5).reshape(-1, N), path)
+    new_faulty = propagate(_band_runs(6, 1, seed=6, fault=0.5).reshape(-1, N), path)
+
+    def error(whitening, runs=labels):
+        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                    options={"residue_whitening": whitening})
+        est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
+                healthy_recordings=runs)
+        return est, (np.abs(est.predict(new_healthy)).mean()
+                     + np.abs(est.predict(new_faulty) - 0.5).mean())
+
+    whitened, err_on = error("auto")
+    plain, err_off = error("off")
+    assert whitened.residue_weights_ is not None and plain.residue_weights_ is None
+    assert err_on < 0.7 * err_off
+    one_run, _ = error("on", np.zeros(24, int))
+    assert one_run.residue_weights_ is None
+    paper = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                  estimator="paper").fit(
+        db, fit_runs, example, 0.5, long, selection_tf=held_out, healthy_recordings=labels)
+    assert paper.residue_weights_ is None

@@ -370,7 +370,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         names = PAPER_FEATURES if self.features is None else tuple(self.features)
 
         # the block diagram: target side, feature selection, grade choice, grade models
-        target = fit_target_side(self, inputs, names, recordings)
+        target = fit_target_side(self, inputs, names, recordings, twins is not None)
         selection = self._select_features(by_grade, nominal, inputs, names,
                                           seeds["select_features"], twins)
         cols = [names.index(n) for n in selection.selected]

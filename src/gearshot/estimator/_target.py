@@ -9,11 +9,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..signal.alignment import subtract_with_lags
+from ..signal.orders import mesh_band_orders
 from . import steps
 from ._inputs import _FitInputs, _on_grid
 from ._shared_work import keep, kept, shared, sharing
 from .calibration import resolve_calibration
-from .whitening import residue_weights, two_sided, weight_differences
+from .whitening import MIN_RUNS, residue_weights, two_sided, weight_differences
 from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
@@ -61,11 +62,16 @@ class _TargetSide:
 
 
 def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
-                    recordings: NDArray[Any] | None = None) -> _TargetSide:
+                    recordings: NDArray[Any] | None = None,
+                    matched: bool = False) -> _TargetSide:
     """Steps 3 and 5–7 on the target: TF, scale, references, healthy features.
 
     ``recordings`` (the healthy SAs' recording labels, or None): each training SA's
     step-6 reference is then taken from the *other* recordings only (:func:`cross_run`).
+    ``matched``: the simulated side subtracts twins and adds the target's residue. The
+    residue whitening needs it (without it the weighted residue has no counterpart) and
+    healthy recordings of ``MIN_RUNS`` runs or more (weights learned within one run
+    meet another run's residue where that run was quiet).
     """
     tf = target_tf(est, inputs.healthy_long, inputs.n_points)
     scale = steps.rms_scale(inputs.target_healthy, name="target_healthy")
@@ -81,7 +87,9 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         sub_h = suppressed_target(train_h, references, upsample, unscaled)
     else:
         sub_h = cross_run(train_h, references, recordings, upsample, unscaled)
-    weights, sim_tf = whitening(est, inputs, sub_h, scale, tf)
+    runs = 0 if recordings is None else np.unique(np.asarray(recordings)).size
+    weights, sim_tf = (whitening(est, inputs, sub_h, scale, tf)
+                       if matched and runs >= MIN_RUNS else (None, tf))
     sub_w = sub_h
     if weights is not None:   # step 6 again on the filtered SAs (their own lags)
         w_train, w_refs = (weight_differences(a, weights) for a in (train_h, references))
@@ -109,6 +117,7 @@ def whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: floa
         return None, tf
     healthy, n = inputs.target_healthy, inputs.n_points
     base = residue_weights(differences)
+    base[mesh_band_orders(n, est._mesh_orders(), 2)] = 0.0   # what the features drop
     weights = base
     if est.rms_normalization:
         weights = base * (scale / steps.rms_scale(weight_differences(healthy, base),

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
-__all__ = ["SMOOTH_ORDERS", "FLOOR", "residue_weights", "weight_differences",
+__all__ = ["SMOOTH_ORDERS", "FLOOR", "MIN_RUNS", "residue_weights", "weight_differences",
            "two_sided"]
 
 FloatArray = NDArray[np.float64]
@@ -40,6 +40,10 @@ SMOOTH_ORDERS = 9
 #: The smoothed power is floored at this share of its median (no order weighs more than
 #: ``FLOOR ** -0.5`` times a typical one).
 FLOOR = 1e-3
+#: Healthy recordings (runs) a fit needs before it whitens: the weights must learn the
+#: residue a *new run* leaves, which one run's segments do not show (PHM09, one healthy
+#: recording per fit: whitened, run 2's healthy gear read 0.17 at 40 Hz High, trusted).
+MIN_RUNS = 3
 
 
 def residue_weights(differences: ArrayLike) -> FloatArray:

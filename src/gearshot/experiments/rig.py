@@ -36,6 +36,9 @@ class RigDataset:
     gear_teeth, pinion_teeth : int
         The pair the SAs were segmented for (declared to the estimator's ``fit``, which
         refuses a database of another pair).
+    healthy_recordings : ndarray of str (n,) or None
+        The recording each training healthy SA comes from (``fit``'s
+        ``healthy_recordings``: references from other runs, residue whitening).
     """
 
     target_healthy: np.ndarray
@@ -48,6 +51,7 @@ class RigDataset:
     example_recording: str
     gear_teeth: int = GEAR_TEETH
     pinion_teeth: int = PINION_TEETH
+    healthy_recordings: np.ndarray | None = None
 
     def fit_args(self, database):
         """Positional arguments for :meth:`OneFaultShotEstimator.fit`."""
@@ -55,8 +59,12 @@ class RigDataset:
                 self.healthy_long)
 
     def fit_kwargs(self):
-        """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair."""
-        return {"gear_teeth": self.gear_teeth, "pinion_teeth": self.pinion_teeth}
+        """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair and
+        the healthy SAs' recordings."""
+        kw = {"gear_teeth": self.gear_teeth, "pinion_teeth": self.pinion_teeth}
+        if self.healthy_recordings is not None:
+            kw["healthy_recordings"] = self.healthy_recordings
+        return kw
 
 
 def _campaign_rows(campaign, speed, load):
@@ -132,6 +140,7 @@ def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5,
 
     train_h = rng.permutation(healthy)[:n_train_healthy]
     target_healthy = np.vstack([sa_of(i)[0] for i in train_h])
+    labels = np.concatenate([[str(rows.loc[i, "path"])] * len(sa_of(i)[0]) for i in train_h])
     healthy_long = sa_of(train_h[0], long=True)[1]
     ex_rec = int(rng.choice(faulty))
     ex_sa = sa_of(ex_rec)[0]
@@ -154,4 +163,5 @@ def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5,
         example_recording=str(rows.loc[ex_rec, "path"]),
         gear_teeth=int(gear_teeth),
         pinion_teeth=int(pinion_teeth),
+        healthy_recordings=labels,
     )
