@@ -16,14 +16,23 @@ differ from the library's only in the physics of the simulated faults and gear p
   nominal cut (centre 0.5, depth 0.5, no offsets, no roughness): the fault's shape treated
   as unknown and marginalised (domain randomisation), no hidden truth read.
 
-Both replace, for the build only, the fault objects the database builder makes from its
-sizes (``gearshot.sim.dynamics.resolve_faults``); the stored labels stay the nominal sizes,
-as a rig's labels are. The rigs' SA segments come from the family's cache.
+* ``--mode factors --setting S``: the rigs recorded again with parts of their hidden
+  reality switched off (``SETTINGS``: "clean" none of noise, interference, ripple, drift,
+  tacho jitter; "noise", "interference", "load", "jitter", "sripple" (the once-per-rev
+  speed ripple), "drift" (the slow speed drift), "speed" (both) each alone; their own
+  cache ``WORK/rigs_S``), estimated against the family database and against the rig's
+  own-physics database of ``--mode oracle`` (run it first, same ``--work``).
+
+The oracle and prior modes replace, for the build only, the fault objects the database
+builder makes from its sizes (``gearshot.sim.dynamics.resolve_faults``); the stored labels
+stay the nominal sizes, as a rig's labels are. The rigs' SA segments come from the family's cache.
 
     GEARSHOT_DATA=DATA OMP_NUM_THREADS=1 python benchmarks/physics_budget.py --mode oracle \
         --work WORK --seeds 100 ... 123
     GEARSHOT_DATA=DATA OMP_NUM_THREADS=1 python benchmarks/physics_budget.py --mode prior \
         --work WORK --range dev
+    GEARSHOT_DATA=DATA OMP_NUM_THREADS=1 python benchmarks/physics_budget.py --mode factors \
+        --setting drift --work WORK --seeds 100 ... 111
 
 Rows go to ``WORK/<mode>.jsonl`` (the family's row format); the family's tables are
 printed at the end.
@@ -126,9 +135,43 @@ def _prior(seeds, work: Path, frf: Path, draws: int) -> Path:
     return results
 
 
+_OFF = dict(snr_db=200.0, motor_level=0.0, extra_level=0.0, impact_level=0.0,
+            speed_drift=0.0, speed_ripple=0.0, load_ripple=0.0, tacho_jitter=0.0)
+_KEEP = {"clean": (), "noise": ("snr_db",),
+         "interference": ("motor_level", "extra_level", "impact_level"),
+         "load": ("load_ripple",), "jitter": ("tacho_jitter",), "sripple": ("speed_ripple",),
+         "drift": ("speed_drift",), "speed": ("speed_drift", "speed_ripple")}
+SETTINGS = {name: {k: v for k, v in _OFF.items() if k not in keep}
+            for name, keep in _KEEP.items()}
+
+
+def _factors(seeds, work: Path, frf: Path, draws: int, setting: str) -> Path:
+    import gearshot.experiments.family_rigs as family_rigs
+
+    off = SETTINGS[setting]
+
+    def rig_with(cls, seed, paths, grade, path_index):
+        return cls(seed=seed, tf_bank=paths, grade=grade,
+                   reality_overrides={"tf_index": int(path_index), **off})
+
+    family_rigs._rig = rig_with
+    stores = {"nominal": data_home() / "family" / "db-4conditions-h50-f350-s0-paired"}
+    for seed in seeds:
+        stores["oracle"] = work / f"oracle-db-{seed}"
+        for name, store in stores.items():
+            frame = family.rig_family_experiment(
+                store, [seed], results=work / f"{setting}_{name}.jsonl", frf_folder=frf,
+                n_draws=draws, variants=["full"], params={},
+                cache_dir=work / f"rigs_{setting}", client=None, progress=False)
+            print(f"{setting} rig {seed} {name}: MAE "
+                  + " ".join(f"{m:.3f}" for m in frame["mae"]), flush=True)
+    return work / f"{setting}_nominal.jsonl"
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--mode", choices=["oracle", "prior"], required=True)
+    parser.add_argument("--mode", choices=["oracle", "prior", "factors"], required=True)
+    parser.add_argument("--setting", choices=list(SETTINGS), default="clean")
     parser.add_argument("--work", required=True, help="folder for the databases and rows")
     parser.add_argument("--range", choices=list(family.RANGES), default="dev")
     parser.add_argument("--seeds", type=int, nargs="+")
@@ -140,8 +183,11 @@ def main(argv=None) -> None:
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     dynamics.resolve_faults = _faults
-    run = _oracle if args.mode == "oracle" else _prior
-    results = run(seeds, work, Path(args.frf_folder), args.draws)
+    frf = Path(args.frf_folder)
+    if args.mode == "factors":
+        results = _factors(seeds, work, frf, args.draws, args.setting)
+    else:
+        results = (_oracle if args.mode == "oracle" else _prior)(seeds, work, frf, args.draws)
     frame = family.read_family_results(results)
     frame = frame[frame["seed"].isin(seeds) & (frame["draw"] < args.draws)]
     print(family.format_family_tables(frame))

@@ -58,11 +58,12 @@ class RigDataset:
         return (database, self.target_healthy, self.faulty_example, self.faulty_size,
                 self.healthy_long)
 
-    def fit_kwargs(self):
-        """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair and
-        the healthy SAs' recordings."""
+    def fit_kwargs(self, recordings: bool = True):
+        """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair and,
+        with ``recordings``, the healthy SAs' recordings (the paper's Sec. 4.2 experiment,
+        :func:`~gearshot.experiments.rig_experiment`, passes none, as the paper)."""
         kw = {"gear_teeth": self.gear_teeth, "pinion_teeth": self.pinion_teeth}
-        if self.healthy_recordings is not None:
+        if recordings and self.healthy_recordings is not None:
             kw["healthy_recordings"] = self.healthy_recordings
         return kw
 

@@ -250,7 +250,7 @@ def rig_experiment(campaign, database, *, speed, load, selection_tf, variants=RI
                          segments=cache)
         for row in evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
                                      variants=variants, selection_tf=selection_tf,
-                                     random_state=seed + r, fit_kwargs=ds.fit_kwargs(),
+                                     random_state=seed + r, fit_kwargs=ds.fit_kwargs(False),
                                      keep_estimators=keep_estimators is True
                                      or (keep_estimators == "first" and r == 0),
                                      **dict(params or {})):
