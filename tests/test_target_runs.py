@@ -32,6 +32,22 @@ def _runs(n_runs: int, per_run: int, *, seed: int, fault: float = 0.0,
                      for change in (_run_change(rng, run_size) for _ in range(n_runs))])
 
 
+def _scenario(make_runs):
+    """Through a resonant path: 4 fit runs of 6 healthy SAs (labelled), a long healthy
+    signal, an example of size 0.5, 6 new healthy runs of 2 SAs and 6 new faulty SAs; the
+    held-out path for step 1 and a paired database."""
+    path, held_out = tf_pair()
+    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
+
+    def through(runs):
+        return propagate(runs.reshape(-1, N), path)
+
+    return (held_out, db, through(make_runs(4, 6, seed=2)), np.repeat(np.arange(4), 6),
+            through(make_runs(1, 40, seed=3)).ravel(),
+            through(make_runs(1, 1, seed=4, fault=0.5))[0],
+            through(make_runs(6, 2, seed=5)), through(make_runs(6, 1, seed=6, fault=0.5)))
+
+
 def test_cross_run_subtracts_references_of_other_recordings_only():
     runs = _runs(3, 3, seed=1)
     train, refs = runs[:, :2].reshape(-1, N), runs[:, 2]
@@ -57,14 +73,8 @@ def test_new_runs_read_healthy_when_the_fit_differences_cross_runs(monkeypatch):
     :func:`cross_run` replaces) the same new healthy runs read as a half-size fault."""
     import gearshot.estimator._target as target
 
-    path, held_out = tf_pair()
-    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
-    fit_runs = propagate(_runs(4, 6, seed=2).reshape(-1, N), path)
-    labels = np.repeat(np.arange(4), 6)
-    long = propagate(_runs(1, 40, seed=3).reshape(-1, N), path).ravel()
-    example = propagate(_runs(1, 1, seed=4, fault=0.5)[0, 0], path)
-    new_healthy = propagate(_runs(6, 2, seed=5).reshape(-1, N), path)
-    new_faulty = propagate(_runs(6, 1, seed=6, fault=0.5).reshape(-1, N), path)
+    (held_out, db, fit_runs, labels, long, example, new_healthy,
+     new_faulty) = _scenario(_runs)
 
     def fit(whitening="auto"):
         est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
@@ -105,14 +115,8 @@ def test_residue_whitening_reads_new_runs_of_a_band_limited_change_closer_to_tru
     """The fit's 4 runs show where a new run's residue lies; weighting those orders down
     reads new healthy runs nearer 0 and new faulty ones nearer their size than the
     unweighted differences do. One run gives no weights (``MIN_RUNS``)."""
-    path, held_out = tf_pair()
-    db = paired_synthetic_database(n_healthy=20, n_faulty=60)
-    fit_runs = propagate(_band_runs(4, 6, seed=2).reshape(-1, N), path)
-    labels = np.repeat(np.arange(4), 6)
-    long = propagate(_band_runs(1, 40, seed=3).reshape(-1, N), path).ravel()
-    example = propagate(_band_runs(1, 1, seed=4, fault=0.5)[0, 0], path)
-    new_healthy = propagate(_band_runs(6, 2, seed=5).reshape(-1, N), path)
-    new_faulty = propagate(_band_runs(6, 1, seed=6, fault=0.5).reshape(-1, N), path)
+    (held_out, db, fit_runs, labels, long, example, new_healthy,
+     new_faulty) = _scenario(_band_runs)
 
     def error(whitening, runs=labels):
         est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,

@@ -62,7 +62,8 @@ class RigDataset:
         """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair and,
         with ``recordings``, the healthy SAs' recordings (the paper's Sec. 4.2 experiment,
         :func:`~gearshot.experiments.rig_experiment`, passes none, as the paper)."""
-        kw = {"gear_teeth": self.gear_teeth, "pinion_teeth": self.pinion_teeth}
+        kw: dict[str, object] = {"gear_teeth": self.gear_teeth,
+                                 "pinion_teeth": self.pinion_teeth}
         if recordings and self.healthy_recordings is not None:
             kw["healthy_recordings"] = self.healthy_recordings
         return kw
