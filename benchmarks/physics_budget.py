@@ -44,6 +44,7 @@ import argparse
 import time
 import zlib
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -62,13 +63,6 @@ _NOMINAL = dynamics.resolve_faults
 _STATE: dict = {"reality": None, "prior": False}
 
 
-def _cut(size, center, depth, edges, roughness):
-    lo = max(center - 0.5 * size * (1 + edges[0]), 0.0)
-    hi = min(center + 0.5 * size * (1 + edges[1]), 1.0)
-    return IrregularFaceFault(size=hi - lo, center=0.5 * (lo + hi), depth=depth,
-                              roughness=tuple(roughness))
-
-
 def _faults(fault_sizes, faults, center, depth, fault_type="ftff"):
     """The builder's fault objects: the rig's cut, a cut drawn from the prior, or nominal."""
     reality, prior = _STATE["reality"], _STATE["prior"]
@@ -82,14 +76,14 @@ def _faults(fault_sizes, faults, center, depth, fault_type="ftff"):
             c, d = rng.uniform(*PRIOR["center"]), rng.uniform(*PRIOR["depth"])
             e = rng.uniform(-PRIOR["edges"], PRIOR["edges"], 2)
             r = rng.uniform(-PRIOR["roughness"], PRIOR["roughness"], 3)
+            reality = SimpleNamespace(fault_center=c, fault_depth=d, fault_edges=tuple(e),
+                                      fault_roughness=tuple(r))
         if y <= 0:
             out.extend(_NOMINAL([0.0], None, 0.5, 0.5))
-        elif prior:
-            out.append(_cut(float(y), c, d, e, r))
-        else:
+        else:   # the cut the rig (or the drawn shape) makes for a label y
             s, c, d = physical_fault(float(y), reality)
             out.append(IrregularFaceFault(size=s, center=c, depth=d,
-                                          roughness=reality.fault_roughness))
+                                          roughness=tuple(reality.fault_roughness)))
     return out
 
 

@@ -14,7 +14,7 @@ from . import steps
 from ._inputs import _FitInputs, _on_grid
 from ._shared_work import keep, kept, shared, sharing
 from .calibration import resolve_calibration
-from .whitening import MIN_RUNS, residue_weights, two_sided, weight_differences
+from .whitening import MIN_RUNS, filter_orders, residue_weights, two_sided
 from .zero_shot import residue_mean_square
 
 FloatArray = NDArray[np.float64]
@@ -87,12 +87,10 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         sub_h = suppressed_target(train_h, references, upsample, unscaled)
     else:
         sub_h = cross_run(train_h, references, recordings, upsample, unscaled)
-    runs = 0 if recordings is None else np.unique(np.asarray(recordings)).size
-    weights, sim_tf = (whitening(est, inputs, sub_h, scale, tf)
-                       if matched and runs >= MIN_RUNS else (None, tf))
+    weights, sim_tf = fit_whitening(est, inputs, sub_h, scale, tf, recordings, matched)
     sub_w = sub_h
     if weights is not None:   # step 6 again on the filtered SAs (their own lags)
-        w_train, w_refs = (weight_differences(a, weights) for a in (train_h, references))
+        w_train, w_refs = (filter_orders(a, weights) for a in (train_h, references))
         sub_w = (suppressed_target(w_train, w_refs, upsample) if recordings is None
                  else cross_run(w_train, w_refs, recordings, upsample))
     feats_h, mean_h = steps.centred_features(sub_w, mesh_order=est._mesh_orders(),
@@ -103,24 +101,30 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
                        residue_mean_square(sub_h, est._mesh_orders()), weights, sim_tf)
 
 
-def whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,
-              tf: ComplexArray | None) -> tuple[FloatArray | None, ComplexArray | None]:
+def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,
+                  tf: ComplexArray | None, recordings: NDArray[Any] | None, matched: bool
+                  ) -> tuple[FloatArray | None, ComplexArray | None]:
     """The target differences' weights and the simulated side's transfer function
-    (:mod:`.whitening`; ``(None, tf)`` when the estimator does not whiten).
+    (:mod:`.whitening`), or ``(None, tf)`` when the fit does not whiten: the option is
+    off (``"auto"``: for the paper's estimator), the calibration is joint, the simulated
+    side is not ``matched`` or the healthy SAs come from fewer than ``MIN_RUNS``
+    ``recordings``.
 
     Step 5 then divides each side by its own healthy RMS *after* the weights: the target's
     weights carry the ratio of the raw to the filtered scale (its differences are formed
     on the raw scale), the simulated side filters before its scale is taken."""
     mode = est._options().residue_whitening
+    runs = 0 if recordings is None else np.unique(np.asarray(recordings)).size
     if mode == "off" or (mode == "auto" and getattr(est, "estimator", "paper") == "paper") \
-            or resolve_calibration(est.calibration) is not None:   # joint: not whitened
+            or resolve_calibration(est.calibration) is not None or not matched \
+            or runs < MIN_RUNS:
         return None, tf
     healthy, n = inputs.target_healthy, inputs.n_points
     base = residue_weights(differences)
     base[mesh_band_orders(n, est._mesh_orders(), 2)] = 0.0   # what the features drop
     weights = base
     if est.rms_normalization:
-        weights = base * (scale / steps.rms_scale(weight_differences(healthy, base),
+        weights = base * (scale / steps.rms_scale(filter_orders(healthy, base),
                                                   name="target_healthy"))
     sim_tf = two_sided(base, n).astype(np.complex128)
     return weights, sim_tf if tf is None else sim_tf * np.asarray(tf)
@@ -178,8 +182,8 @@ def target_features(est: Any, sa: ArrayLike | None, scale: float, references: Fl
         if weights is None:
             sub = suppressed_target(y, references, upsample, unscaled)
         else:   # filtered SAs and references, their own lags
-            sub = suppressed_target(weight_differences(y, weights),
-                                    weight_differences(references, weights), upsample)
+            sub = suppressed_target(filter_orders(y, weights),
+                                    filter_orders(references, weights), upsample)
         feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
         return feats
 

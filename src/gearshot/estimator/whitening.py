@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
-__all__ = ["SMOOTH_ORDERS", "FLOOR", "MIN_RUNS", "residue_weights", "weight_differences",
+__all__ = ["SMOOTH_ORDERS", "FLOOR", "MIN_RUNS", "residue_weights", "filter_orders",
            "two_sided"]
 
 FloatArray = NDArray[np.float64]
@@ -69,9 +69,10 @@ def residue_weights(differences: ArrayLike) -> FloatArray:
     return np.asarray(weights / np.sqrt(np.mean(weights ** 2)), dtype=np.float64)
 
 
-def weight_differences(differences: ArrayLike, weights: ArrayLike | None) -> FloatArray:
-    """``differences`` (..., n) filtered by one-sided real ``weights`` (None: unchanged)."""
-    d = np.asarray(differences, dtype=float)
+def filter_orders(signals: ArrayLike, weights: ArrayLike | None) -> FloatArray:
+    """``signals`` (..., n: SAs or their differences) filtered by one-sided real
+    ``weights`` per order (None: unchanged)."""
+    d = np.asarray(signals, dtype=float)
     if weights is None:
         return d
     n = d.shape[-1]
@@ -85,4 +86,3 @@ def two_sided(weights: ArrayLike, n: int) -> FloatArray:
     w = np.asarray(weights, dtype=float)
     k = np.arange(n)
     return np.asarray(w[np.minimum(k, n - k)], dtype=np.float64)
-
