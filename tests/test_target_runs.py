@@ -136,3 +136,43 @@ def test_residue_whitening_reads_new_runs_of_a_band_limited_change_closer_to_tru
                                   estimator="paper").fit(
         db, fit_runs, example, 0.5, long, selection_tf=held_out, healthy_recordings=labels)
     assert paper.residue_weights_ is None
+
+
+def test_recorded_residue_draws_are_turned_signed_copies_of_the_healthy_differences():
+    from gearshot.estimator._simulated import recorded_residue_spectrum
+
+    rng = np.random.default_rng(0)
+    levels = np.array([0.2, 1.0, 5.0])[:, None]     # three runs, their residue levels apart
+    rows = levels * rng.normal(size=(3, 64))
+    spec = recorded_residue_spectrum(rows, 300, np.random.default_rng(1))
+    draws = np.fft.irfft(spec, n=64, axis=-1)
+    for d in draws:   # each draw is ± one row turned by a whole number of points
+        assert any(np.allclose(d, s * np.roll(r, t)) for r in rows for s in (1, -1)
+                   for t in range(64))
+    # every run's own level is drawn, and only those (Gaussian draws of the mean power
+    # would all lie near one level)
+    power, row_power = (draws ** 2).mean(axis=1), (rows ** 2).mean(axis=1)
+    nearest = np.abs(power[:, None] - row_power[None, :]).argmin(axis=1)
+    np.testing.assert_allclose(power, row_power[nearest])
+    assert set(nearest.tolist()) == {0, 1, 2}
+    np.testing.assert_allclose(spec, recorded_residue_spectrum(rows, 300,
+                                                               np.random.default_rng(1)))
+
+
+def test_recorded_residue_draws_follow_the_whitening():
+    """``residue_draws="auto"`` draws the matched residue from the fit's healthy
+    differences when the fit whitens (several runs), and stays Gaussian when it does not
+    (one run: the same estimates as ``"gaussian"``)."""
+    (held_out, db, fit_runs, labels, long, example, new_healthy,
+     new_faulty) = _scenario(_band_runs)
+
+    def predict(draws, runs=labels):
+        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                    options={"residue_draws": draws})
+        est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
+                healthy_recordings=runs)
+        return est.predict(np.vstack([new_healthy, new_faulty]))
+
+    assert not np.allclose(predict("auto"), predict("gaussian"))
+    one_run = np.zeros(24, int)
+    np.testing.assert_array_equal(predict("auto", one_run), predict("gaussian", one_run))

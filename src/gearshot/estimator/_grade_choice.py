@@ -15,7 +15,7 @@ from sklearn.base import BaseEstimator
 from .._errors import GearshotError
 from . import steps
 from ._inputs import _FitInputs
-from ._simulated import residue_noise_spectrum
+from ._simulated import recorded_residue_spectrum, residue_noise_spectrum
 from ._target import _TargetSide, target_features
 from .calibration import resolve_calibration
 from .regressors import StepModel, fit_regressor
@@ -71,11 +71,11 @@ class _FitContext:
     def matched_noise(self, n_signals: int) -> FloatArray:
         """The residue noise of ``n_signals`` simulated signals (:func:`_matched_noise`)."""
         return _matched_noise(self.cache, self.target.residue_power, self.inputs.n_points,
-                              self.noise_seed, n_signals)
+                              self.noise_seed, n_signals, self.target.residues)
 
 
 def _matched_noise(cache: dict[str, Any], power: FloatArray, n_points: int, seed: int,
-                   n_signals: int) -> FloatArray:
+                   n_signals: int, recorded: FloatArray | None = None) -> FloatArray:
     """The residue noise of ``n_signals`` simulated signals (noise matching).
 
     Drawn from the ``match_noise`` step seed afresh for every set, so every grade and
@@ -84,19 +84,26 @@ def _matched_noise(cache: dict[str, Any], power: FloatArray, n_points: int, seed
     :func:`~gearshot.estimator.steps.residue_noise` computes from the same draw)."""
     key = f"noise/{n_signals}"
     if key not in cache:
-        spectrum = _matched_noise_spectrum(cache, power, n_points, seed, n_signals)
+        spectrum = _matched_noise_spectrum(cache, power, n_points, seed, n_signals,
+                                           recorded)
         cache[key] = np.asarray(np.fft.irfft(spectrum, n=n_points, axis=-1), np.float64)
     noise: FloatArray = cache[key]
     return noise
 
 
 def _matched_noise_spectrum(cache: dict[str, Any], power: FloatArray, n_points: int,
-                            seed: int, n_signals: int) -> NDArray[np.complex128]:
-    """The ``rfft`` of :func:`_matched_noise` (what the grade models add), kept in ``cache``."""
+                            seed: int, n_signals: int, recorded: FloatArray | None = None
+                            ) -> NDArray[np.complex128]:
+    """The ``rfft`` of :func:`_matched_noise` (what the grade models add), kept in ``cache``:
+    drawn from the ``recorded`` healthy differences when given
+    (:func:`~gearshot.estimator._simulated.recorded_residue_spectrum`), else Gaussian with
+    their mean ``power``."""
     key = f"noise_spectrum/{n_signals}"
     if key not in cache:
         rng = np.random.default_rng(np.random.RandomState(seed).randint(2**31 - 1))
-        cache[key] = residue_noise_spectrum(power, n_signals, n_points, rng)
+        cache[key] = (residue_noise_spectrum(power, n_signals, n_points, rng)
+                      if recorded is None else
+                      recorded_residue_spectrum(recorded, n_signals, rng))
     spectrum: NDArray[np.complex128] = cache[key]
     return spectrum
 
@@ -166,7 +173,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
                     None if twins is None else twins[grade],
                     None if twins is None else _matched_noise_spectrum(
                         cache, target.residue_power, inputs.n_points, noise_seed,
-                        sa.shape[0]), cache)
+                        sa.shape[0], target.residues), cache)
             return models[grade]
 
         def example_features() -> FloatArray:

@@ -79,6 +79,27 @@ def difference_features(sim_sa: FloatArray, reference: FloatArray, tf: ArrayLike
     return spectrum_features(spec, n, mesh_order, names=names)
 
 
+def recorded_residue_spectrum(differences: ArrayLike, n_signals: int,
+                              rng: np.random.Generator) -> ComplexArray:
+    """``rfft`` of ``n_signals`` residue signals drawn from the target's own healthy
+    difference signals (n, n_points): each a randomly chosen one, turned by a random whole
+    number of points around the cycle and given a random sign.
+
+    Each draw keeps the power spectrum of the difference it comes from, and so the spread
+    of levels between runs that a Gaussian draw with their mean power
+    (:func:`residue_noise_spectrum`) averages away; the turn puts it anywhere relative to
+    the simulated fault.
+    """
+    d = np.atleast_2d(np.asarray(differences, dtype=float))
+    n_points = d.shape[-1]
+    pick = rng.integers(0, d.shape[0], n_signals)
+    turn = rng.integers(0, n_points, n_signals)
+    sign = rng.choice(np.array([-1.0, 1.0]), n_signals)
+    k = np.arange(n_points // 2 + 1)
+    spec = np.fft.rfft(d, axis=-1)[pick] * np.exp(-2j * np.pi * np.outer(turn, k) / n_points)
+    return np.asarray(spec * sign[:, None], dtype=np.complex128)
+
+
 def residue_noise_spectrum(power: ArrayLike, n_signals: int, n_points: int,
                            rng: np.random.Generator) -> ComplexArray:
     """``rfft`` of Gaussian noise signals whose expected power spectrum is ``power``: white

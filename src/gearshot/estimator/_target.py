@@ -59,6 +59,7 @@ class _TargetSide:
     residue_ms: float
     weights: FloatArray | None = None          # residue whitening of the differences
     simulated_tf: ComplexArray | None = None   # what the simulated side goes through
+    residues: FloatArray | None = None         # the matched noise's draws, when recorded
 
 
 def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
@@ -71,7 +72,9 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
     ``matched``: the simulated side subtracts twins and adds the target's residue. The
     residue whitening needs it (without it the weighted residue has no counterpart) and
     healthy recordings of ``MIN_RUNS`` runs or more (weights learned within one run
-    meet another run's residue where that run was quiet).
+    meet another run's residue where that run was quiet). The residue added is drawn from
+    the healthy differences themselves when ``residue_draws`` says so (``"auto"``: when
+    the fit whitens), else Gaussian with their mean power.
     """
     tf = target_tf(est, inputs.healthy_long, inputs.n_points)
     scale = steps.rms_scale(inputs.target_healthy, name="target_healthy")
@@ -96,9 +99,12 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
     feats_h, mean_h = steps.centred_features(sub_w, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))
+    draws = est._options().residue_draws
+    recorded = matched and (draws == "recorded" or (draws == "auto" and weights is not None))
     return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
                        steps.residue_power(sub_w),
-                       residue_mean_square(sub_h, est._mesh_orders()), weights, sim_tf)
+                       residue_mean_square(sub_h, est._mesh_orders()), weights, sim_tf,
+                       sub_w if recorded else None)
 
 
 def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,

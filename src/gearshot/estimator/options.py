@@ -79,6 +79,13 @@ class EstimatorOptions:
         the target's healthy residue (:mod:`gearshot.estimator.whitening`). "auto": on,
         except for the paper's estimator (``estimator="paper"``), which keeps its literal
         pipeline. Chosen on the rig family's development range (RESULTS, "Estimator").
+    residue_draws : {"auto", "recorded", "gaussian"}, default "auto"
+        What the grade models add to each simulated difference as the target's residue
+        (with twins): one of the target's own healthy difference signals, turned by a
+        random number of points and given a random sign ("recorded": the spread of levels
+        between runs kept), or Gaussian noise with their mean power spectrum
+        ("gaussian"). "auto": recorded when the fit whitens, else Gaussian. Chosen on the
+        rig family's development range (RESULTS, "Estimator").
 
     Examples
     --------
@@ -102,6 +109,7 @@ class EstimatorOptions:
     n_neighbors: Iterable[int] = range(1, 101)
     validation_fraction: float = 0.3
     residue_whitening: str = "auto"
+    residue_draws: str = "auto"
 
     def __post_init__(self) -> None:
         validate_params({f.name: getattr(self, f.name) for f in fields(self)},
@@ -124,6 +132,7 @@ OPTION_CONSTRAINTS: dict[str, list[Constraint]] = {
     "n_neighbors": [IntegerSequence(1, None)],
     "validation_fraction": [Interval(float, 0, 1, closed="neither")],
     "residue_whitening": [Options(("auto", "on", "off"))],
+    "residue_draws": [Options(("auto", "recorded", "gaussian"))],
 }
 
 
