@@ -111,18 +111,25 @@ def _band_runs(n_runs: int, per_run: int, *, seed: int, fault: float = 0.0) -> n
     return np.array(out)
 
 
+def _band_fit(scenario, options, runs=None):
+    """The estimator fitted on a :func:`_scenario`'s runs (labelled by run unless ``runs``
+    relabels them) with ``options``."""
+    held_out, db, fit_runs, labels, long, example = scenario[:6]
+    est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                options=options)
+    return est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
+                   healthy_recordings=labels if runs is None else runs)
+
+
 def test_residue_whitening_reads_new_runs_of_a_band_limited_change_closer_to_truth():
     """The fit's 4 runs show where a new run's residue lies; weighting those orders down
     reads new healthy runs nearer 0 and new faulty ones nearer their size than the
     unweighted differences do. One run gives no weights (``MIN_RUNS``)."""
-    (held_out, db, fit_runs, labels, long, example, new_healthy,
-     new_faulty) = _scenario(_band_runs)
+    scenario = _scenario(_band_runs)
+    held_out, db, fit_runs, labels, long, example, new_healthy, new_faulty = scenario
 
-    def error(whitening, runs=labels):
-        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
-                                    options={"residue_whitening": whitening})
-        est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
-                healthy_recordings=runs)
+    def error(whitening, runs=None):
+        est = _band_fit(scenario, {"residue_whitening": whitening}, runs)
         return est, (np.abs(est.predict(new_healthy)).mean()
                      + np.abs(est.predict(new_faulty) - 0.5).mean())
 
@@ -163,15 +170,11 @@ def test_recorded_residue_draws_follow_the_whitening():
     """``residue_draws="auto"`` draws the matched residue from the fit's healthy
     differences when the fit whitens (several runs), and stays Gaussian when it does not
     (one run: the same estimates as ``"gaussian"``)."""
-    (held_out, db, fit_runs, labels, long, example, new_healthy,
-     new_faulty) = _scenario(_band_runs)
+    scenario = _scenario(_band_runs)
+    new = np.vstack(scenario[6:])
 
-    def predict(draws, runs=labels):
-        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
-                                    options={"residue_draws": draws})
-        est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
-                healthy_recordings=runs)
-        return est.predict(np.vstack([new_healthy, new_faulty]))
+    def predict(draws, runs=None):
+        return _band_fit(scenario, {"residue_draws": draws}, runs).predict(new)
 
     assert not np.allclose(predict("auto"), predict("gaussian"))
     one_run = np.zeros(24, int)
