@@ -86,16 +86,18 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         unscaled = steps.split_target_healthy(inputs.target_healthy)
         keep("unscaled references", (references, float(scale)), unscaled[1])
     upsample = est._options().upsample
-    if recordings is None:
-        sub_h = suppressed_target(train_h, references, upsample, unscaled)
-    else:
-        sub_h = cross_run(train_h, references, recordings, upsample, unscaled)
+
+    def step6(train: FloatArray, refs: FloatArray,
+              raw: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
+        if recordings is None:
+            return suppressed_target(train, refs, upsample, raw)
+        return cross_run(train, refs, recordings, upsample, raw)
+
+    sub_h = step6(train_h, references, unscaled)
     weights, sim_tf = fit_whitening(est, inputs, sub_h, scale, tf, recordings, matched)
     sub_w = sub_h
     if weights is not None:   # step 6 again on the filtered SAs (their own lags)
-        w_train, w_refs = (filter_orders(a, weights) for a in (train_h, references))
-        sub_w = (suppressed_target(w_train, w_refs, upsample) if recordings is None
-                 else cross_run(w_train, w_refs, recordings, upsample))
+        sub_w = step6(filter_orders(train_h, weights), filter_orders(references, weights))
     feats_h, mean_h = steps.centred_features(sub_w, mesh_order=est._mesh_orders(),
                                              names=names,
                                              healthy_mask=np.ones(len(sub_h), bool))

@@ -29,6 +29,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
+from .steps import residue_power
+
 __all__ = ["SMOOTH_ORDERS", "FLOOR", "MIN_RUNS", "residue_weights", "filter_orders",
            "two_sided"]
 
@@ -59,8 +61,7 @@ def residue_weights(differences: ArrayLike) -> FloatArray:
     >>> bool(w[20] < 0.1 * np.median(w)), round(float(np.sqrt(np.mean(w ** 2))), 6)
     (True, 1.0)
     """
-    d = np.atleast_2d(np.asarray(differences, dtype=float))
-    power = np.mean(np.abs(np.fft.rfft(d, axis=-1)) ** 2, axis=0)
+    power = residue_power(differences)
     tiny = np.finfo(float).tiny
     smooth = np.exp(uniform_filter1d(np.log(power + tiny), SMOOTH_ORDERS, mode="nearest"))
     smooth = np.maximum(smooth, FLOOR * float(np.median(smooth)) + tiny)
