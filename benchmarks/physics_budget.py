@@ -19,8 +19,10 @@ differ from the library's only in the physics of the simulated faults and gear p
 * ``--mode factors --setting S``: the rigs recorded again with parts of their hidden
   reality switched off (``SETTINGS``: "clean" none of noise, interference, ripple, drift,
   tacho jitter; "noise", "interference", "load", "jitter", "sripple" (the once-per-rev
-  speed ripple), "drift" (the slow speed drift), "speed" (both) each alone; their own
-  cache ``WORK/rigs_S``), estimated against the family database and against the rig's
+  speed ripple), "drift" (the slow speed drift), "speed" (both) each alone; the drift
+  beside one other part: "drift_noise", "drift_interf", "drift_jitter", "drift_load";
+  "all_but_load" everything but the load ripple; their own cache ``WORK/rigs_S``),
+  estimated against the family database and against the rig's
   own-physics database of ``--mode oracle`` (run it first, same ``--work``).
 
 The oracle and prior modes replace, for the build only, the fault objects the database
@@ -134,7 +136,13 @@ _OFF = dict(snr_db=200.0, motor_level=0.0, extra_level=0.0, impact_level=0.0,
 _KEEP = {"clean": (), "noise": ("snr_db",),
          "interference": ("motor_level", "extra_level", "impact_level"),
          "load": ("load_ripple",), "jitter": ("tacho_jitter",), "sripple": ("speed_ripple",),
-         "drift": ("speed_drift",), "speed": ("speed_drift", "speed_ripple")}
+         "drift": ("speed_drift",), "speed": ("speed_drift", "speed_ripple"),
+         "drift_noise": ("speed_drift", "snr_db"),
+         "drift_interf": ("speed_drift", "motor_level", "extra_level", "impact_level"),
+         "drift_jitter": ("speed_drift", "tacho_jitter"),
+         "drift_load": ("speed_drift", "load_ripple"),
+         "all_but_load": ("speed_drift", "speed_ripple", "snr_db", "motor_level",
+                          "extra_level", "impact_level", "tacho_jitter")}
 SETTINGS = {name: {k: v for k, v in _OFF.items() if k not in keep}
             for name, keep in _KEEP.items()}
 
