@@ -179,3 +179,35 @@ def test_recorded_residue_draws_follow_the_whitening():
     assert not np.allclose(predict("auto"), predict("gaussian"))
     one_run = np.zeros(24, int)
     np.testing.assert_array_equal(predict("auto", one_run), predict("gaussian", one_run))
+
+
+def test_auto_model_discrepancy_follows_the_whitening():
+    """``model_discrepancy="auto"`` widens a whitened one-fault-shot fit's intervals by
+    ``WHITENED_DISCREPANCY`` and any other fit's by ``MODEL_DISCREPANCY``: the intervals
+    are those of the number set by hand, and the smaller one is narrower."""
+    from types import SimpleNamespace
+
+    from gearshot.estimator.uncertainty import (
+        MODEL_DISCREPANCY,
+        WHITENED_DISCREPANCY,
+        fit_discrepancy,
+    )
+
+    assert WHITENED_DISCREPANCY < MODEL_DISCREPANCY
+    scenario = _scenario(_band_runs)
+    new = np.vstack(scenario[6:])
+    whitened = _band_fit(scenario, None)
+    assert whitened.model_discrepancy == "auto"
+    assert fit_discrepancy(whitened) == WHITENED_DISCREPANCY
+    auto = whitened.predict_interval(new)
+    whitened.model_discrepancy = WHITENED_DISCREPANCY
+    np.testing.assert_array_equal(auto, whitened.predict_interval(new))
+    whitened.model_discrepancy = MODEL_DISCREPANCY
+    low, high = whitened.predict_interval(new)
+    assert np.mean(high - low) > np.mean(auto[1] - auto[0]) + 0.01
+    one_run = _band_fit(scenario, None, np.zeros(24, int))   # no whitening
+    assert fit_discrepancy(one_run) == MODEL_DISCREPANCY
+    zero_shot = SimpleNamespace(model_discrepancy="auto", grade_strategy_="zero_shot",
+                                residue_weights_=whitened.residue_weights_)
+    assert fit_discrepancy(zero_shot) == MODEL_DISCREPANCY
+    assert fit_discrepancy(SimpleNamespace(model_discrepancy=0.3)) == 0.3

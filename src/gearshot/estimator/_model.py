@@ -136,17 +136,17 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     fault_type : str, optional
         Fault type whose database slice trains the model (``fault_type`` coordinate of
         :func:`gearshot.sim.load_database`); ``None``: the database's only type.
-    model_discrepancy : float >= 0, default 0.12
+    model_discrepancy : "auto" or float >= 0, default "auto"
         Standard deviation (fault-size units) of the simulation-to-reality error that
-        :meth:`predict_interval` adds to the simulated validation residuals. Conformal
-        residuals come from the simulated domain and cannot show the bias that one
-        example leaves after tuning. 0.12 was chosen on the development range of the
-        rig family (issue #12, benchmarks/RESULTS.md) for the configuration of record
-        (paired database, twin reference): the value whose 90 % intervals cover
-        85–95 % of the test sizes pooled with every condition ≥ 80 % (92.8 % pooled,
-        88.9 % at the worst condition). With an unpaired database (the paper's first
-        healthy reference) the same range picks 0.14. 0 gives pure split-conformal
-        intervals. There is no upper bound (intervals are clipped to [0, 1]).
+        :meth:`predict_interval` adds to the simulated validation residuals of a fit
+        without hold-outs (they cannot show the bias one example leaves after tuning).
+        "auto": :data:`~gearshot.estimator.uncertainty.WHITENED_DISCREPANCY` (0.09) for
+        a one-fault-shot fit that whitens its residue, else
+        :data:`~gearshot.estimator.uncertainty.MODEL_DISCREPANCY` (0.12); both chosen on
+        the rig family's development range as the smallest whose 90 % intervals cover
+        85–95 % of the test sizes pooled and ≥ 85 % (0.12: 80 %) in every condition
+        (benchmarks/RESULTS.md). 0 gives pure split-conformal intervals; no upper
+        bound (intervals are clipped to [0, 1]).
     estimator : {"boosting", "paper", "isotonic"}, default "boosting"
         Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): boosted
         trees (10.96 % against the paper's KNN's 11.31 % on the development rigs), the
@@ -230,7 +230,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         "rms_normalization": [Boolean()],
         "mesh_order": [NoneValue(), Interval(int, 1, None), IntegerSequence(1, None)],
         "fault_type": [NoneValue(), Options(tuple(FAULT_TYPE_NAMES))],
-        "model_discrepancy": [Interval(float, 0, None)],
+        "model_discrepancy": [Options(("auto",)), Interval(float, 0, None)],
         "estimator": [Options(ESTIMATORS)],
         "random_state": [RandomStateValue()],
         "options": [NoneValue(), Resolvable(
@@ -244,7 +244,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
                  transfer_function: str | ArrayLike | Any = "estimate",
                  rms_normalization: bool = True,
                  mesh_order: int | Sequence[int] | None = None,
-                 fault_type: str | None = None, model_discrepancy: float = 0.12,
+                 fault_type: str | None = None, model_discrepancy: float | str = "auto",
                  estimator: str = "boosting", random_state: Any = None,
                  options: EstimatorOptions | Mapping[str, Any] | None = None) -> None:
         self.features = features

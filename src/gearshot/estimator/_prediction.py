@@ -16,7 +16,7 @@ from .comparability import Comparability, ComparabilityReference
 from .detection import reach_zero_below_limit
 from .fit_check import TRUST_COLUMNS, FitCheck, recording_majority, trusted_column
 from .trusted import comparable_at_speed
-from .uncertainty import conformal_quantile, holdout_interval, mixture_interval
+from .uncertainty import conformal_quantile, fit_discrepancy, holdout_interval, mixture_interval
 
 FloatArray = NDArray[np.float64]
 
@@ -199,8 +199,10 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
 
         Each grade model says ``y = ŷ_g ± r + δ``: ``r`` from its validation residuals
         (split conformal), ``δ ~ N(0, model_discrepancy²)`` the simulation-to-reality
-        error the validation split cannot show. With soft grade weighting the interval
-        is the central ``coverage`` range of the weighted mixture over the grade models
+        error the validation split cannot show (``"auto"``:
+        :func:`~gearshot.estimator.uncertainty.fit_discrepancy`). With soft grade
+        weighting the interval is the central ``coverage`` range of the weighted mixture
+        over the grade models
         (:func:`~gearshot.estimator.mixture_interval`); with one model and
         ``model_discrepancy=0`` it is the plain split-conformal interval.
 
@@ -232,7 +234,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             low = reach_zero_below_limit(self, pred, low, coverage)
             return np.clip(low, 0, 1), np.clip(high, 0, 1)
         X = self.features_of(sa)
-        discrepancy = float(self.model_discrepancy)
+        discrepancy = fit_discrepancy(self)
         settings, models = self.calibration_["settings"], self.setting_models_
         per_model = [m.predict(X) for m in models]
         if len(models) == 1 and discrepancy == 0:
