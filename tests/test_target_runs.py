@@ -6,8 +6,10 @@ new recording's are. Analytic SAs: one gear, each run off by its own synchronous
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from estimator_data import N, paired_synthetic_database, synthetic_sa, tf_pair
 
+from gearshot._errors import NotFittedError
 from gearshot.estimator import OneFaultShotEstimator
 from gearshot.estimator._target import cross_run
 from gearshot.signal.alignment import subtract_healthy
@@ -198,7 +200,7 @@ def test_auto_model_discrepancy_follows_the_whitening():
     new = np.vstack(scenario[6:])
     whitened = _band_fit(scenario, None)
     assert whitened.model_discrepancy == "auto"
-    assert fit_discrepancy(whitened) == WHITENED_DISCREPANCY
+    assert fit_discrepancy(whitened) == WHITENED_DISCREPANCY == whitened.model_discrepancy_
     auto = whitened.predict_interval(new)
     whitened.model_discrepancy = WHITENED_DISCREPANCY
     np.testing.assert_array_equal(auto, whitened.predict_interval(new))
@@ -206,7 +208,9 @@ def test_auto_model_discrepancy_follows_the_whitening():
     low, high = whitened.predict_interval(new)
     assert np.mean(high - low) > np.mean(auto[1] - auto[0]) + 0.01
     one_run = _band_fit(scenario, None, np.zeros(24, int))   # no whitening
-    assert fit_discrepancy(one_run) == MODEL_DISCREPANCY
+    assert fit_discrepancy(one_run) == MODEL_DISCREPANCY == one_run.model_discrepancy_
+    with pytest.raises(NotFittedError, match="model_discrepancy_"):
+        _ = OneFaultShotEstimator().model_discrepancy_
     zero_shot = SimpleNamespace(model_discrepancy="auto", grade_strategy_="zero_shot",
                                 residue_weights_=whitened.residue_weights_)
     assert fit_discrepancy(zero_shot) == MODEL_DISCREPANCY

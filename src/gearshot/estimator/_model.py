@@ -141,7 +141,7 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         :meth:`predict_interval` adds to the simulated validation residuals of a fit
         without hold-outs (they cannot show the bias one example leaves after tuning).
         "auto": :data:`~gearshot.estimator.uncertainty.WHITENED_DISCREPANCY` (0.09) for
-        a one-fault-shot fit that whitens its residue, else
+        a one-fault-shot fit that whitens its residue (``model_discrepancy_``), else
         :data:`~gearshot.estimator.uncertainty.MODEL_DISCREPANCY` (0.12); both chosen on
         the rig family's development range as the smallest whose 90 % intervals cover
         85–95 % of the test sizes pooled and ≥ 85 % (0.12: 80 %) in every condition

@@ -43,6 +43,13 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             raise NotFittedError(f"This {type(self).__name__} is not fitted yet; call fit "
                                  f"before {method}")
 
+    @property
+    def model_discrepancy_(self) -> float:
+        """The ``model_discrepancy`` this fit's intervals use (``"auto"`` resolved by
+        :func:`~gearshot.estimator.uncertainty.fit_discrepancy`)."""
+        self._check_fitted("model_discrepancy_")
+        return fit_discrepancy(self)
+
     def features_of(self, sa: ArrayLike) -> FloatArray:
         """Selected, centred target features of SAs (what the KNN sees, before scaling).
 
