@@ -344,6 +344,26 @@ def test_a_wrong_declared_size_fails_the_fit_and_nothing_is_trusted(spur_db):
     assert frame.attrs["detection_limit"] > 0.3
 
 
+def test_a_healthy_record_declared_faulty_does_not_stand_out_and_fails_the_fit(spur_db):
+    """The healthy gear's own run 2 given as the 0.5 example (30 Hz High): in no selected
+    feature does it rise above the healthy segments' 95th percentile, so it cannot fix
+    the scale; the verdict says so and nothing is trusted. The chipped gear's record
+    stands out (the passing fit above)."""
+    frame = _predict(spur_db, "spur3_30hz_High_1.zip", "spur3_30hz_High_2.zip", 0.5)
+    verdict = frame.attrs["fit_check"]["verdict"]
+    assert "the example does not stand out from the healthy segments (contrast -" in verdict
+    assert not frame["trusted"].any()
+
+
+def test_example_contrast_fails_a_fit_only_below_zero_and_only_with_an_example():
+    ok = check_fit([0.02, 0.05], [0.5, 0.48], 0.5, example_contrast=0.3)
+    assert ok.verdict == "passed"
+    low = check_fit([0.02, 0.05], [0.5, 0.48], 0.5, example_contrast=-0.4)
+    assert low.verdict == ("the example does not stand out from the healthy segments "
+                           "(contrast -0.40 < 0): it cannot fix the estimates' scale")
+    assert check_fit([0.02, 0.05], None, None, example_contrast=-0.4).verdict == "passed"
+
+
 def test_a_fit_that_cannot_reproduce_its_example_says_so_first(spur_db):
     """40 Hz High on the input sensor: the example itself reads 0.19 against the declared
     0.5 (no grade reproduces it) and its record's other segments 0.24; the first cause

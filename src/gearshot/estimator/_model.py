@@ -63,7 +63,7 @@ from ._prediction import _Prediction
 from ._target import fit_target_side
 from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
 from .comparability import fit_comparability
-from .detection import detection_limit, holdout_detection
+from .detection import detection_limit, example_contrast, holdout_detection
 from .drift import fit_drift
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
@@ -347,7 +347,8 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         self.healthy_drift_ = fit_drift(target_healthy, holdouts.healthy, healthy_recordings)
         self.fit_check_ = check_holdouts(self.predict, holdouts, len(self.references_) + len(
             self.target_healthy_features_), self.faulty_size_, faulty_example,  # + the example
-            drift=self.healthy_drift_, detection_limit=self.__dict__["detection_limit_"])
+            drift=self.healthy_drift_, detection_limit=self.__dict__["detection_limit_"],
+            example_contrast=example_contrast(self, faulty_example))
         if (limit := holdout_detection(self.fit_check_)) is not None:   # a passed check
             self.detection_limit_ = self.detection_threshold_ = limit  # from the hold-outs
         return self

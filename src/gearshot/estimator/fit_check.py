@@ -261,7 +261,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
               example_limit: float = EXAMPLE_LIMIT,
               min_holdouts: int = MIN_HOLDOUTS,
               example_self: float | None = None, drift: str | None = None,
-              detection_limit: float | None = None) -> FitCheck:
+              detection_limit: float | None = None,
+              example_contrast: float | None = None) -> FitCheck:
     """The verdict of a fit from its hold-outs' estimates.
 
     Parameters
@@ -290,6 +291,9 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         The fit's simulated detection limit: healthy hold-outs that fail yet read below
         it are said to lie where this machine's signal does not tell a healthy gear from
         a smaller fault.
+    example_contrast : float, optional
+        How far the example stands out from the fit's healthy segments
+        (:func:`~gearshot.estimator.detection.example_contrast`): below 0 fails the fit.
 
     Returns
     -------
@@ -327,6 +331,9 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         failed.append(f"the example itself reads {own:.2f} against the declared "
                       f"{declared_size:g} (limit ± {example_limit:g}): no simulated grade "
                       f"reproduces it")
+    if example_contrast is not None and declared_size is not None and example_contrast < 0:
+        failed.append(f"the example does not stand out from the healthy segments (contrast "
+                      f"{example_contrast:.2f} < 0): it cannot fix the estimates' scale")
     if h_mean is not None and h_mean > healthy_limit:
         unresolved = "" if detection_limit is None or h_mean >= detection_limit else (
             f", below the fit's detection limit {detection_limit:.2f}: this machine's "
@@ -354,7 +361,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                    holdouts: Holdouts, n_fit: int, declared_size: float | None,
                    example: ArrayLike | None = None, *, drift: Drift | None = None,
-                   detection_limit: float | None = None) -> FitCheck:
+                   detection_limit: float | None = None,
+                   example_contrast: float | None = None) -> FitCheck:
     """The fit check of a fitted estimator: its hold-outs read by ``predict``.
 
     Parameters
@@ -372,8 +380,8 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     drift : Drift, optional
         The healthy baseline's drift test (:func:`~gearshot.estimator.drift.fit_drift`):
         a drifting one fails the fit.
-    detection_limit : float, optional
-        The fit's simulated detection limit (:func:`check_fit`).
+    detection_limit, example_contrast : float, optional
+        The fit's simulated detection limit and its example's contrast (:func:`check_fit`).
     """
     def read(sa: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
         return None if sa is None or not len(sa) else predict(sa)
@@ -389,4 +397,4 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     return check_fit(read(holdouts.healthy), read(holdouts.example), declared_size,
                      healthy_note=note, example_self=None if own is None else own[0],
                      drift=None if drift is None else drift.reason(),
-                     detection_limit=detection_limit)
+                     detection_limit=detection_limit, example_contrast=example_contrast)
