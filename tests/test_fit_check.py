@@ -364,6 +364,26 @@ def test_example_contrast_fails_a_fit_only_below_zero_and_only_with_an_example()
     assert check_fit([0.02, 0.05], None, None, example_contrast=-0.4).verdict == "passed"
 
 
+def test_example_contrast_is_the_largest_standardised_excess_over_the_healthy_rows():
+    from types import SimpleNamespace
+
+    from gearshot.estimator.detection import MIN_CONTRAST_ROWS, example_contrast
+
+    healthy = np.column_stack([np.arange(20.0), np.zeros(20), 10 * np.arange(20.0)])
+    est = SimpleNamespace(candidate_features_=("a", "b", "c"), selected_features_=("c", "a"),
+                          target_healthy_features_=healthy,
+                          features_of=lambda sa: np.asarray(sa)[:, :2])
+    q_c, q_a = np.quantile(healthy[:, 2], 0.95), np.quantile(healthy[:, 0], 0.95)
+    s_c, s_a = healthy[:, 2].std(), healthy[:, 0].std()
+    # c stands out by 1 of its spreads, a by 3 of its own: the larger counts
+    x = [q_c + s_c, q_a + 3 * s_a]
+    assert example_contrast(est, x) == pytest.approx(3.0)
+    assert example_contrast(est, [q_c - s_c, q_a - 2 * s_a]) == pytest.approx(-1.0)
+    assert example_contrast(est, None) is None
+    est.target_healthy_features_ = healthy[:MIN_CONTRAST_ROWS - 1]
+    assert example_contrast(est, x) is None
+
+
 def test_a_fit_that_cannot_reproduce_its_example_says_so_first(spur_db):
     """40 Hz High on the input sensor: the example itself reads 0.19 against the declared
     0.5 (no grade reproduces it) and its record's other segments 0.24; the first cause

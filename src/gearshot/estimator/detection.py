@@ -48,13 +48,16 @@ from sklearn.isotonic import IsotonicRegression
 from .._errors import GearshotError, NotFittedError
 
 __all__ = ["DETECTION_CONFIDENCE", "DetectionLimit", "below_detection_limit",
-           "detection_limit", "example_contrast", "holdout_detection",
+           "detection_limit", "example_contrast", "holdout_detection", "MIN_CONTRAST_ROWS",
            "reach_zero_below_limit"]
 
 FloatArray = NDArray[np.float64]
 
 #: Share of healthy estimates below the threshold (the limit's stated confidence).
 DETECTION_CONFIDENCE = 0.95
+
+#: Fewest healthy training rows :func:`example_contrast` compares the example with.
+MIN_CONTRAST_ROWS = 5
 
 
 @dataclass(frozen=True)
@@ -242,14 +245,15 @@ def example_contrast(estimator: Any, example: ArrayLike | None,
     own scatter in every feature: the grade choice then fits a fault the signal does not
     show, and the scale of every estimate is unanchored (rig family, development rigs
     100–123: the 4 of 48 fits below 0 read 0.07–0.34 MAE against 0.07 for the rest;
-    benchmarks/RESULTS.md). None without an example (zero-shot).
+    benchmarks/RESULTS.md). None without an example (zero-shot) or with fewer than
+    :data:`MIN_CONTRAST_ROWS` healthy rows (no scatter to compare with).
     """
-    if example is None:
-        return None
-    x = estimator.features_of(np.asarray(example, dtype=float).reshape(1, -1))[0]
     names = list(estimator.candidate_features_)
     cols = [names.index(n) for n in estimator.selected_features_]
     healthy = np.asarray(estimator.target_healthy_features_, dtype=float)[:, cols]
+    if example is None or len(healthy) < MIN_CONTRAST_ROWS:
+        return None
+    x = estimator.features_of(np.asarray(example, dtype=float).reshape(1, -1))[0]
     q = np.quantile(healthy, confidence, axis=0)
     spread = np.maximum(healthy.std(axis=0), 1e-12)
     return float(np.max((x - q) / spread))
