@@ -33,6 +33,10 @@ smallest estimate whose hold-out-calibrated interval
 that an estimate is below the limit exactly when its interval reaches 0. (On the PHM09
 run-2 protocol the simulated limit, 0.46 at 30 Hz High, put 64 % of the chipped gear's
 run-2 segments below it while every one of them read above every healthy one.)
+
+The example itself must be told apart from healthy too: :func:`example_contrast` says
+how far it stands out from the fit's healthy segments, and below 0 the fit check fails
+(the example cannot fix the scale of the estimates).
 """
 
 from __future__ import annotations
