@@ -9,7 +9,7 @@ PHM09 spur (``../shared/data/phm09``, machine ``examples/machines/phm09_spur.tom
 monitored input shaft 32T, 10-revolution SAs of the input shaft, meshes 32 and 16). One fit
 per cell (speed x load) and sensor: healthy = spur3 run 1, its last quarter of segments held
 out; example = spur2 run 1's most typical segment
-(`gearshot.estimator.fit_check.typical_segment`, as `predict` takes it) at 0.5.
+(`gearshot.estimator.example.typical_segment`, as `predict` takes it) at 0.5.
 
 * same machine (must stay comparable): spur3 run 1 hold-outs, spur2 run 1's other segments,
   spur3 and spur2 run 2 (``*_2.zip``);
@@ -61,7 +61,7 @@ import pandas as pd
 from gearshot import Machine
 from gearshot.app.conditions import fit_path_check, fit_speed_check
 from gearshot.estimator.comparability import fit_comparability
-from gearshot.estimator.fit_check import typical_segment
+from gearshot.estimator.example import typical_segment
 from gearshot.signal.path_pattern import path_pattern
 
 ROOT = Path(__file__).resolve().parents[1]

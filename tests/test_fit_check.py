@@ -362,12 +362,15 @@ def test_example_contrast_fails_a_fit_only_below_zero_and_only_with_an_example()
     assert low.verdict == ("the example does not stand out from the healthy segments "
                            "(contrast -0.40 < 0): it cannot fix the estimates' scale")
     assert check_fit([0.02, 0.05], None, None, example_contrast=-0.4).verdict == "passed"
+    # an example side failure (another sensor may show the fault), in the JSON too
+    assert low.example_failed and not ok.example_failed
+    assert low.as_dict()["example_contrast"] == -0.4 and ok.as_dict()["example_contrast"] == 0.3
 
 
 def test_example_contrast_is_the_largest_standardised_excess_over_the_healthy_rows():
     from types import SimpleNamespace
 
-    from gearshot.estimator.detection import MIN_CONTRAST_ROWS, example_contrast
+    from gearshot.estimator.example import MIN_CONTRAST_ROWS, example_contrast
 
     healthy = np.column_stack([np.arange(20.0), np.zeros(20), 10 * np.arange(20.0)])
     est = SimpleNamespace(candidate_features_=("a", "b", "c"), selected_features_=("c", "a"),
@@ -550,7 +553,7 @@ def test_predict_without_machine_holds_out_and_checks(tmp_path, duration, n_held
 def test_typical_segment_is_the_one_nearest_the_record_mean():
     """The example of a faulty record: not an odd first segment, but the segment the
     others agree with best."""
-    from gearshot.estimator.fit_check import typical_segment
+    from gearshot.estimator.example import typical_segment
 
     rng = np.random.default_rng(5)
     base = np.sin(2 * np.pi * 7 * np.arange(256) / 256)

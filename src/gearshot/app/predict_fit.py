@@ -129,7 +129,7 @@ def _segments(files, healthy, faulty, kw, holdout=0.0, reads=None):
     """SA segments of the targets; the healthy recordings' fitted segments (one array per
     recording; the first one's long angle-domain signal too, without its hold-outs); the
     faulty example (the faulty recording's most typical segment,
-    :func:`~gearshot.estimator.fit_check.typical_segment`) and its record's other segments;
+    :func:`~gearshot.estimator.example.typical_segment`) and its record's other segments;
     each healthy recording's hold-outs (its last ``floor(holdout · n)`` segments) as
     (path, SAs).
 
@@ -137,7 +137,8 @@ def _segments(files, healthy, faulty, kw, holdout=0.0, reads=None):
     segment (or unreadable) fails now, not after minutes of fitting; ``reads`` (a dict,
     optional) keeps each file's segments and checks for the next fit on the same files.
     """
-    from ..estimator.fit_check import holdout_count, typical_segment
+    from ..estimator.example import typical_segment
+    from ..estimator.fit_check import holdout_count
     from ..io import recording_segments
 
     health: dict = {}   # resolved path -> its input checks (gearshot.io.input_health)

@@ -12,7 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
-from ..estimator.fit_check import typical_segment
+from ..estimator.example import typical_segment
 from ..io.input_health import input_check_column, mark_rows, require_ok
 from ..machine.signal_check import verify_machine
 from .conditions import (
@@ -77,7 +77,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
         Healthy recordings.
     faulty : path
         The faulty recording; its segment ``example_segment`` is the one example (None:
-        its most typical, :func:`~gearshot.estimator.fit_check.typical_segment`).
+        its most typical, :func:`~gearshot.estimator.example.typical_segment`).
     faulty_size : float
         The example's declared size in (0, 1].
     recordings : sequence of path

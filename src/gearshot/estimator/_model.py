@@ -63,8 +63,9 @@ from ._prediction import _Prediction
 from ._target import fit_target_side
 from .calibration import CALIBRATION_STRATEGIES, CalibrationOptions, resolve_calibration
 from .comparability import fit_comparability
-from .detection import detection_limit, example_contrast, holdout_detection
+from .detection import detection_limit, holdout_detection
 from .drift import fit_drift
+from .example import example_contrast
 from .fit_check import check_holdouts, split_holdouts
 from .options import EstimatorOptions, resolve_options
 from .regressors import ESTIMATORS
@@ -143,10 +144,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         "auto": :data:`~gearshot.estimator.uncertainty.WHITENED_DISCREPANCY` (0.09) for
         a one-fault-shot fit that whitens its residue (``model_discrepancy_``), else
         :data:`~gearshot.estimator.uncertainty.MODEL_DISCREPANCY` (0.12); both chosen on
-        the rig family's development range as the smallest whose 90 % intervals cover
-        85–95 % of the test sizes pooled and ≥ 85 % (0.12: 80 %) in every condition
-        (benchmarks/RESULTS.md). 0 gives pure split-conformal intervals; no upper
-        bound (intervals are clipped to [0, 1]).
+        the rig family's development range (the smallest whose 90 % intervals cover 85–95 %
+        pooled, ≥ 85 % in every condition; 0.12: 80 %; benchmarks/RESULTS.md). 0 gives
+        pure split-conformal intervals; no upper bound (intervals are clipped to [0, 1]).
     estimator : {"boosting", "paper", "isotonic"}, default "boosting"
         Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): boosted
         trees (10.96 % against the paper's KNN's 11.31 % on the development rigs), the

@@ -34,9 +34,8 @@ that an estimate is below the limit exactly when its interval reaches 0. (On the
 run-2 protocol the simulated limit, 0.46 at 30 Hz High, put 64 % of the chipped gear's
 run-2 segments below it while every one of them read above every healthy one.)
 
-The example itself must be told apart from healthy too: :func:`example_contrast` says
-how far it stands out from the fit's healthy segments, and below 0 the fit check fails
-(the example cannot fix the scale of the estimates).
+The example itself must be told apart from healthy too
+(:func:`gearshot.estimator.example.example_contrast`: below 0 the fit check fails).
 """
 
 from __future__ import annotations
@@ -52,16 +51,12 @@ from sklearn.isotonic import IsotonicRegression
 from .._errors import GearshotError, NotFittedError
 
 __all__ = ["DETECTION_CONFIDENCE", "DetectionLimit", "below_detection_limit",
-           "detection_limit", "example_contrast", "holdout_detection", "MIN_CONTRAST_ROWS",
-           "reach_zero_below_limit"]
+           "detection_limit", "holdout_detection", "reach_zero_below_limit"]
 
 FloatArray = NDArray[np.float64]
 
 #: Share of healthy estimates below the threshold (the limit's stated confidence).
 DETECTION_CONFIDENCE = 0.95
-
-#: Fewest healthy training rows :func:`example_contrast` compares the example with.
-MIN_CONTRAST_ROWS = 5
 
 
 @dataclass(frozen=True)
@@ -236,28 +231,3 @@ def reach_zero_below_limit(estimator: Any, estimates: ArrayLike, low: ArrayLike,
         return bounds
     below = below_detection_limit(estimator, estimates)
     return np.asarray(np.where(below, 0.0, bounds), dtype=np.float64)
-
-
-def example_contrast(estimator: Any, example: ArrayLike | None,
-                     confidence: float = DETECTION_CONFIDENCE) -> float | None:
-    """How far the one faulty example stands out from the machine's own healthy segments.
-
-    In the fit's selected, centred features, the largest over the features of ``(x −
-    q) / s``: ``x`` the example's value, ``q`` the ``confidence`` quantile and ``s`` the
-    standard deviation of the fit's healthy training rows (differences across runs when
-    the fit knows its recordings). Below 0 the example lies inside the healthy segments'
-    own scatter in every feature: the grade choice then fits a fault the signal does not
-    show, and the scale of every estimate is unanchored (rig family, development rigs
-    100–123: the 4 of 48 fits below 0 read 0.07–0.34 MAE against 0.07 for the rest;
-    benchmarks/RESULTS.md). None without an example (zero-shot) or with fewer than
-    :data:`MIN_CONTRAST_ROWS` healthy rows (no scatter to compare with).
-    """
-    names = list(estimator.candidate_features_)
-    cols = [names.index(n) for n in estimator.selected_features_]
-    healthy = np.asarray(estimator.target_healthy_features_, dtype=float)[:, cols]
-    if example is None or len(healthy) < MIN_CONTRAST_ROWS:
-        return None
-    x = estimator.features_of(np.asarray(example, dtype=float).reshape(1, -1))[0]
-    q = np.quantile(healthy, confidence, axis=0)
-    spread = np.maximum(healthy.std(axis=0), 1e-12)
-    return float(np.max((x - q) / spread))

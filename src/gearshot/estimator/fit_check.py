@@ -95,6 +95,9 @@ class FitCheck:
     drift : str or None
         Why the healthy baseline is said to drift while recorded (a failed fit), or None
         (:mod:`~gearshot.estimator.drift`).
+    example_contrast : float or None
+        How far the example stands out from the fit's healthy segments (below 0 fails;
+        :func:`~gearshot.estimator.example.example_contrast`; None: not measured).
     """
 
     verdict: str
@@ -109,6 +112,7 @@ class FitCheck:
     example_limit: float = EXAMPLE_LIMIT
     example_self: float | None = None
     drift: str | None = None
+    example_contrast: float | None = None
 
     @property
     def passed(self) -> bool:
@@ -119,7 +123,8 @@ class FitCheck:
     def example_failed(self) -> bool:
         """Whether the verdict fails the fit on the example side: its record's other
         segments (enough to check) read more than ``example_limit`` from the declared
-        size, or the example itself does while they are too few or fail too."""
+        size, the example itself does while they are too few or fail too, or it does not
+        stand out from the healthy segments (``example_contrast`` below 0)."""
         size = self.declared_size
         if size is None:
             return False
@@ -128,7 +133,9 @@ class FitCheck:
         record_off = mean is not None and checked and abs(mean - size) > self.example_limit
         own = getattr(self, "example_self", None)
         own_off = own is not None and abs(own - size) > self.example_limit
-        return bool(record_off or (own_off and not checked))
+        contrast = getattr(self, "example_contrast", None)   # None in an older FitCheck
+        return bool(record_off or (own_off and not checked)
+                    or (contrast is not None and contrast < 0))
 
     @property
     def checked(self) -> bool:
@@ -164,14 +171,6 @@ def holdout_count(n_segments: int, holdout: float) -> int:
     holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
     return int(np.floor(holdout * int(n_segments)))
 
-
-def typical_segment(sa: ArrayLike) -> int:
-    """Index of the segment of one record nearest (Euclidean) to the record's mean SA: the
-    example a fit calibrates on. One segment carries its own noise into the calibration,
-    and the record's other segments check it; the record's most typical segment is the
-    one the others agree with best."""
-    arr = np.atleast_2d(np.asarray(sa, dtype=float))
-    return int(np.argmin(np.sum((arr - arr.mean(axis=0)) ** 2, axis=1)))
 
 
 @dataclass(frozen=True)
@@ -293,7 +292,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         a smaller fault.
     example_contrast : float, optional
         How far the example stands out from the fit's healthy segments
-        (:func:`~gearshot.estimator.detection.example_contrast`): below 0 fails the fit.
+        (:func:`~gearshot.estimator.example.example_contrast`): below 0 fails the fit.
 
     Returns
     -------
@@ -355,7 +354,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         verdict = PASSED
     return FitCheck(verdict, healthy, example, declared_size, h_mean, e_mean,
                     len(healthy), len(example), healthy_limit, example_limit, own,
-                    drift or None)
+                    drift or None, example_contrast)
 
 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],

@@ -111,7 +111,7 @@ def family_task(spec: dict) -> list[dict]:
 
 
 def _family_rows(spec: dict) -> list[dict]:
-    from ..estimator.detection import example_contrast
+    from ..estimator.example import example_contrast
     from ..sim import load_database
     from ..transfer import TransferFunctionBank
     from .rig import rig_dataset
