@@ -373,8 +373,7 @@ def test_example_contrast_is_the_largest_standardised_excess_over_the_healthy_ro
     from gearshot.estimator.example import MIN_CONTRAST_ROWS, example_contrast
 
     healthy = np.column_stack([np.arange(20.0), np.zeros(20), 10 * np.arange(20.0)])
-    est = SimpleNamespace(candidate_features_=("a", "b", "c"), selected_features_=("c", "a"),
-                          target_healthy_features_=healthy,
+    est = SimpleNamespace(selected_columns_=[2, 0], target_healthy_features_=healthy,
                           features_of=lambda sa: np.asarray(sa)[:, :2])
     q_c, q_a = np.quantile(healthy[:, 2], 0.95), np.quantile(healthy[:, 0], 0.95)
     s_c, s_a = healthy[:, 2].std(), healthy[:, 0].std()

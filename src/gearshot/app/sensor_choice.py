@@ -3,9 +3,9 @@
 The machine's first sensor, unless its fit cannot read its own example
 (:mod:`gearshot.estimator.fit_check`: the example record's other segments, or the example
 itself, far from the declared size, or an example that does not stand out from the
-healthy segments in this sensor's signal). Then the machine's other sensors are fitted in their
-order, and the first whose fit passes is used; when none passes, the first sensor's fit
-is kept (and every estimate of it stays untrusted). A fit that fails only because its
+healthy segments in this sensor's signal). Then the machine's other sensors are fitted in
+their order, and the first whose fit passes is used; when none passes, the first sensor's
+fit is kept (and every estimate of it stays untrusted). A fit that fails only because its
 healthy hold-outs read high (or is unchecked) is kept as it is: the healthy recordings
 vary more than the fit covers, a property of the recordings that another sensor shares
 (the README journey, spur1 + spur3 High healthy at 30 Hz: the input sensor's hold-outs

@@ -41,9 +41,8 @@ def example_contrast(estimator: Any, example: ArrayLike | None,
     benchmarks/RESULTS.md). None without an example (zero-shot) or with fewer than
     :data:`MIN_CONTRAST_ROWS` healthy rows (no scatter to compare with).
     """
-    names = list(estimator.candidate_features_)
-    cols = [names.index(n) for n in estimator.selected_features_]
-    healthy = np.asarray(estimator.target_healthy_features_, dtype=float)[:, cols]
+    healthy = np.asarray(estimator.target_healthy_features_,
+                         dtype=float)[:, estimator.selected_columns_]
     if example is None or len(healthy) < MIN_CONTRAST_ROWS:
         return None
     x = estimator.features_of(np.asarray(example, dtype=float).reshape(1, -1))[0]

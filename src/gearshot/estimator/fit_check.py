@@ -172,7 +172,6 @@ def holdout_count(n_segments: int, holdout: float) -> int:
     return int(np.floor(holdout * int(n_segments)))
 
 
-
 @dataclass(frozen=True)
 class Holdouts:
     """The SAs a fit keeps out to check itself.

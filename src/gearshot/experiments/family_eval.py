@@ -111,7 +111,6 @@ def family_task(spec: dict) -> list[dict]:
 
 
 def _family_rows(spec: dict) -> list[dict]:
-    from ..estimator.example import example_contrast
     from ..sim import load_database
     from ..transfer import TransferFunctionBank
     from .rig import rig_dataset
@@ -159,7 +158,7 @@ def _family_rows(spec: dict) -> list[dict]:
             row["fitted_grade"] = row.pop("grade")  # "grade" is the rig's true grade
             est = row.pop("estimator")
             row["fit_check"] = est.fit_check_.verdict
-            row["example_contrast"] = example_contrast(est, ds.faulty_example)
+            row["example_contrast"] = est.fit_check_.example_contrast
             row.update(_interval_sweep(est, ds.test_sa, ds.test_size))
             row.update(_detection_check(est, pred, ds.test_size))
             by_size = {f"{y:.2f}": float(np.mean(pred[ds.test_size == y]))
