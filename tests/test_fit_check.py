@@ -286,7 +286,8 @@ def test_a_sensor_whose_fit_refuses_itself_gives_way_to_one_whose_fit_passes(spu
 def test_another_sensor_is_tried_only_when_the_example_is_not_read(monkeypatch):
     """The sensor choice (gearshot.app.sensor_choice): a first sensor whose fit fails only
     on its healthy hold-outs is kept (the recordings' own spread, shared by every
-    sensor); one that cannot read its example gives way to the next that passes."""
+    sensor); one that cannot read its example gives way to the next that passes, or,
+    when none passes, to the next that reads its example."""
     from types import SimpleNamespace
 
     from gearshot.app.sensor_choice import fit_with_sensor_choice
@@ -318,6 +319,16 @@ def test_another_sensor_is_tried_only_when_the_example_is_not_read(monkeypatch):
     (est,), used, note = fit_with_sensor_choice(fit, machine, None)
     assert tried == names and used == names[1] and est.fit_check_ is passing
     assert note.startswith(f"sensor {names[1]}: the fit on {names[0]} did not pass")
+    # none passes: the one that reads its example (fails on its healthy side only) is
+    # used over a first sensor in whose signal the example does not stand out ...
+    fit, tried = fits({names[0]: example_off, names[1]: healthy_only})
+    (est,), used, note = fit_with_sensor_choice(fit, machine, None)
+    assert tried == names and used == names[1] and est.fit_check_ is healthy_only
+    assert note.startswith(f"sensor {names[1]}: the fit on {names[0]} did not pass")
+    # ... and when neither reads its example, the first is kept, without a note
+    fit, tried = fits({names[0]: example_off, names[1]: example_off})
+    (est,), used, note = fit_with_sensor_choice(fit, machine, None)
+    assert tried == names and used == names[0] and note == ""
 
 
 def test_a_segment_is_trusted_only_in_a_mostly_trusted_recording():

@@ -4,10 +4,13 @@ The machine's first sensor, unless its fit cannot read its own example
 (:mod:`gearshot.estimator.fit_check`: the example record's other segments, or the example
 itself, far from the declared size, or an example that does not stand out from the
 healthy segments in this sensor's signal). Then the machine's other sensors are fitted in
-their order, and the first whose fit passes is used; when none passes, the first sensor's
-fit is kept (and every estimate of it stays untrusted). A fit that fails only because its
-healthy hold-outs read high (or is unchecked) is kept as it is: the healthy recordings
-vary more than the fit covers, a property of the recordings that another sensor shares
+their order, and the first whose fit passes is used. When none passes, the first of them
+that reads its example (its fit fails only on its healthy hold-outs) is used, else the
+first sensor's fit is kept; either way every estimate stays untrusted, but a sensor in
+whose signal the fault stands out at least orders the segments by it. A first fit that
+fails only because its healthy hold-outs read high (or is unchecked) is kept as it is:
+the healthy recordings vary more than the fit covers, a property of the recordings that
+another sensor shares
 (the README journey, spur1 + spur3 High healthy at 30 Hz: the input sensor's hold-outs
 read 0.16 on average; the output sensor's pass at 0.115 only as the mean of spur1's 0.21
 and spur3's 0.03, and that fit then trusted the chipped gear's Low-load record, a load it
@@ -58,19 +61,28 @@ def fit_with_sensor_choice(fit: Callable[[str | None], Any], machine,
     """
     if sensor is not None or len(machine.sensors) < 2:
         return fit(sensor), machine.sensor(sensor).name, ""
-    first = None
+    kept = None
     refused: list[tuple[str, str]] = []
     for candidate in machine.sensors:
         result = fit(candidate.name)
         check = getattr(result[0], "fit_check_", None)
         if check is not None and check.passed:
-            note = "" if not refused else (
-                f"sensor {candidate.name}: the fit on " + "; on ".join(
-                    f"{name} did not pass its check ({verdict})" for name, verdict in refused))
-            return result, candidate.name, note
+            return result, candidate.name, _note(candidate.name, refused)
         refused.append((candidate.name, "unchecked" if check is None else check.verdict))
-        first = first or (result, candidate.name)
+        if kept is None:
+            kept = (result, candidate.name)
+        elif check is not None and not check.example_failed:
+            # none passes; this one reads its example, where the first did not
+            return result, candidate.name, _note(candidate.name, refused[:-1])
         if check is None or not check.example_failed:
             break   # healthy hold-outs read high (or too few): so would another sensor's
-    assert first is not None
-    return first[0], first[1], ""
+    assert kept is not None
+    return kept[0], kept[1], ""
+
+
+def _note(used: str, refused: list[tuple[str, str]]) -> str:
+    """Why ``used`` and not the sensors ``refused`` before it ("" when none was)."""
+    if not refused:
+        return ""
+    return f"sensor {used}: the fit on " + "; on ".join(
+        f"{name} did not pass its check ({verdict})" for name, verdict in refused)
