@@ -20,7 +20,8 @@ out; example = spur2 run 1's most typical segment
   and back), same load: the reference never sees the speed gate;
 * another build: spur1, same cell; another gearbox: helical1, helical2, helical5 read
   through the spur machine, same cell; another sensor: spur3 and spur2 run 1 on the other
-  accelerometer.
+  accelerometer; another gain: spur3 and spur2 run 2 multiplied by 2 and by 0.5 (a sensor
+  of another sensitivity; added with ``LEVEL_RUN_SPREAD``, after the split's first run).
 
 Virtual rigs (``gearshot.rig.VirtualRig(seed)``, pair 17/38, 50-cycle SAs of the gear
 revolution, mesh order 38) at 15 rps, 10 N m: healthy repetitions 0-4 (4 segments each), the
@@ -28,7 +29,8 @@ example is the most typical segment of the size-0.6 repetition 0. Same machine: 
 repetition 5, sizes 0.3 (repetitions 0, 1) and 0.6 (repetition 1), the example record's
 other segments. Flagged: another load (5 and 20 N m), another speed (20 rps), another path
 (its TF replaced by the next of its bank), another attenuation (+6 dB, -6 dB above 24 dB),
-another rig (seed + 1000), each healthy repetition 0 and size 0.6 repetition 0.
+another rig (seed + 1000), each healthy repetition 0 and size 0.6 repetition 0; another
+gain: healthy repetition 5 and sizes 0.3 and 0.6 (repetition 1) multiplied by 2 and 0.5.
 
 **Split, fixed before any held-out number was computed.** Development (the feature set, the
 standardisation, the fault line's weighting and the false-alarm rate were chosen on it):
@@ -68,6 +70,8 @@ ROOT = Path(__file__).resolve().parents[1]
 PARTS = {"dev": dict(speeds=(30,), rig_seeds=(701,)),
          "held-out": dict(speeds=(40,), rig_seeds=(702, 703))}
 SENSORS = ("acc_input", "acc_output")
+#: Sensor gains of the "another gain" records (the same run through another sensitivity).
+GAINS = (2.0, 0.5)
 EXPECT = {"same machine": "comparable"}
 
 
@@ -142,6 +146,9 @@ def phm_rows(phm: _Phm, speeds, size: float) -> list[dict]:
                 add("same machine", f"spur2_{sp}hz_{ld}_1 rest", np.delete(example, k, 0))
                 for case in ("spur3", "spur2"):
                     add("same machine", f"{case}_{sp}hz_{ld}_2", phm(f"{case}_{sp}hz_{ld}_2", se))
+                    for gain in GAINS:   # the same run through a sensor of another gain
+                        add("another gain", f"{case}_{sp}hz_{ld}_2 x{gain}",
+                            gain * phm(f"{case}_{sp}hz_{ld}_2", se))
                     for run in (1, 2):
                         add("another load", f"{case}_{sp}hz_{other_load}_{run}",
                             phm(f"{case}_{sp}hz_{other_load}_{run}", se))
@@ -204,6 +211,10 @@ def rig_rows(seed: int) -> list[dict]:
     add("same machine", "size 0.6 rep 0 rest", (np.delete(example, k, 0), example_path))
     for size, rep in ((0.3, 0), (0.3, 1), (0.6, 1)):
         add("same machine", f"size {size} rep {rep}", _rig_record(rig, size=size, rep=rep))
+    for size, rep in ((0.0, 5), (0.3, 1), (0.6, 1)):
+        sa, pattern = _rig_record(rig, size=size, rep=rep)
+        for gain in GAINS:
+            add("another gain", f"size {size} rep {rep} x{gain}", (gain * sa, pattern))
     atten = truth.attenuation_db + (6.0 if truth.attenuation_db <= 24 else -6.0)
     others = {
         ("another load", "5 N m"): (rig, dict(load=5.0)),

@@ -94,6 +94,41 @@ def test_run_2_of_the_same_machine_is_comparable(phm):
         assert res.record_comparable and res.comparable.mean() >= 0.9, name
 
 
+@pytest.mark.parametrize("sensor", ["acc_input", "acc_output"])
+def test_run_2_through_a_sensor_of_another_gain_is_flagged(phm, sensor):
+    """The estimate is not invariant to the level (step 5 divides by the fitted healthy
+    RMS: the healthy gear's run 2 reads 0.07 at 30 Hz High, 0.55 through a sensor of twice
+    the gain). A one-run fit cannot see how far the level moves between runs; with
+    LEVEL_RUN_SPREAD for it, the healthy gear's run 2 through a sensor of 2 or 0.5 times
+    the gain is flagged, as it is not without it (acc_input: 0 % flagged at x2)."""
+    ref = _reference(phm, sensor=sensor)
+    run2 = phm("spur3_30hz_High_2", sensor)
+    assert ref.evaluate(run2).comparable.mean() >= 0.9
+    for gain in (2.0, 0.5):
+        res = ref.evaluate(gain * run2)
+        assert (~res.comparable).mean() >= 0.9 and not res.record_comparable, gain
+    assert np.isfinite(ref.level_spread)
+
+
+def test_the_level_follows_the_shape_of_every_group_together():
+    """The level may move along the fault only as far as the signal's shape does, the
+    shape's step taken over every other group together: a group the fault barely moves
+    (a short direction) has a step of noise alone, which freed the level before."""
+    from gearshot.estimator.comparability_states import LEVEL_STEP_RATIO, _distance
+
+    masks = [np.array([True] + [False] * 6), np.array([False] + [True] * 5 + [False]),
+             np.array([False] * 6 + [True])]
+    direction = np.array([10.0, 5, 5, 5, 5, 5, 0.01])   # the last group: barely moved
+    anchors = np.zeros((1, 7))
+    louder = np.array([[5.0, 0, 0, 0, 0, 0, 0.5]])      # level alone, noise elsewhere
+    score, level = _distance(louder, anchors, direction, 2.0, masks)
+    assert level[0] > 4.9 and score[0] > 1.5
+    halfway = np.array([[5.0, 2.5, 2.5, 2.5, 2.5, 2.5, 0.0]])   # a smaller fault: on the line
+    score, level = _distance(halfway, anchors, direction, 2.0, masks)
+    assert level[0] < 1e-9 and score[0] < 0.5
+    assert LEVEL_STEP_RATIO == 2.0
+
+
 def test_another_speed_is_flagged_without_any_speed_gate(phm):
     """40 Hz records of the same gears against a 30 Hz fit: the SA cycle is the same, the
     transfer path's resonances sit at other orders and the level differs."""

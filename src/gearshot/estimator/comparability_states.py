@@ -30,8 +30,9 @@ MIN_STD = 1e-3
 #: development rig comparable).
 FAULT_SHAPE_UNCERTAINTY = 0.25
 
-#: Largest step of the level along the fault, in multiples of the largest step of the
-#: other groups: a fault that raises the level changes the signal's shape too (its
+#: Largest step of the level along the fault, in multiples of the step of the signal's
+#: shape (every other group's features projected together on their part of the fault
+#: direction): a fault that raises the level changes the signal's shape too (its
 #: sidebands, shaft orders, kurtosis), while another gain or a louder path moves the level
 #: alone. Chosen on the development part of the matrix and the development lives.
 LEVEL_STEP_RATIO = 2.0
@@ -59,18 +60,26 @@ def _distance(z: FloatArray, anchors: FloatArray, direction: FloatArray,
               ) -> tuple[FloatArray, FloatArray]:
     """Distance of standardised rows ``z`` from the nearest state ``anchor + t_g v_g``
     (the first mask is the level's: its step at most :data:`LEVEL_STEP_RATIO` times the
-    largest step of the other groups), and the level's residual at that state in its
-    standard deviations."""
+    step of the other groups taken together), and the level's residual at that state in
+    its standard deviations.
+
+    The other groups are taken together, not by the farthest-moved one: a group that the
+    fault barely moves has a short direction, so its step is set by noise alone and may be
+    anything up to ``max_step`` at no cost; it freed the level of every segment, and a
+    healthy record through a sensor of twice the gain passed as a fault state."""
     offset = z[:, None, :] - anchors[None, :, :]        # (m, n_anchors, d)
     total = np.zeros(offset.shape[:2])
-    steps = []
-    for mask in masks:
+
+    def step(mask: NDArray[np.bool_]) -> FloatArray:
         v = direction[mask]
         vv = float(v @ v)
-        steps.append(np.clip(offset[..., mask] @ v / vv, 0.0, max_step) if vv > 0
-                     else np.zeros(total.shape))
-    if len(steps) > 1:
-        steps[0] = np.minimum(steps[0], LEVEL_STEP_RATIO * np.max(steps[1:], axis=0))
+        return (np.clip(offset[..., mask] @ v / vv, 0.0, max_step) if vv > 0
+                else np.zeros(total.shape))
+
+    steps = [step(mask) for mask in masks]
+    if len(steps) > 1:   # the shape's step: every other group at once
+        shape = np.logical_or.reduce(masks[1:])
+        steps[0] = np.minimum(steps[0], LEVEL_STEP_RATIO * step(shape))
     level = np.zeros(total.shape)
     for i, (mask, t) in enumerate(zip(masks, steps, strict=True)):
         v = direction[mask]
