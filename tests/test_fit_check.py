@@ -283,6 +283,37 @@ def test_a_sensor_whose_fit_refuses_itself_gives_way_to_one_whose_fit_passes(spu
     assert kept.attrs["sensor"] == "acc_input" and kept.attrs["sensor_note"] == ""
 
 
+def test_a_drifting_fit_keeps_its_drift_and_widens_its_intervals(spur_db):
+    """40 Hz Low: the healthy record drifts while recorded, the fit refuses itself and
+    keeps the drift's ratio; its intervals use the wider run spread (every healthy run-2
+    segment's holds 0, every chipped one's the declared 0.5)."""
+    from gearshot.app.predict_machine import predict_from_machine
+    from gearshot.estimator.fit_check import FitCheck
+    from gearshot.estimator.uncertainty import RUN_SPREAD, holdout_interval
+
+    frame = predict_from_machine(
+        Machine.from_toml(SPUR), spur_db, [_record("spur3_40hz_Low_1.zip")],
+        _record("spur2_40hz_Low_1.zip"), 0.5,
+        [_record("spur3_40hz_Low_2.zip"), _record("spur2_40hz_Low_2.zip")],
+        speed=40.0, load=10.0, cycles_per_segment=10, seed=0, sensor="acc_input")
+    check = frame.attrs["fit_check"]
+    assert check["drift"] and check["drift"].startswith("the healthy recording drifts")
+    assert check["drift_ratio"] > 1.5 and not frame["trusted"].any()
+    spread = FitCheck(**{k: v for k, v in check.items() if k != "passed"}).run_spread
+    assert spread == pytest.approx(RUN_SPREAD * np.sqrt(check["drift_ratio"]))
+    run2 = frame[frame["recording"].str.endswith("_2.zip")]
+    healthy = run2[run2["recording"].str.contains("spur3")]
+    chipped = run2[run2["recording"].str.contains("spur2")]
+    assert ((healthy["low"] <= 0) & (0 <= healthy["high"])).all()
+    assert ((chipped["low"] <= 0.5) & (0.5 <= chipped["high"])).mean() >= 0.9
+    # the lows are those of the wider spread, never above the plain spread's
+    h_res = np.asarray(check["healthy_estimates"])
+    e_res = np.asarray(check["example_estimates"]) - 0.5
+    plain, _ = holdout_interval(run2["predicted"].to_numpy(), h_res, e_res, 0.9,
+                                example_size=0.5)
+    assert (run2["low"].to_numpy() <= np.clip(plain, 0, 1) + 1e-9).all()
+
+
 def test_another_sensor_is_tried_only_when_the_example_is_not_read(monkeypatch):
     """The sensor choice (gearshot.app.sensor_choice): a first sensor whose fit fails only
     on its healthy hold-outs is kept (the recordings' own spread, shared by every

@@ -108,3 +108,28 @@ def test_the_low_load_healthy_record_drifts_and_the_high_load_one_does_not():
     high = healthy_drift(_input_segments("spur3_30hz_High_1.zip"))
     assert low.drifting and low.ratio > 1.5
     assert not high.drifting and high.p_value > 0.5 and high.ratio < 1.1
+
+
+def test_a_drifting_baseline_widens_a_new_runs_spread():
+    """A later run moves farther than a drifting baseline's hold-outs show: the interval's
+    run spread grows with the drift's amplitude (the square root of its energy ratio),
+    and so does the reading up to which a healthy segment's interval holds 0."""
+    from gearshot.estimator.uncertainty import RUN_SPREAD, holdout_interval
+
+    drift = healthy_drift(_segments(11, 0.05))
+    assert drift.drifting and drift.ratio > DRIFT_RATIO
+    check = check_fit([0.02, 0.05], [0.5, 0.48], 0.5, drift=drift.reason(),
+                      drift_ratio=drift.ratio)
+    assert check.drift_ratio == drift.ratio
+    assert check.run_spread == pytest.approx(RUN_SPREAD * np.sqrt(drift.ratio))
+    assert check.as_dict()["drift_ratio"] == drift.ratio
+    # no drift: the ratio is not kept and the spread is RUN_SPREAD
+    steady = check_fit([0.02, 0.05], [0.5, 0.48], 0.5, drift_ratio=3.0)
+    assert steady.drift_ratio is None and steady.run_spread == RUN_SPREAD
+    healthy, example = check.residuals()
+    grid = np.linspace(0.0, 0.6, 61)
+    plain, _ = holdout_interval(grid, healthy, example, 0.9, example_size=0.5)
+    wide, _ = holdout_interval(grid, healthy, example, 0.9, example_size=0.5,
+                               run_spread=check.run_spread)
+    assert (wide <= plain + 1e-12).all()
+    assert grid[wide <= 0].max() > grid[plain <= 0].max() + 0.05

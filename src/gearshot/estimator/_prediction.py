@@ -198,8 +198,9 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
 
         A checked fit (``fit_check_`` with enough healthy hold-outs and segments of the
         example record, passed or failed) gives intervals calibrated on their real
-        residuals, widened by the run-to-run spread
-        (:func:`~gearshot.estimator.uncertainty.holdout_interval`): a healthy segment of
+        residuals, widened by the run-to-run spread (:attr:`FitCheck.run_spread
+        <gearshot.estimator.fit_check.FitCheck.run_spread>`, wider for a healthy baseline
+        that drifts; :func:`~gearshot.estimator.uncertainty.holdout_interval`): a healthy segment of
         the machine has 0 in its interval, the example record's segments the declared
         size, at ``coverage``. Without hold-outs (an unchecked fit) the intervals are
         the simulated ones below, which cannot show the simulation-to-reality bias.
@@ -237,6 +238,7 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
             healthy, example = check.residuals()
             pred = self.predict(sa)
             low, high = holdout_interval(pred, healthy, example, coverage,
+                                         run_spread=check.run_spread,
                                          example_size=check.declared_size)
             low = reach_zero_below_limit(self, pred, low, coverage)
             return np.clip(low, 0, 1), np.clip(high, 0, 1)

@@ -44,8 +44,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._errors import GearshotError
-from .._validation import as_signal_array, check_in_range
+from .._validation import check_in_range
 from .drift import Drift
+from .holdouts import Holdouts, holdout_count, split_holdouts
 from .trusted import (  # the trust columns of a predict table, re-exported here
     LABEL_CHECKS,
     MIN_TRUSTED_SHARE,
@@ -98,6 +99,10 @@ class FitCheck:
     example_contrast : float or None
         How far the example stands out from the fit's healthy segments (below 0 fails;
         :func:`~gearshot.estimator.example.example_contrast`; None: not measured).
+    drift_ratio : float or None
+        The drifting baseline's trend ratio (:attr:`~gearshot.estimator.drift.Drift.ratio`:
+        residual energy of segments far apart over neighbours'), None when it does not
+        drift; it widens the intervals (:attr:`run_spread`).
     """
 
     verdict: str
@@ -113,6 +118,21 @@ class FitCheck:
     example_self: float | None = None
     drift: str | None = None
     example_contrast: float | None = None
+    drift_ratio: float | None = None
+
+    @property
+    def run_spread(self) -> float:
+        """Standard deviation of a new run's change of a segment's estimate that the
+        hold-outs cannot show (:data:`~gearshot.estimator.uncertainty.RUN_SPREAD`). A
+        baseline that drifts while it is recorded moves farther than that: the spread
+        grows with the drift's amplitude, ``RUN_SPREAD · sqrt(drift_ratio)`` (the ratio is
+        one of residual energies), with no further parameter."""
+        from .uncertainty import RUN_SPREAD
+
+        ratio = self.drift_ratio
+        if ratio is None or not np.isfinite(ratio) or ratio <= 1:
+            return RUN_SPREAD
+        return RUN_SPREAD * float(np.sqrt(ratio))
 
     @property
     def passed(self) -> bool:
@@ -159,91 +179,6 @@ class FitCheck:
         return out
 
 
-def holdout_count(n_segments: int, holdout: float) -> int:
-    """Hold-outs of a recording of ``n_segments`` segments: ``floor(holdout · n)`` (the
-    last ones), so that at least one segment stays for the fit whenever ``holdout < 1``.
-
-    Raises
-    ------
-    GearshotError
-        When ``holdout`` is outside [0, 1).
-    """
-    holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
-    return int(np.floor(holdout * int(n_segments)))
-
-
-@dataclass(frozen=True)
-class Holdouts:
-    """The SAs a fit keeps out to check itself.
-
-    Attributes
-    ----------
-    healthy : ndarray (n, n_points) or None
-    example : ndarray (n, n_points) or None
-        The example record's other segments.
-    fraction : float or None
-        The ``holdout`` fraction that cut ``healthy`` from the target's healthy SAs (None
-        when the hold-outs were given).
-    """
-
-    healthy: NDArray[np.float64] | None
-    example: NDArray[np.float64] | None
-    fraction: float | None
-
-
-def split_holdouts(target_healthy: ArrayLike, holdout: float = 0.0,
-                   healthy_holdout: ArrayLike | None = None,
-                   example_record: ArrayLike | None = None,
-                   ) -> tuple[NDArray[np.float64], Holdouts]:
-    """The healthy SAs the fit uses and the hold-outs it checks itself on.
-
-    Parameters
-    ----------
-    target_healthy : array_like (n, n_points)
-    holdout : float in [0, 1)
-        With ``healthy_holdout`` None: the last ``floor(holdout · n)`` healthy SAs are
-        held out (:func:`holdout_count`). Otherwise the fraction the caller cut
-        ``healthy_holdout`` with (said in an "unchecked" verdict; 0: not said).
-    healthy_holdout, example_record : array_like (m, n_points) or (n_points,), optional
-
-    Returns
-    -------
-    fit_healthy : ndarray (n - n_holdout, n_points)
-    holdouts : Holdouts
-
-    Raises
-    ------
-    GearshotError
-        For a bad ``holdout`` or hold-outs whose length differs from the healthy SAs'.
-    """
-    healthy = as_signal_array(target_healthy, "target_healthy", min_ndim=2, max_ndim=2)
-    n_points = healthy.shape[1]
-
-    def checked(sa: ArrayLike | None, name: str) -> NDArray[np.float64] | None:
-        if sa is None:
-            return None
-        arr = np.asarray(sa, dtype=float)
-        if arr.size == 0:
-            return np.empty((0, n_points))
-        arr = as_signal_array(arr, name, max_ndim=2)
-        arr = arr.reshape(-1, arr.shape[-1])
-        if arr.shape[1] != n_points:
-            raise GearshotError(f"{name} has {arr.shape[1]} points per cycle; "
-                                f"target_healthy has {n_points}")
-        return arr
-
-    example = checked(example_record, "example_record")
-    if healthy_holdout is not None:  # cut by the caller (``holdout`` only said)
-        holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
-        return healthy, Holdouts(checked(healthy_holdout, "healthy_holdout"), example,
-                                 float(holdout) if holdout else None)
-    n_out = holdout_count(healthy.shape[0], holdout)
-    if n_out == 0:
-        return healthy, Holdouts(None, example, float(holdout) if holdout else None)
-    return (healthy[: healthy.shape[0] - n_out],
-            Holdouts(healthy[healthy.shape[0] - n_out:], example, float(holdout)))
-
-
 def _estimates(values: ArrayLike | None, name: str) -> tuple[float, ...]:
     if values is None:
         return ()
@@ -260,7 +195,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
               min_holdouts: int = MIN_HOLDOUTS,
               example_self: float | None = None, drift: str | None = None,
               detection_limit: float | None = None,
-              example_contrast: float | None = None) -> FitCheck:
+              example_contrast: float | None = None,
+              drift_ratio: float | None = None) -> FitCheck:
     """The verdict of a fit from its hold-outs' estimates.
 
     Parameters
@@ -292,6 +228,8 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
     example_contrast : float, optional
         How far the example stands out from the fit's healthy segments
         (:func:`~gearshot.estimator.example.example_contrast`): below 0 fails the fit.
+    drift_ratio : float, optional
+        The drifting baseline's trend ratio (kept with ``drift``; :attr:`FitCheck.run_spread`).
 
     Returns
     -------
@@ -353,7 +291,7 @@ def check_fit(healthy_estimates: ArrayLike | None, example_estimates: ArrayLike 
         verdict = PASSED
     return FitCheck(verdict, healthy, example, declared_size, h_mean, e_mean,
                     len(healthy), len(example), healthy_limit, example_limit, own,
-                    drift or None, example_contrast)
+                    drift or None, example_contrast, drift_ratio if drift else None)
 
 
 def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]],
@@ -395,4 +333,5 @@ def check_holdouts(predict: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     return check_fit(read(holdouts.healthy), read(holdouts.example), declared_size,
                      healthy_note=note, example_self=None if own is None else own[0],
                      drift=None if drift is None else drift.reason(),
-                     detection_limit=detection_limit, example_contrast=example_contrast)
+                     detection_limit=detection_limit, example_contrast=example_contrast,
+                     drift_ratio=None if drift is None else drift.ratio)
