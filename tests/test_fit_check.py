@@ -288,6 +288,7 @@ def test_a_drifting_fit_keeps_its_drift_and_widens_its_intervals(spur_db):
     keeps the drift's ratio; its intervals use the wider run spread (every healthy run-2
     segment's holds 0, every chipped one's the declared 0.5)."""
     from gearshot.app.predict_machine import predict_from_machine
+    from gearshot.app.trust import fit_check_line
     from gearshot.estimator.fit_check import FitCheck
     from gearshot.estimator.uncertainty import RUN_SPREAD, holdout_interval
 
@@ -301,6 +302,10 @@ def test_a_drifting_fit_keeps_its_drift_and_widens_its_intervals(spur_db):
     assert check["drift_ratio"] > 1.5 and not frame["trusted"].any()
     spread = FitCheck(**{k: v for k, v in check.items() if k != "passed"}).run_spread
     assert spread == pytest.approx(RUN_SPREAD * np.sqrt(check["drift_ratio"]))
+    # predict's fit-check line says so
+    line = fit_check_line(frame)
+    assert line.endswith(f"its intervals take a later run's spread as {RUN_SPREAD:g} × "
+                         f"√{check['drift_ratio']:.2f} = {spread:.2f} (the drift)")
     run2 = frame[frame["recording"].str.endswith("_2.zip")]
     healthy = run2[run2["recording"].str.contains("spur3")]
     chipped = run2[run2["recording"].str.contains("spur2")]

@@ -59,6 +59,12 @@ def fit_check_line(frame: pd.DataFrame) -> str:
         line += " (" + "; ".join(parts) + ")"
     if check["verdict"] != "passed":
         line += " — no estimate of this fit is trusted"
+    ratio = check.get("drift_ratio")
+    if ratio:
+        from ..estimator.uncertainty import RUN_SPREAD
+
+        line += (f"; its intervals take a later run's spread as {RUN_SPREAD:g} × "
+                 f"√{ratio:.2f} = {RUN_SPREAD * ratio ** 0.5:.2f} (the drift)")
     return line
 
 
