@@ -60,6 +60,9 @@ def main(argv=None):
                         "segments, shared by every range and tag (default DATA/family/rigs)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--rigs-table", action="store_true", help="print the per-rig table")
+    parser.add_argument("--checked", action="store_true", help="fit as gearshot predict "
+                        "does, checking itself (held-out healthy segments, the example "
+                        "recording's other segments); a new configuration")
     args = parser.parse_args(argv)
 
     data = Path(args.data) if args.data else data_home()
@@ -87,7 +90,7 @@ def main(argv=None):
             n_draws=args.draws, variants=args.variants, duration=args.duration,
             segments=args.segments, repetitions=args.repetitions, params=params,
             cache_dir=Path(args.rigs_cache) if args.rigs_cache else data / "family" / "rigs",
-            client=client)
+            client=client, checked=args.checked)
     finally:
         if client is not None:
             client.close()

@@ -108,6 +108,33 @@ def test_rig_dataset_keeps_the_example_recording_out_of_the_test_set(small_campa
         rig_dataset(small_campaign, speed=15.0, cycles_per_segment=10)
 
 
+def test_a_checked_fit_holds_out_each_healthy_recordings_last_quarter(small_campaign):
+    """``checked``: the fit is given what ``gearshot predict`` gives: the last quarter of
+    each healthy recording held out, the example recording's other segments."""
+    from gearshot.experiments.rig import CHECKED_HOLDOUT
+
+    ds = rig_dataset(small_campaign, n_train_healthy=2, cycles_per_segment=10,
+                     random_state=0)
+    labels = ds.healthy_recordings
+    args, kw = ds.fit_args("db", checked=True), ds.fit_kwargs(checked=True)
+    plain = ds.fit_kwargs()
+    assert "healthy_holdout" not in plain and plain["healthy_recordings"] is labels
+    kept, held = [], []
+    for name in dict.fromkeys(labels.tolist()):
+        sa = ds.target_healthy[labels == name]
+        n_out = int(np.floor(CHECKED_HOLDOUT * len(sa)))
+        assert n_out >= 1
+        kept.append(sa[: len(sa) - n_out])
+        held.append(sa[len(sa) - n_out:])
+    assert_allclose(args[1], np.vstack(kept))
+    assert_allclose(kw["healthy_holdout"], np.vstack(held))
+    assert len(kw["healthy_recordings"]) == len(args[1]) and kw["holdout"] == CHECKED_HOLDOUT
+    rest = kw["example_record"]
+    assert rest.shape[0] >= 1 and rest.shape[1] == ds.faulty_example.size
+    assert not np.any(np.all(rest == ds.faulty_example, axis=1))
+    assert args[0] == "db" and args[2] is ds.faulty_example and args[3] == ds.faulty_size
+
+
 def test_rig_experiment_rejects_an_unknown_keep_estimators(small_campaign):
     with pytest.raises(GearshotError, match="keep_estimators.*'last'"):
         rig_experiment(small_campaign, None, speed=10, load=5, selection_tf=None,

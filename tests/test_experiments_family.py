@@ -106,9 +106,12 @@ def test_results_resume_and_tables(tmp_path, monkeypatch, paths):
 
 
 def _fake_task(spec):
+    checked = spec.get("checked", False)
     return [dict(config=spec["config"], **spec["rig"], draw=d, variant=v,
-                 mae=0.1 if v == "full" else 0.3, coverage=0.9, n_test=10, seconds=1.0,
-                 record_seconds=2.0)
+                 mae=(0.05 + 0.15 * d) if checked else (0.1 if v == "full" else 0.3),
+                 coverage=0.9, n_test=10, seconds=1.0, record_seconds=2.0, width=0.3,
+                 fit_check=("passed" if d == 0 else "healthy hold-outs read 0.30")
+                 if checked else "unchecked: no hold-outs")
             for d in spec["draws"] for v in spec["variants"] if (d, v) not in spec["done"]]
 
 
@@ -154,6 +157,17 @@ def test_cli_rig_family_runs_resumes_and_writes_tables(tmp_path, monkeypatch, pa
     res = CliRunner().invoke(app, args[:-4] + ["--param", "model_discrepancy=0.1"])
     assert res.exit_code == 0, res.output
     assert calls == [100, 101, 102] * 2
+    assert "own check" not in res.output   # unchecked fits: no verdict table
+    # fits that check themselves (--checked) are another configuration, with their table
+    res = CliRunner().invoke(app, args + ["--checked"])
+    assert res.exit_code == 0, res.output
+    assert calls == [100, 101, 102] * 3
+    assert "The fits' own check" in res.output
+    check = json.loads(out.read_text())["tables"]["check"]
+    row = dict(zip(check["columns"], check["data"][check["index"].index("full")]))
+    assert row["fits"] == 6 and row["passed %"] == pytest.approx(50.0)
+    assert row["MAE passed"] == pytest.approx(5.0)
+    assert row["MAE refused"] == pytest.approx(20.0)
 
 
 def test_parse_params_names_the_option_and_value():

@@ -181,7 +181,8 @@ def family_results_file(seed_range: str | None) -> Path:
 def run_rig_family(seeds, *, seed_range: str | None, results: Path | None, draws: int,
                    variants, frf_folder: Path | None, segments: int, repetitions: int,
                    params: dict, paired: bool = True, rigs_cache: Path | None = None,
-                   scheduler: str | None = None, workers: int = 1) -> ExperimentRun:
+                   scheduler: str | None = None, workers: int = 1,
+                   checked: bool = False) -> ExperimentRun:
     """Issue #12's family of virtual rigs ``seeds`` (resumable): the family's database
     under ``DATA_HOME/family``, the rows of this configuration and the summary tables.
 
@@ -200,10 +201,12 @@ def run_rig_family(seeds, *, seed_range: str | None, results: Path | None, draws
         frame = family.rig_family_experiment(
             store, seeds, results=results, frf_folder=frf_folder, n_draws=draws,
             variants=variants, segments=segments, repetitions=repetitions, params=params,
-            cache_dir=rigs_cache or home / "family" / "rigs", client=client)
+            cache_dir=rigs_cache or home / "family" / "rigs", client=client,
+            checked=checked)
     tables = family.family_tables(frame)
     payload = {"experiment": "rig-family", "range": seed_range, "seeds": list(seeds),
                "draws": draws, "params": params, "results": str(results),
+               "checked": bool(checked),
                "tables": {name: json.loads(t.to_json(orient="split"))
                           for name, t in tables.items() if name != "rigs"}}
     return ExperimentRun(table=tables, payload=payload, results=frame,

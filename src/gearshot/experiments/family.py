@@ -72,7 +72,7 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
                           variants=("full",), duration=None, segments=4,
                           healthy=RIG_HEALTHY_RECORDINGS,
                           sizes=TABLE1_SIZES, repetitions=2, params=None,
-                          cache_dir=None, client=None, progress=True):
+                          cache_dir=None, client=None, progress=True, checked=False):
     """Evaluate the estimator variants on a family of virtual rigs; resumable.
 
     Parameters
@@ -100,6 +100,11 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
     params : dict, optional
         Estimator parameters applied to every variant (a variant's own settings win).
         Part of the configuration key: other ``params`` give new rows.
+    checked : bool, default False
+        Fit as ``gearshot predict`` does, checking itself: the last quarter of each
+        training healthy recording's segments and the example recording's other
+        segments are held out (:meth:`~gearshot.experiments.RigDataset.fit_kwargs`), so
+        every row's ``fit_check`` is a verdict; a new configuration (part of the key).
     cache_dir : path, optional
         Where rigs' SA segments are cached (default ``<results>.rigs/``).
     client : dask.distributed.Client, optional
@@ -122,8 +127,11 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
     # the key holds every estimator parameter in effect (explicit ones and the library's
     # defaults, so that a changed default is a new configuration) and the path bank
     # (another bank is another family)
-    config = config_hash(dict(params=_effective_params(params), campaign=campaign,
-                        store=str(store), bank=[p.name for p in paths]))
+    key = dict(params=_effective_params(params), campaign=campaign, store=str(store),
+               bank=[p.name for p in paths])
+    if checked:   # only then: the key of every earlier configuration stays as it was
+        key["checked"] = True
+    config = config_hash(key)
     rigs = draw_family(seeds, paths, conditions=conditions)
     cache_dir = Path(cache_dir) if cache_dir else results.with_name(results.name + ".rigs")
     done = _done_rows(results, config)
@@ -137,7 +145,7 @@ def rig_family_experiment(store, seeds, *, results, frf_folder=None, n_synthetic
                           else str(frf_folder), n_synthetic=n_synthetic, bank_seed=bank_seed,
                           cache_dir=str(cache_dir), campaign=campaign, store=str(store),
                           draws=draws, variants=list(variants), params=params,
-                          config=config, done=sorted(have)))
+                          config=config, done=sorted(have), checked=bool(checked)))
     for spec in specs:
         spec["done"] = {tuple(x) for x in spec["done"]}
     results.parent.mkdir(parents=True, exist_ok=True)

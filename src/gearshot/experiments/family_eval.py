@@ -130,12 +130,13 @@ def _family_rows(spec: dict) -> list[dict]:
         if not todo:
             continue
         ds = rig_dataset(index, random_state=[rig.seed, draw], segments=segments)
+        checked = bool(spec.get("checked", False))
         out = []
         plain = [v for v in todo if v not in DIAGNOSTIC_VARIANTS]
         if plain:
-            out += evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
+            out += evaluate_variants(ds.fit_args(database, checked), ds.test_sa, ds.test_size,
                                      variants=plain, selection_tf=selection,
-                                     fit_kwargs=ds.fit_kwargs(),
+                                     fit_kwargs=ds.fit_kwargs(checked=checked),
                                      random_state=1000 * rig.seed + draw,
                                      keep_estimators=True, **spec["params"])
         for name in (v for v in todo if v in DIAGNOSTIC_VARIANTS):
@@ -145,9 +146,9 @@ def _family_rows(spec: dict) -> list[dict]:
                 oracle = _calibration_oracle_class()
                 oracle.oracle_sa, oracle.oracle_size = ds.test_sa, ds.test_size
                 factory = oracle
-            row, = evaluate_variants(ds.fit_args(database), ds.test_sa, ds.test_size,
+            row, = evaluate_variants(ds.fit_args(database, checked), ds.test_sa, ds.test_size,
                                      variants=["full"], selection_tf=selection,
-                                     fit_kwargs=ds.fit_kwargs(),
+                                     fit_kwargs=ds.fit_kwargs(checked=checked),
                                      random_state=1000 * rig.seed + draw,
                                      keep_estimators=True, estimator_class=factory,
                                      **{**spec["params"], **extra})

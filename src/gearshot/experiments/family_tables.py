@@ -41,6 +41,9 @@ def format_family_tables(frame: pd.DataFrame, *, rigs_table: bool = False) -> st
                  tables["grade"].to_string(), "", "MAE % by path attenuation:",
                  tables["attenuation"].to_string(), "", "90 % interval coverage %:",
                  tables["coverage"].to_string()]
+        if "check" in tables:
+            parts += ["", "The fits' own check (passed / refused: MAE % of each; the passed "
+                      "fits' 90 % coverage % and width):", tables["check"].to_string()]
         full = frame[frame["variant"] == "full"]
         if not full.empty:
             parts += ["", f"full: fit+predict median {full['seconds'].median():.2f} s per "
@@ -92,6 +95,27 @@ def family_tables(frame: pd.DataFrame) -> dict:
                         aggfunc="mean").mul(100)
     cov["pooled"] = f.groupby("variant").apply(
         lambda g: np.average(g["coverage"], weights=g["n_test"])).mul(100)
-    return {"condition": cond.round(2), "kind": kind.round(2), "grade": grade.round(2),
-            "attenuation": att.round(2), "coverage": cov.round(1), "rigs": rigs}
+    out = {"condition": cond.round(2), "kind": kind.round(2), "grade": grade.round(2),
+           "attenuation": att.round(2), "coverage": cov.round(1), "rigs": rigs}
+    if "fit_check" in f and not f["fit_check"].astype(str).str.startswith("unchecked").all():
+        out["check"] = _check_table(f)
+    return out
+
+
+def _check_table(f: pd.DataFrame) -> pd.DataFrame:
+    """Per variant, the fits that passed their own check against those that refused
+    themselves: how many, their MAE %, and the passed fits' coverage % and width."""
+    passed = f["fit_check"].astype(str) == "passed"
+    rows = {}
+    for variant, g in f.groupby("variant"):
+        ok = passed.loc[g.index]
+        yes, no = g[ok], g[~ok]
+        rows[variant] = {
+            "fits": len(g), "passed %": 100.0 * ok.mean(),
+            "MAE passed": 100.0 * yes["mae"].mean() if len(yes) else np.nan,
+            "MAE refused": 100.0 * no["mae"].mean() if len(no) else np.nan,
+            "coverage passed": 100.0 * np.average(yes["coverage"], weights=yes["n_test"])
+            if len(yes) else np.nan,
+            "width passed": yes["width"].mean() if len(yes) else np.nan}
+    return pd.DataFrame.from_dict(rows, orient="index").round(3)
 

@@ -13,7 +13,11 @@ from .._validation import check_int
 from ..io import recording_segments
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
-__all__ = ["RigDataset", "rig_dataset"]
+__all__ = ["RigDataset", "rig_dataset", "CHECKED_HOLDOUT"]
+
+#: Share of each healthy recording's segments a ``checked`` fit holds out (as ``gearshot
+#: predict``'s ``--holdout``).
+CHECKED_HOLDOUT = 0.25
 
 
 @dataclass(frozen=True)
@@ -39,6 +43,9 @@ class RigDataset:
     healthy_recordings : ndarray of str (n,) or None
         The recording each training healthy SA comes from (``fit``'s
         ``healthy_recordings``: references from other runs, residue whitening).
+    example_rest : ndarray (k, n_points) or None
+        The example recording's other segments (``fit``'s ``example_record`` with
+        ``checked``; they are in no test set).
     """
 
     target_healthy: np.ndarray
@@ -52,21 +59,50 @@ class RigDataset:
     gear_teeth: int = GEAR_TEETH
     pinion_teeth: int = PINION_TEETH
     healthy_recordings: np.ndarray | None = None
+    example_rest: np.ndarray | None = None
 
-    def fit_args(self, database):
-        """Positional arguments for :meth:`OneFaultShotEstimator.fit`."""
-        return (database, self.target_healthy, self.faulty_example, self.faulty_size,
-                self.healthy_long)
+    def fit_args(self, database, checked: bool = False):
+        """Positional arguments for :meth:`OneFaultShotEstimator.fit` (with ``checked``,
+        the healthy SAs the fit keeps: :meth:`fit_kwargs`)."""
+        healthy = self.target_healthy[self._checked_split()[0]] if checked \
+            else self.target_healthy
+        return (database, healthy, self.faulty_example, self.faulty_size, self.healthy_long)
 
-    def fit_kwargs(self, recordings: bool = True):
+    def fit_kwargs(self, recordings: bool = True, checked: bool = False):
         """Keyword arguments for :meth:`OneFaultShotEstimator.fit`: the SAs' pair and,
         with ``recordings``, the healthy SAs' recordings (the paper's Sec. 4.2 experiment,
-        :func:`~gearshot.experiments.rig_experiment`, passes none, as the paper)."""
+        :func:`~gearshot.experiments.rig_experiment`, passes none, as the paper).
+
+        ``checked``: the fit checks itself as ``gearshot predict``'s does: the last
+        quarter of each healthy recording's segments is held out (``healthy_holdout``,
+        ``holdout=0.25``) and the example recording's other segments are its
+        ``example_record``."""
         kw: dict[str, object] = {"gear_teeth": self.gear_teeth,
                                  "pinion_teeth": self.pinion_teeth}
+        keep, hold = self._checked_split() if checked else (None, None)
         if recordings and self.healthy_recordings is not None:
-            kw["healthy_recordings"] = self.healthy_recordings
+            kw["healthy_recordings"] = self.healthy_recordings if keep is None \
+                else self.healthy_recordings[keep]
+        if checked:
+            kw.update(healthy_holdout=self.target_healthy[hold], holdout=CHECKED_HOLDOUT,
+                      example_record=self.example_rest)
         return kw
+
+    def _checked_split(self):
+        """Indices of the healthy SAs kept and held out: the last ``CHECKED_HOLDOUT`` of
+        each recording's (:func:`~gearshot.estimator.holdouts.holdout_count`)."""
+        from ..estimator.holdouts import holdout_count
+
+        labels = self.healthy_recordings
+        if labels is None:
+            labels = np.zeros(len(self.target_healthy), dtype=int)
+        keep, hold = [], []
+        for name in dict.fromkeys(np.asarray(labels).tolist()):
+            idx = np.flatnonzero(np.asarray(labels) == name)
+            n_out = holdout_count(idx.size, CHECKED_HOLDOUT)
+            keep += idx[: idx.size - n_out].tolist()
+            hold += idx[idx.size - n_out:].tolist()
+        return np.asarray(keep, dtype=np.intp), np.asarray(hold, dtype=np.intp)
 
 
 def _campaign_rows(campaign, speed, load):
@@ -146,7 +182,8 @@ def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5,
     healthy_long = sa_of(train_h[0], long=True)[1]
     ex_rec = int(rng.choice(faulty))
     ex_sa = sa_of(ex_rec)[0]
-    example = ex_sa[int(rng.integers(ex_sa.shape[0]))]
+    ex_k = int(rng.integers(ex_sa.shape[0]))
+    example = ex_sa[ex_k]
     test_rows = [i for i in rows.index if i not in set(train_h) and i != ex_rec]
     test_sa, test_y, test_rec = [], [], []
     for i in test_rows:
@@ -166,4 +203,5 @@ def rig_dataset(campaign, *, speed=None, load=None, n_train_healthy=5,
         gear_teeth=int(gear_teeth),
         pinion_teeth=int(pinion_teeth),
         healthy_recordings=labels,
+        example_rest=np.delete(ex_sa, ex_k, axis=0),
     )

@@ -203,6 +203,10 @@ def experiment_rig_family(
     json_out: Path | None = typer.Option(None, "--json", help="Write the summary tables "
                                             "as JSON."),
     rigs_table: bool = typer.Option(False, "--rigs-table", help="Print the per-rig table."),
+    checked: bool = typer.Option(False, "--checked", help="Fit as 'gearshot predict' "
+                                 "does, checking itself on held-out healthy segments and "
+                                 "the example recording's other segments (a new "
+                                 "configuration; the tables add the fits' verdicts)."),
     scheduler: Scheduler = None,
     workers: int = typer.Option(1, "--workers", help="LocalCluster workers (rigs in "
                                 "parallel) when no --scheduler is given."),
@@ -226,7 +230,8 @@ def experiment_rig_family(
     run = run_rig_family(pool, seed_range=name, results=results, draws=draws,
                          variants=variants, frf_folder=frf_folder, segments=segments,
                          repetitions=repetitions, params=params, paired=paired,
-                         rigs_cache=rigs_cache, scheduler=scheduler, workers=workers)
+                         rigs_cache=rigs_cache, scheduler=scheduler, workers=workers,
+                         checked=checked)
     typer.echo(f"{len(pool)} rigs × {draws} draws, {len(run.results)} rows in {results}")
     typer.echo(family.format_family_tables(run.results, rigs_table=rigs_table))
     write_json(json_out, run.payload)
