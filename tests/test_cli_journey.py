@@ -207,9 +207,13 @@ def test_indicator_figures_go_through_the_atomic_writer(small, tmp_path, monkeyp
 def _family_payload():
     frame = pd.DataFrame({"mae": [10.0, 12.0]}, index=pd.Index(["full", "no_tuning"],
                                                                name="variant"))
+    check = pd.DataFrame({"fits": [48.0], "passed %": [72.917], "MAE passed": [5.542],
+                          "MAE refused": [16.198], "coverage passed": [94.405],
+                          "width passed": [0.344]}, index=["full"])
     return {"experiment": "rig-family", "range": "dev", "seeds": [100, 101], "draws": 2,
             "params": {}, "results": "x.jsonl",
-            "tables": {"condition": json.loads(frame.to_json(orient="split"))}}
+            "tables": {"condition": json.loads(frame.to_json(orient="split")),
+                       "check": json.loads(check.to_json(orient="split"))}}
 
 
 @pytest.mark.parametrize("kind", ["demo", "rig", "rig-family", "predict", "indicators"])
@@ -245,6 +249,9 @@ def test_report_reads_every_json_gearshot_writes(kind, small, tmp_path):
             "indicators": "acc_output"}[kind]
     assert want in text, text
     assert list(out.glob("*.png")), "a figure"
+    if kind == "rig-family":   # the fits' verdicts, titled, their width not rounded away
+        assert "## The fits' own check (`--checked`)" in text
+        assert "| full | 48 | 72.9 | 5.54 | 16.2 | 94.4 | 0.344 |" in text, text
 
 
 @pytest.mark.parametrize("content", ['{"hello": 1}', "[1, 2]", "not json at all"])

@@ -236,6 +236,18 @@ def _demo_report(payload, out: Path, source: Path) -> Path:
     return write_report(out, payload, figs)
 
 
+#: Titles and number formats of a rig-family JSON's tables (others: their name, 0.1).
+_FAMILY_TABLES = {
+    "condition": ("MAE by condition (speed/load); mean, p90 and max over rigs", "{:.2f}"),
+    "kind": ("MAE by path type", "{:.2f}"),
+    "grade": ("MAE by the rig's true grade", "{:.2f}"),
+    "attenuation": ("MAE by path attenuation", "{:.2f}"),
+    "coverage": ("90 % interval coverage", "{:.1f}"),
+    "check": ("The fits' own check (`--checked`): MAE of the fits that passed and of "
+              "those that refused themselves; the passed fits' coverage and width", "{:.3g}"),
+}
+
+
 def _family_report(payload, out: Path, source: Path) -> Path:
     import pandas as pd
 
@@ -247,7 +259,8 @@ def _family_report(payload, out: Path, source: Path) -> Path:
                                  index=split["index"]).astype(float)
               for name, split in payload["tables"].items()}
     for name, frame in tables.items():
-        lines += [f"## {name}", ""] + _md_table(frame.reset_index(names=""), "{:.1f}")
+        title, fmt = _FAMILY_TABLES.get(name, (name, "{:.1f}"))
+        lines += [f"## {title}", ""] + _md_table(frame.reset_index(names=""), fmt)
     cond = tables.get("condition")
     if cond is not None and len(cond.columns) and len(cond):
         from .figures import ablation_figure
