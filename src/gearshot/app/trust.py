@@ -61,10 +61,10 @@ def fit_check_line(frame: pd.DataFrame) -> str:
         line += " — no estimate of this fit is trusted"
     ratio = check.get("drift_ratio")
     if ratio:
-        from ..estimator.uncertainty import RUN_SPREAD
+        from ..estimator.uncertainty import RUN_SPREAD, drift_run_spread
 
         line += (f"; its intervals take a later run's spread as {RUN_SPREAD:g} × "
-                 f"√{ratio:.2f} = {RUN_SPREAD * ratio ** 0.5:.2f} (the drift)")
+                 f"√{ratio:.2f} = {drift_run_spread(ratio):.2f} (the drift)")
     return line
 
 

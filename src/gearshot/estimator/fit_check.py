@@ -55,6 +55,7 @@ from .trusted import (  # the trust columns of a predict table, re-exported here
     recording_majority,
     trusted_column,
 )
+from .uncertainty import drift_run_spread
 
 __all__ = ["FitCheck", "Holdouts", "check_fit", "check_holdouts", "holdout_count",
            "split_holdouts",
@@ -123,16 +124,9 @@ class FitCheck:
     @property
     def run_spread(self) -> float:
         """Standard deviation of a new run's change of a segment's estimate that the
-        hold-outs cannot show (:data:`~gearshot.estimator.uncertainty.RUN_SPREAD`). A
-        baseline that drifts while it is recorded moves farther than that: the spread
-        grows with the drift's amplitude, ``RUN_SPREAD · sqrt(drift_ratio)`` (the ratio is
-        one of residual energies), with no further parameter."""
-        from .uncertainty import RUN_SPREAD
-
-        ratio = self.drift_ratio
-        if ratio is None or not np.isfinite(ratio) or ratio <= 1:
-            return RUN_SPREAD
-        return RUN_SPREAD * float(np.sqrt(ratio))
+        hold-outs cannot show, wider for a drifting baseline
+        (:func:`~gearshot.estimator.uncertainty.drift_run_spread` of ``drift_ratio``)."""
+        return drift_run_spread(self.drift_ratio)
 
     @property
     def passed(self) -> bool:

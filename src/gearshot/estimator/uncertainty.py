@@ -10,8 +10,9 @@ The paper keeps one tuned grade and gives point estimates. Two additions live he
   mixed over the weighted grade models (the interval of a fit without hold-outs).
 * :func:`holdout_interval`: intervals calibrated on the real residuals of the fit's own
   hold-outs (:mod:`gearshot.estimator.fit_check`), widened by a new run's residue
-  (:data:`RUN_SPREAD`) and by the machine's own scale between and beyond the anchors
-  (:data:`SCALE_SPREAD`): the interval of a checked fit.
+  (:data:`RUN_SPREAD`; :func:`drift_run_spread` for a baseline that drifts) and by the
+  machine's own scale between and beyond the anchors (:data:`SCALE_SPREAD`): the
+  interval of a checked fit.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._errors import GearshotError
 
 __all__ = ["grade_weights", "prune_weights", "conformal_quantile", "mixture_interval",
-           "holdout_interval", "fit_discrepancy", "RUN_SPREAD", "SCALE_SPREAD",
+           "holdout_interval", "fit_discrepancy", "drift_run_spread", "RUN_SPREAD",
+           "SCALE_SPREAD",
            "EXTRAPOLATION_SPREAD", "MODEL_DISCREPANCY", "WHITENED_DISCREPANCY"]
 
 #: Standard deviation (fault-size units) of the change of a segment's estimate from one
@@ -42,6 +44,16 @@ __all__ = ["grade_weights", "prune_weights", "conformal_quantile", "mixture_inte
 #: healthy segments lie lower (benchmarks/RESULTS.md "Trust: fit check, intervals and
 #: run-to-run").
 RUN_SPREAD = 0.14
+
+
+def drift_run_spread(drift_ratio: float | None) -> float:
+    """A new run's spread (:data:`RUN_SPREAD`) for a healthy baseline that drifts while it
+    is recorded: it moves farther than its hold-outs show, by the drift's amplitude,
+    ``RUN_SPREAD · sqrt(drift_ratio)`` (the ratio is one of residual energies; no further
+    parameter). :data:`RUN_SPREAD` for ``drift_ratio`` None, not finite or at most 1."""
+    if drift_ratio is None or not np.isfinite(drift_ratio) or drift_ratio <= 1:
+        return RUN_SPREAD
+    return RUN_SPREAD * float(np.sqrt(drift_ratio))
 
 #: Standard deviation (fault-size units) of the error of the machine's own scale: a
 #: fault of another size than the example's may read above or below it by a share of

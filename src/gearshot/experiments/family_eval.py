@@ -125,12 +125,12 @@ def _family_rows(spec: dict) -> list[dict]:
     database = load_database(spec["store"], speed=rig.speed, load=rig.load)
     selection = TransferFunctionBank.synthetic(1, rng=np.random.default_rng([rig.seed, 99]))[0]
     rows = []
+    checked = bool(spec.get("checked", False))   # fit as gearshot predict does
     for draw in spec["draws"]:
         todo = [v for v in spec["variants"] if (draw, v) not in spec["done"]]
         if not todo:
             continue
         ds = rig_dataset(index, random_state=[rig.seed, draw], segments=segments)
-        checked = bool(spec.get("checked", False))
         out = []
         plain = [v for v in todo if v not in DIAGNOSTIC_VARIANTS]
         if plain:
