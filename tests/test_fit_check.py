@@ -79,6 +79,24 @@ def test_too_few_holdouts_leave_the_fit_unchecked():
     assert "(and healthy hold-outs read 0.50" in check_fit([0.5], [], 0.5).verdict
 
 
+def test_every_entry_point_holds_out_the_same_share_by_default():
+    import inspect
+
+    from gearshot.app import monitor, predict, predict_fit, predict_machine
+    from gearshot.app.cli import estimate
+    from gearshot.estimator.holdouts import HOLDOUT, recording_holdouts
+
+    defaults = {inspect.signature(f).parameters["holdout"].default for f in (
+        predict.predict_from_files, predict.predict_recordings, predict_fit.fit_from_files,
+        predict_machine.predict_from_machine, predict_machine.fit_machine, monitor.fit_model)}
+    assert defaults == {HOLDOUT}
+    cli = inspect.signature(estimate.predict).parameters["holdout"].default
+    assert cli.default == HOLDOUT
+    # per recording, the last floor(share · n) segments; 3 segments give none
+    keep, hold = recording_holdouts([7, 7, 7, 2, 2, 2, 2, 2, 2, 2, 2], HOLDOUT)
+    assert hold.tolist() == [9, 10] and keep.tolist() == list(range(9))
+
+
 def test_a_fit_that_misreads_its_own_example_fails_whatever_its_holdouts():
     own = ("the example itself reads 0.20 against the declared 0.5 (limit ± "
            f"{EXAMPLE_LIMIT:g}): no simulated grade reproduces it")

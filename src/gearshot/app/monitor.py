@@ -21,6 +21,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
+from ..estimator.holdouts import HOLDOUT
 
 __all__ = ["fit_model", "estimate_recordings", "monitor_history", "monitor_fleet",
            "write_monitor_outputs", "LOAD_TOLERANCE"]
@@ -47,7 +48,7 @@ def fit_model(database, healthy: Sequence[str | Path], faulty: str | Path | None
               load: float | None = None, coverage: float = 0.9,
               gear_teeth: int | None = None, pinion_teeth: int | None = None, seed: int = 0,
               cycles_per_segment: int | None = None, sensor: str | None = None,
-              holdout: float = 0.25, speed_tolerance: float = 0.05,
+              holdout: float = HOLDOUT, speed_tolerance: float = 0.05,
               false_alarm_rate: float | None = None, sustain: int | None = None):
     """Fit and write a model file (``gearshot fit``).
 

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from .._errors import GearshotError
+from ..estimator.holdouts import HOLDOUT
 from ..io.input_health import input_check_column, mark_rows
 from .fit_summary import fit_attrs
 from .predict_fit import FittedFiles, _check_files, _key, estimate_segments, fit_from_files
@@ -38,7 +39,7 @@ def _recording_files(path: Path):
 
 def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, speed, load=None,
                        coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                       selection_tf=None, holdout=0.25):
+                       selection_tf=None, holdout=HOLDOUT):
     """Fit the estimator from files and predict every SA segment of ``recordings``.
 
     The recordings are segmented for ``gear_teeth`` / ``pinion_teeth`` (default: the
@@ -55,7 +56,7 @@ def predict_from_files(database, healthy, faulty, faulty_size, recordings, *, sp
     selection_tf : optional
         Step 1's held-out TF (default :func:`gearshot.estimator.default_selection_tf` of
         ``seed``).
-    holdout : float in [0, 1), default 0.25
+    holdout : float in [0, 1), default :data:`~gearshot.estimator.holdouts.HOLDOUT` (0.25)
         Fraction of each healthy recording's segments (the last ``floor(holdout · n)``)
         kept out of the fit (and of the TF estimate) and estimated
         (``role="healthy_holdout"``); with the faulty recording's other segments
@@ -195,7 +196,7 @@ def summary_table(frame: pd.DataFrame, roles: Sequence[str] = ROLES) -> pd.DataF
 
 def predict_recordings(database, healthy, faulty, faulty_size, recordings, *, machine=None,
                        speed=None, load=None, coverage=0.9, gear_teeth=None, pinion_teeth=None,
-                       seed=0, cycles_per_segment=None, sensor=None, holdout=0.25,
+                       seed=0, cycles_per_segment=None, sensor=None, holdout=HOLDOUT,
                        speed_tolerance=0.05) -> tuple[pd.DataFrame, str]:
     """``gearshot predict``: fit and estimate, through a machine file or without one.
 

@@ -12,6 +12,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_in_range
+from ..estimator.holdouts import HOLDOUT
 from ..io.input_health import require_ok
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
@@ -38,7 +39,7 @@ class FittedFiles:
 
 def fit_from_files(database, healthy, faulty, faulty_size, *, speed, load=None,
                    coverage=0.9, gear_teeth=None, pinion_teeth=None, seed=0,
-                   selection_tf=None, recordings=(), holdout=0.25, holdout_files=(),
+                   selection_tf=None, recordings=(), holdout=HOLDOUT, holdout_files=(),
                    reads=None, params=None):
     """Fit the estimator from recording files (the fit of ``gearshot predict`` and
     ``gearshot fit`` without ``--machine``), its hold-outs checking it.

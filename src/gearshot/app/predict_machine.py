@@ -13,6 +13,7 @@ import pandas as pd
 from .._errors import GearshotError
 from .._validation import check_in_range, check_int
 from ..estimator.example import typical_segment
+from ..estimator.holdouts import HOLDOUT
 from ..io.input_health import input_check_column, mark_rows, require_ok
 from ..machine.signal_check import verify_machine
 from .conditions import (
@@ -59,7 +60,7 @@ def predict_from_machine(machine, database, healthy: Sequence[str | Path],
                          recordings: Sequence[str | Path] = (), *,
                          speed: float | None = None, load: float | None = None,
                          cycles_per_segment: int | None = None, sensor: str | None = None,
-                         holdout: float = 0.25, example_segment: int | None = None,
+                         holdout: float = HOLDOUT, example_segment: int | None = None,
                          coverage: float = 0.9, seed: int = 0,
                          params: dict | None = None,
                          speed_tolerance: float = SPEED_TOLERANCE) -> pd.DataFrame:
@@ -147,7 +148,7 @@ def fit_machine(machine, database, healthy: Sequence[str | Path], faulty: str | 
                 faulty_size: float | None, recordings: Sequence[str | Path] = (), *,
                 speed: float | None = None, load: float | None = None,
                 cycles_per_segment: int | None = None, sensor: str | None = None,
-                holdout: float = 0.25, example_segment: int | None = None, seed: int = 0,
+                holdout: float = HOLDOUT, example_segment: int | None = None, seed: int = 0,
                 params: dict | None = None, speed_tolerance: float = SPEED_TOLERANCE):
     """The fit of :func:`predict_from_machine` (same parameters); ``faulty`` None fits
     zero-shot (``calibration="zero_shot"``). With ``sensor`` None the sensor is chosen

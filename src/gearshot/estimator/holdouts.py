@@ -12,7 +12,12 @@ from numpy.typing import ArrayLike, NDArray
 from .._errors import GearshotError
 from .._validation import as_signal_array, check_in_range
 
-__all__ = ["Holdouts", "holdout_count", "split_holdouts"]
+__all__ = ["Holdouts", "HOLDOUT", "holdout_count", "recording_holdouts", "split_holdouts"]
+
+#: Share of each healthy recording's segments (the last ones) that a checked fit holds out
+#: by default (``gearshot predict --holdout``, :func:`gearshot.app.predict.predict_from_files`
+#: and the rig family's ``--checked`` fits).
+HOLDOUT = 0.25
 
 
 def holdout_count(n_segments: int, holdout: float) -> int:
@@ -26,6 +31,27 @@ def holdout_count(n_segments: int, holdout: float) -> int:
     """
     holdout = check_in_range(holdout, "holdout", 0.0, 1.0, high_inclusive=False)
     return int(np.floor(holdout * int(n_segments)))
+
+
+def recording_holdouts(labels: ArrayLike, holdout: float = HOLDOUT,
+                       ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Indices of the healthy SAs a fit keeps and of those it holds out: the last
+    :func:`holdout_count` segments of each recording (``labels``: one per SA, in
+    recording order within each label).
+
+    >>> keep, hold = recording_holdouts(["a"] * 4 + ["b"] * 8)
+    >>> hold.tolist()
+    [3, 10, 11]
+    """
+    names = np.asarray(labels)
+    keep: list[int] = []
+    hold: list[int] = []
+    for name in dict.fromkeys(names.tolist()):
+        idx = np.flatnonzero(names == name)
+        n_out = holdout_count(idx.size, holdout)
+        keep += idx[: idx.size - n_out].tolist()
+        hold += idx[idx.size - n_out:].tolist()
+    return np.asarray(keep, dtype=np.intp), np.asarray(hold, dtype=np.intp)
 
 
 @dataclass(frozen=True)

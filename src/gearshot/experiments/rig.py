@@ -10,14 +10,15 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_int
+from ..estimator.holdouts import HOLDOUT
 from ..io import recording_segments
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
 __all__ = ["RigDataset", "rig_dataset", "CHECKED_HOLDOUT"]
 
-#: Share of each healthy recording's segments a ``checked`` fit holds out (as ``gearshot
-#: predict``'s ``--holdout``).
-CHECKED_HOLDOUT = 0.25
+#: Share of each healthy recording's segments a ``checked`` fit holds out (``gearshot
+#: predict``'s default, :data:`gearshot.estimator.holdouts.HOLDOUT`).
+CHECKED_HOLDOUT = HOLDOUT
 
 
 @dataclass(frozen=True)
@@ -90,19 +91,13 @@ class RigDataset:
 
     def _checked_split(self):
         """Indices of the healthy SAs kept and held out: the last ``CHECKED_HOLDOUT`` of
-        each recording's (:func:`~gearshot.estimator.holdouts.holdout_count`)."""
-        from ..estimator.holdouts import holdout_count
+        each recording's (:func:`~gearshot.estimator.holdouts.recording_holdouts`)."""
+        from ..estimator.holdouts import recording_holdouts
 
         labels = self.healthy_recordings
         if labels is None:
             labels = np.zeros(len(self.target_healthy), dtype=int)
-        keep, hold = [], []
-        for name in dict.fromkeys(np.asarray(labels).tolist()):
-            idx = np.flatnonzero(np.asarray(labels) == name)
-            n_out = holdout_count(idx.size, CHECKED_HOLDOUT)
-            keep += idx[: idx.size - n_out].tolist()
-            hold += idx[idx.size - n_out:].tolist()
-        return np.asarray(keep, dtype=np.intp), np.asarray(hold, dtype=np.intp)
+        return recording_holdouts(labels, CHECKED_HOLDOUT)
 
 
 def _campaign_rows(campaign, speed, load):
