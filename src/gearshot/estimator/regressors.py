@@ -24,6 +24,7 @@ simulation reads this machine's healthy segments, which the detection limit need
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -81,6 +82,22 @@ BOOSTING_TREES = 30
 BOOSTING_STEP = 0.2
 
 
+@functools.cache
+def _controller() -> Any:
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
+def _one_thread() -> Any:
+    """A context in which the trees' OpenMP loops run on one thread: on a few hundred rows
+    their threads cost more than they share (the library default's fit + predict on rig
+    100 of the family took 1.32 s wall with the box's 2 threads and 0.92 s with one;
+    benchmarks/RESULTS.md "5. Speed"). Process-wide while it lasts, as every OpenMP
+    setting is."""
+    return _controller().limit(limits=1, user_api="openmp")
+
+
 def _learner(name: str, seed: int) -> Any:
     if name == "isotonic":
         return ScoreIsotonic()
@@ -122,7 +139,8 @@ class LearnedModel:
 
     def predict(self, X: ArrayLike) -> FloatArray:
         """Fault sizes of feature rows ``X`` (n_samples, n_features), clipped to [0, 1]."""
-        raw = np.asarray(self.learner.predict(np.asarray(X, float)), dtype=np.float64)
+        with _one_thread():
+            raw = np.asarray(self.learner.predict(np.asarray(X, float)), dtype=np.float64)
         return np.asarray(np.clip(raw, 0.0, 1.0), dtype=np.float64)
 
 
@@ -178,7 +196,7 @@ def fit_regressor(name: str, X: ArrayLike, y: ArrayLike, *,
     train, val = next(split.split(X))
     first_own = X.shape[0] - n_own
     simulated = train[train < first_own]   # the probe trains on no row of the machine's own
-    with sklearn.config_context(assume_finite=True):
+    with sklearn.config_context(assume_finite=True), _one_thread():
         probe = _learner(name, seed).fit(X[simulated], y[simulated])
         estimate = np.clip(probe.predict(X[val]), 0, 1)
         own = np.clip(probe.predict(X[first_own:]), 0, 1) if n_own else None
