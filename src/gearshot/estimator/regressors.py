@@ -80,6 +80,12 @@ class ScoreIsotonic:
 #: at 0.1, in about two thirds of the CPU time; benchmarks/RESULTS.md).
 BOOSTING_TREES = 30
 BOOSTING_STEP = 0.2
+#: Leaves per tree of ``"boosting"``: the smallest of 4, 6, 8, 10, 15 whose development
+#: rigs (100–123 × 2 draws) score within 0.1 point of 15's mean and 0.6 of its p90 with
+#: every condition's 90 % coverage ≥ 85 % (15: 8.09 %, p90 15.07, 0.90 s per fit +
+#: predict on rig 100; 10: 8.12; 8: 8.09; **6: 8.09 %, p90 15.16, 0.62 s**; 4: 8.14 %,
+#: coverage at 30 rps / 10 N m 83.7 %; benchmarks/RESULTS.md "5. Speed").
+BOOSTING_LEAVES = 6
 
 
 @functools.cache
@@ -102,7 +108,7 @@ def _learner(name: str, seed: int) -> Any:
     if name == "isotonic":
         return ScoreIsotonic()
     return HistGradientBoostingRegressor(loss="absolute_error", max_iter=BOOSTING_TREES,
-                                         learning_rate=BOOSTING_STEP, max_leaf_nodes=15,
+                                         learning_rate=BOOSTING_STEP, max_leaf_nodes=BOOSTING_LEAVES,
                                          min_samples_leaf=10, random_state=seed)
 
 
