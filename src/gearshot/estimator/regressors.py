@@ -107,9 +107,9 @@ def _one_thread() -> Any:
 def _learner(name: str, seed: int) -> Any:
     if name == "isotonic":
         return ScoreIsotonic()
-    return HistGradientBoostingRegressor(loss="absolute_error", max_iter=BOOSTING_TREES,
-                                         learning_rate=BOOSTING_STEP, max_leaf_nodes=BOOSTING_LEAVES,
-                                         min_samples_leaf=10, random_state=seed)
+    return HistGradientBoostingRegressor(
+        loss="absolute_error", max_iter=BOOSTING_TREES, learning_rate=BOOSTING_STEP,
+        max_leaf_nodes=BOOSTING_LEAVES, min_samples_leaf=10, random_state=seed)
 
 
 @dataclass(frozen=True)
