@@ -1,0 +1,53 @@
+"""Rig-family rows broken down by transfer path kind and true grade band.
+
+Reads the rows that ``benchmarks/rig_family.py`` writes (one JSON object per rig and
+draw) and prints, per path kind (the real beam FRFs against every other path) and band of
+the rig's true DIN grade: rigs, MAE %, ``detection_limit_``, the mean estimate of each
+test size and the fitted grade minus the true one.
+
+    python benchmarks/family_breakdown.py ROWS.jsonl [ROWS.jsonl ...] [--variant full]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import pandas as pd
+
+BANDS = [(1, 6, "1-6"), (7, 9, "7-9"), (10, 12, "10-12")]
+
+
+def band(grade: int) -> str:
+    """The grade band of a true DIN grade."""
+    return next(name for lo, hi, name in BANDS if lo <= grade <= hi)
+
+
+def breakdown(rows: pd.DataFrame) -> pd.DataFrame:
+    """One line per (path kind, grade band): rigs, MAE %, limit, mean estimates by size."""
+    sizes = pd.DataFrame(list(rows["mean_prediction"])).add_prefix("reads ")
+    frame = pd.concat([rows.reset_index(drop=True), sizes], axis=1)
+    frame["path"] = frame["kind"].where(frame["kind"] == "beam", "other")
+    frame["band"] = frame["grade"].map(band)
+    frame["grade_off"] = frame["fitted_grade"] - frame["grade"]
+    cols = {"seed": "nunique", "mae": "mean", "detection_limit": "mean",
+            "grade_off": "mean", **{c: "mean" for c in sizes.columns}}
+    out = frame.groupby(["path", "band"]).agg(cols).rename(columns={"seed": "rigs"})
+    out["mae"] *= 100
+    return out.round(3)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("rows", nargs="+")
+    ap.add_argument("--variant", default="full")
+    args = ap.parse_args()
+    rows = pd.DataFrame([json.loads(line) for path in args.rows
+                         for line in open(path, encoding="utf-8") if line.strip()])
+    rows = rows[rows["variant"] == args.variant]
+    with pd.option_context("display.width", 200, "display.max_columns", 20):
+        print(breakdown(rows).to_string())
+
+
+if __name__ == "__main__":
+    main()
