@@ -20,20 +20,14 @@ import json
 
 import pandas as pd
 
-BANDS = [(1, 6, "1-6"), (7, 9, "7-9"), (10, 12, "10-12")]
-
-
-def band(grade: int) -> str:
-    """The grade band of a true DIN grade."""
-    return next(name for lo, hi, name in BANDS if lo <= grade <= hi)
-
 
 def breakdown(rows: pd.DataFrame) -> pd.DataFrame:
     """One line per (path kind, grade band): rigs, MAE %, limit, mean estimates by size."""
     sizes = pd.DataFrame(list(rows["mean_prediction"])).add_prefix("reads ")
     frame = pd.concat([rows.reset_index(drop=True), sizes], axis=1)
     frame["path"] = frame["kind"].where(frame["kind"] == "beam", "other")
-    frame["band"] = frame["grade"].map(band)
+    frame["band"] = pd.cut(frame["grade"], [0, 6, 9, 12],
+                           labels=["1-6", "7-9", "10-12"]).astype(str)
     frame["grade_off"] = frame["fitted_grade"] - frame["grade"]
     cols = {"seed": "nunique", "mae": "mean", "detection_limit": "mean",
             "grade_off": "mean", **{c: "mean" for c in sizes.columns}}

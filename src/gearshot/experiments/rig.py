@@ -10,7 +10,7 @@ import pandas as pd
 
 from .._errors import GearshotError
 from .._validation import check_int
-from ..estimator.holdouts import HOLDOUT
+from ..estimator.holdouts import HOLDOUT, recording_holdouts
 from ..io import recording_segments
 from ..paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 
@@ -76,7 +76,7 @@ class RigDataset:
 
         ``checked``: the fit checks itself as ``gearshot predict``'s does: the last
         quarter of each healthy recording's segments is held out (``healthy_holdout``,
-        ``holdout=0.25``) and the example recording's other segments are its
+        ``holdout=CHECKED_HOLDOUT``) and the example recording's other segments are its
         ``example_record``."""
         kw: dict[str, object] = {"gear_teeth": self.gear_teeth,
                                  "pinion_teeth": self.pinion_teeth}
@@ -92,8 +92,6 @@ class RigDataset:
     def _checked_split(self):
         """Indices of the healthy SAs kept and held out: the last ``CHECKED_HOLDOUT`` of
         each recording's (:func:`~gearshot.estimator.holdouts.recording_holdouts`)."""
-        from ..estimator.holdouts import recording_holdouts
-
         labels = self.healthy_recordings
         if labels is None:
             labels = np.zeros(len(self.target_healthy), dtype=int)
