@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..signal.alignment import subtract_with_lags
+from ..signal.reference_blend import subtract_blend
 from ..signal.orders import mesh_band_orders
 from . import steps
 from ._inputs import _FitInputs, _on_grid
@@ -20,11 +21,20 @@ from .zero_shot import residue_mean_square
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
+#: References blended by step 6 on the target under ``reference_blend="auto"`` (chosen on
+#: the rig family's development range: 1 → 8.09 %, 2 → 8.07, 3 → 7.76, 5 → 7.74;
+#: benchmarks/RESULTS.md, "Estimator").
+BLEND = 3
+
 
 def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int,
-                      unscaled: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
+                      unscaled: tuple[FloatArray, FloatArray] | None = None,
+                      blend: int = 1) -> FloatArray:
     """Step 6 on target SAs (:func:`steps.suppress_harmonics_target`), shared inside a
     :func:`shared_target_work` block.
+
+    ``blend`` > 1: the least-squares blend of that many best-aligned references is
+    subtracted instead of the best one (:func:`~gearshot.signal.reference_blend.subtract_blend`).
 
     ``unscaled``: the same SAs and references before a common scale was divided out
     (``signals == unscaled[0] / s``, ``references == unscaled[1] / s``). The lag search
@@ -33,16 +43,32 @@ def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int
     """
     def compute() -> FloatArray:
         if not sharing():
+            if blend > 1:
+                return subtract_blend(signals, references, n_blend=blend, upsample=upsample)[0]
             return steps.suppress_harmonics_target(signals, references, upsample=upsample)
-        on = (*(unscaled or (signals, references)), int(upsample))
+        on = (*(unscaled or (signals, references)), int(upsample), int(blend))
         lags = kept("lags", on)
-        residual, found = subtract_with_lags(signals, references, upsample=upsample,
-                                             lags=lags)
+        if blend > 1:
+            residual, found = subtract_blend(signals, references, n_blend=blend,
+                                             upsample=upsample, lags=lags)
+        else:
+            residual, found = subtract_with_lags(signals, references, upsample=upsample,
+                                                 lags=lags)
         if lags is None:
             keep("lags", on, found)
         return residual
 
-    return shared("suppress", (signals, references, int(upsample)), compute)
+    return shared("suppress", (signals, references, int(upsample), int(blend)), compute)
+
+
+def reference_blend(est: Any) -> int:
+    """How many healthy references step 6 blends on the target
+    (:attr:`~gearshot.estimator.EstimatorOptions.reference_blend` resolved: ``"auto"`` is
+    :data:`BLEND` except for the paper's estimator, which keeps its one reference)."""
+    value = est._options().reference_blend
+    if value == "auto":
+        return 1 if getattr(est, "estimator", "paper") == "paper" else BLEND
+    return int(value)
 
 
 @dataclass(frozen=True)
@@ -85,13 +111,14 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
     if est.rms_normalization:  # the unscaled arrays' lags serve (shared_target_work)
         unscaled = steps.split_target_healthy(inputs.target_healthy)
         keep("unscaled references", (references, float(scale)), unscaled[1])
-    upsample = est._options().upsample
+    upsample, blend = est._options().upsample, reference_blend(est)
+    est.reference_blend_ = blend   # what predict blends (1 in a fit saved before the blend)
 
     def step6(train: FloatArray, refs: FloatArray,
               raw: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
         if recordings is None:
-            return suppressed_target(train, refs, upsample, raw)
-        return cross_run(train, refs, recordings, upsample, raw)
+            return suppressed_target(train, refs, upsample, raw, blend)
+        return cross_run(train, refs, recordings, upsample, raw, blend)
 
     sub_h = step6(train_h, references, unscaled)
     weights, sim_tf = fit_whitening(est, inputs, sub_h, scale, tf, recordings, matched)
@@ -139,8 +166,8 @@ def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: 
 
 
 def cross_run(train: FloatArray, references: FloatArray, recordings: NDArray[Any],
-              upsample: int, unscaled: tuple[FloatArray, FloatArray] | None = None
-              ) -> FloatArray:
+              upsample: int, unscaled: tuple[FloatArray, FloatArray] | None = None,
+              blend: int = 1) -> FloatArray:
     """Step 6 on the training SAs with references of other recordings only.
 
     A recording estimated later is another run: none of step 6's references comes from
@@ -158,7 +185,7 @@ def cross_run(train: FloatArray, references: FloatArray, recordings: NDArray[Any
         if not other.any():
             other = np.ones(len(references), bool)
         part = None if unscaled is None else (unscaled[0][rows], unscaled[1][other])
-        out[rows] = suppressed_target(train[rows], references[other], upsample, part)
+        out[rows] = suppressed_target(train[rows], references[other], upsample, part, blend)
     return out
 
 
@@ -180,6 +207,7 @@ def target_features(est: Any, sa: ArrayLike | None, scale: float, references: Fl
     residue weights (shared inside a :func:`shared_target_work` block)."""
     x = np.atleast_2d(np.asarray(sa, dtype=float))
     upsample, orders = est._options().upsample, est._mesh_orders()
+    blend = int(est.__dict__.get("reference_blend_", 1))
 
     def compute() -> FloatArray:
         y, unscaled = x, None
@@ -188,14 +216,15 @@ def target_features(est: Any, sa: ArrayLike | None, scale: float, references: Fl
             raw_refs = kept("unscaled references", (references, float(scale)))
             unscaled = None if raw_refs is None else (x, raw_refs)
         if weights is None:
-            sub = suppressed_target(y, references, upsample, unscaled)
+            sub = suppressed_target(y, references, upsample, unscaled, blend)
         else:   # filtered SAs and references, their own lags
             sub = suppressed_target(filter_orders(y, weights),
-                                    filter_orders(references, weights), upsample)
+                                    filter_orders(references, weights), upsample,
+                                    blend=blend)
         feats, _ = steps.centred_features(sub, healthy_mean, mesh_order=orders, names=names)
         return feats
 
     return shared("features", (x, bool(est.rms_normalization), float(scale), references,
                                 np.asarray(healthy_mean, dtype=float), tuple(names),
-                                orders, int(upsample),
+                                orders, int(upsample), blend,
                                 None if weights is None else np.asarray(weights)), compute)

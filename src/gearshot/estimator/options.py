@@ -86,6 +86,14 @@ class EstimatorOptions:
         between runs kept), or Gaussian noise with their mean power spectrum
         ("gaussian"). "auto": recorded when the fit whitens, else Gaussian. Chosen on the
         rig family's development range (RESULTS, "Estimator").
+    reference_blend : int >= 1 or "auto", default "auto"
+        How many delay-aligned healthy references step 6 subtracts from a target SA: 1,
+        the paper's best single reference; more, the least-squares blend of that many
+        best-aligned ones (:func:`~gearshot.signal.reference_blend.subtract_blend`),
+        which follows a healthy pattern that moves from segment to segment (a rough
+        gear's vibration through a lightly damped path while the speed drifts). "auto":
+        3, except for the paper's estimator (1). Chosen on the rig family's development
+        range (RESULTS, "Estimator").
 
     Examples
     --------
@@ -110,6 +118,7 @@ class EstimatorOptions:
     validation_fraction: float = 0.3
     residue_whitening: str = "auto"
     residue_draws: str = "auto"
+    reference_blend: int | str = "auto"
 
     def __post_init__(self) -> None:
         validate_params({f.name: getattr(self, f.name) for f in fields(self)},
@@ -133,6 +142,7 @@ OPTION_CONSTRAINTS: dict[str, list[Constraint]] = {
     "validation_fraction": [Interval(float, 0, 1, closed="neither")],
     "residue_whitening": [Options(("auto", "on", "off"))],
     "residue_draws": [Options(("auto", "recorded", "gaussian"))],
+    "reference_blend": [Options(("auto",)), Interval(int, 1, None)],
 }
 
 

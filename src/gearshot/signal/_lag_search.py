@@ -107,8 +107,9 @@ def roots(m: int) -> ComplexArray:
 
 
 def contenders(sx: ComplexArray, spec_r: ComplexArray, peak: FloatArray,
-               search: _LagSearch) -> BoolArray:
-    """Which references (c, n_refs) may leave the least residual energy for each signal.
+               search: _LagSearch, among: int = 1) -> BoolArray:
+    """Which references (c, n_refs) may be among the ``among`` leaving the least residual
+    energy for each signal (``among=1``: the one leaving the least).
 
     The residual energy of signal spectrum ``X`` and reference ``H`` at delay ``τ`` is
     ``Σ|X|² + Σ|H|² − 2·C(τ) + ν(τ)``, with ``C`` the correlation curve the search
@@ -116,8 +117,9 @@ def contenders(sx: ComplexArray, spec_r: ComplexArray, peak: FloatArray,
     The fine maximum ``C(τ*)`` is at least the coarse maximum ``C_c`` (a fine point) and at
     most ``C_c + D₂h²/2``: at the continuous maximum ``C' = 0``, the nearest coarse point is
     at most ``h`` (half a coarse step) away and ``|C''| ≤ D₂ = Σ_k w_k|X_k||H_k|ω_k²``.
-    A reference whose least possible energy exceeds another's greatest (with a margin for
-    rounding, 1e-9 of the energies' scale) cannot be chosen, and needs no fine search.
+    A reference whose least possible energy exceeds the greatest of ``among`` others (with a
+    margin for rounding, 1e-9 of the energies' scale) cannot be chosen, and needs no fine
+    search.
 
     Parameters
     ----------
@@ -128,6 +130,7 @@ def contenders(sx: ComplexArray, spec_r: ComplexArray, peak: FloatArray,
     peak : ndarray (c, n_refs)
         The maximum of :meth:`_LagSearch.coarse_curve` for each signal × reference.
     search : _LagSearch
+    among : int >= 1
     """
     n, m = search.n, search.n // 2 + 1
     abs_x, abs_r = np.abs(sx[:, :m]), np.abs(spec_r[:, :m])
@@ -144,4 +147,6 @@ def contenders(sx: ComplexArray, spec_r: ComplexArray, peak: FloatArray,
     least = energy - 2 * (coarse_max + d2 * h * h / 2) - nyquist
     most = energy - 2 * coarse_max + nyquist
     margin = 1e-9 * np.max(energy + 2 * scale, axis=-1, keepdims=True)
-    return cast(BoolArray, least <= np.min(most, axis=-1, keepdims=True) + margin)
+    among = min(max(int(among), 1), most.shape[-1])
+    bound = np.partition(most, among - 1, axis=-1)[:, among - 1:among]
+    return cast(BoolArray, least <= bound + margin)

@@ -161,7 +161,7 @@ def subtract_healthy(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample: i
     signals, refs, upsample = _checked(signals, healthy_refs, upsample, max_ndim=None)
     n = signals.shape[-1]
     residual, ref_index, delays, _ = _subtract(signals.reshape(-1, n), refs, upsample,
-                                               prune=True)
+                                               prune=1)
     residual = residual.reshape(signals.shape)
     if return_details:
         batch_shape = signals.shape[:-1]
@@ -184,13 +184,13 @@ def _checked(signals: ArrayLike, healthy_refs: ArrayLike, upsample: int, *,
 
 
 def _subtract(flat: FloatArray, refs: FloatArray, upsample: int,
-              lags: IntArray | None = None, *, prune: bool = False
+              lags: IntArray | None = None, *, prune: int = 0
               ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
     """:func:`subtract_healthy` on rows ``flat`` (c, n): residual, chosen reference, its
     delay (samples) and every reference's lag (c, n_refs; 1/upsample samples), found here
-    or given as ``lags``. With ``prune``, references that cannot be chosen
-    (:func:`~gearshot.signal._lag_search.contenders`) are not searched: their lag is −1
-    (the residual, reference and delay are the same)."""
+    or given as ``lags``. With ``prune`` (≥ 1), references that cannot be among the
+    ``prune`` leaving the least energy (:func:`~gearshot.signal._lag_search.contenders`)
+    are not searched: their lag is −1 (the residual, reference and delay are the same)."""
     n = flat.shape[-1]
     spec_x = scipy.fft.fft(flat, axis=-1)
     spec_r = scipy.fft.fft(refs, axis=-1)
@@ -266,13 +266,13 @@ def subtract_with_lags(signals: ArrayLike, healthy_refs: ArrayLike, *, upsample:
 
 
 def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch | None,
-                    upsample: int, steps: IntArray | None = None, prune: bool = False
+                    upsample: int, steps: IntArray | None = None, prune: int = 0
                     ) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
     """For each signal spectrum in ``sx`` (c, n): the residual after subtracting the
     delay-aligned reference that leaves the least energy, that reference's index, its
     delay in samples and every reference's lag (c, n_refs; ``steps`` if given, else found
-    by ``search``; with ``prune`` only for the references that may be chosen, −1 for the
-    others)."""
+    by ``search``; with ``prune`` only for the references that may be among the ``prune``
+    best, −1 for the others)."""
     n, n_refs = sx.shape[-1], spec_r.shape[0]
     keep = np.ones((len(sx), n_refs), dtype=bool)
     if steps is None:
@@ -283,7 +283,7 @@ def _best_residuals(sx: ComplexArray, spec_r: ComplexArray, search: _LagSearch |
         first = np.argmax(curve, axis=-1)
         if prune and n_refs > 1:
             peak = curve[np.arange(len(curve)), first].reshape(-1, n_refs)
-            keep = contenders(sx, spec_r, peak, search)
+            keep = contenders(sx, spec_r, peak, search, among=int(prune))
             searched = keep.ravel()
             cross, curve, first = cross[searched], curve[searched], first[searched]
         steps = np.full(keep.shape, -1, dtype=np.int64)
