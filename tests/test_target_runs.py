@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from estimator_data import N, paired_synthetic_database, synthetic_sa, tf_pair
 
-from gearshot._errors import NotFittedError
+from gearshot._errors import GearshotError, NotFittedError
 from gearshot.estimator import OneFaultShotEstimator
 from gearshot.estimator._target import cross_run
 from gearshot.signal.alignment import subtract_healthy
@@ -90,8 +90,8 @@ def test_new_runs_read_healthy_when_the_fit_differences_cross_runs(monkeypatch):
         assert by_run.predict(new_healthy).mean() <= 0.15
         assert abs(np.median(by_run.predict(new_faulty)) - 0.5) <= 0.2
     # the residue's power, compared unweighted
-    monkeypatch.setattr(target, "cross_run", lambda train, refs, rec, up, unscaled=None:
-                        target.suppressed_target(train, refs, up, unscaled))
+    monkeypatch.setattr(target, "cross_run", lambda train, refs, rec, up, unscaled=None,
+                        blend=1: target.suppressed_target(train, refs, up, unscaled, blend))
     within_run = fit("off")
     assert by_run.target_residue_power_.sum() > 50 * within_run.target_residue_power_.sum()
     assert within_run.predict(new_healthy).mean() >= 0.3
@@ -215,3 +215,32 @@ def test_auto_model_discrepancy_follows_the_whitening():
                                 residue_weights_=whitened.residue_weights_)
     assert fit_discrepancy(zero_shot) == MODEL_DISCREPANCY
     assert fit_discrepancy(SimpleNamespace(model_discrepancy=0.3)) == 0.3
+
+
+def test_the_fit_records_how_many_references_step_6_blends():
+    """The default blends 3 references in a fit on healthy runs of 3 recordings or more
+    (one that whitens its residue); the paper's estimator and a fit on one recording keep
+    one; a fit saved before the blend existed (no ``reference_blend_``) predicts with one
+    reference."""
+    held_out, db, fit_runs, labels, long, example, new_healthy, _ = _scenario(_runs)
+
+    def fit(recordings=labels, **kwargs):
+        est = OneFaultShotEstimator(nominal_grade=6, grades=[3, 6, 9], random_state=0,
+                                    **kwargs)
+        return est.fit(db, fit_runs, example, 0.5, long, selection_tf=held_out,
+                       healthy_recordings=recordings)
+
+    one = fit(options={"reference_blend": 1})
+    assert fit().reference_blend_ == 3
+    assert fit(estimator="paper").reference_blend_ == 1
+    assert fit(recordings=None).reference_blend_ == 1
+    assert fit(recordings=np.r_[np.zeros(12), np.ones(12)]).reference_blend_ == 1
+    assert one.reference_blend_ == 1
+    blended = fit(options={"reference_blend": 3})
+    old = fit(options={"reference_blend": 1})
+    del old.__dict__["reference_blend_"]
+    np.testing.assert_array_equal(old.predict(new_healthy), one.predict(new_healthy))
+    assert not np.array_equal(blended.predict(new_healthy), one.predict(new_healthy))
+    with pytest.raises(GearshotError, match="reference_blend"):
+        OneFaultShotEstimator(options={"reference_blend": 0}).fit(
+            db, fit_runs, example, 0.5, long, selection_tf=held_out)

@@ -179,7 +179,7 @@ class _GradeChoosing(BaseEstimator):  # type: ignore[misc,unused-ignore]
         def example_features() -> FloatArray:
             feats = target_features(self, inputs.faulty_example, target.scale,
                                     target.references, target.healthy_mean, names,
-                                    target.weights)
+                                    target.weights, target.blend)
             return feats[:, cols]
 
         return _FitContext(by_grade, grades, nominal, target, inputs, example_features,

@@ -42,7 +42,8 @@ class _JointCalibration(BaseEstimator):  # type: ignore[misc,unused-ignore]
                       else list(ctx.cols))
         example_sa, example_size = self._calibration_examples(ctx)
         x_ex = target_features(self, example_sa, target.scale, target.references,
-                               target.healthy_mean, names, target.weights)[:, match_cols]
+                               target.healthy_mean, names, target.weights,
+                               target.blend)[:, match_cols]
         spread = target.healthy_features[:, match_cols].std(axis=0, ddof=1)
         modes = options.tf_modes if target.transfer_function is not None else ("none",)
         n_near = int(options.n_near)

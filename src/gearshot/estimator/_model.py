@@ -149,18 +149,18 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
         pure split-conformal intervals; no upper bound (intervals are clipped to [0, 1]).
     estimator : {"boosting", "paper", "isotonic"}, default "boosting"
         Step 8's regressor (:func:`~gearshot.estimator.regressors.fit_regressor`): boosted
-        trees (10.96 % against the paper's KNN's 11.31 % on the development rigs), the
-        paper's KNN (its sweep and the demo's ablations pass ``"paper"``), or an isotonic
-        map of a linear score (benchmarks/RESULTS.md "Estimator: ... new default").
+        trees (10.96 % against the paper's KNN's 11.31 % on the development rigs), the paper's
+        KNN (its sweep and the demo's ablations pass ``"paper"``), or an isotonic map of a
+        linear score (benchmarks/RESULTS.md "Estimator").
     random_state : int >= 0, numpy RandomState or Generator, or None
         Root of the random numbers. Each random step (:data:`STEP_SEEDS`: the noise of
         step 1, the validation split of step 8 and the matched noise) gets its own child
         seed, so switching one step off leaves the others' random numbers unchanged.
     options : EstimatorOptions, mapping of its fields or None, default None
         The research settings (:class:`~gearshot.estimator.EstimatorOptions`: step 1's
-        threshold and fallback, step 2's smoothing, the zero-shot signature and
-        weighting, the simulated reference of step 6, step 6's delay resolution, step
-        8's K candidates and split); None: their defaults, which are the product.
+        threshold and fallback, step 2's smoothing, the zero-shot signature and weighting,
+        step 6's references and delay resolution, step 8's K candidates and split, the
+        residue whitening); None: their defaults, which are the product.
 
     Attributes
     ----------
@@ -190,10 +190,10 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
     target_residue_power_ : ndarray (n_points // 2 + 1,)
         Power spectrum of the target's healthy difference signals (step 6 output): what
         the twin reference adds to the simulated differences as noise.
-    n_neighbors_, n_points_ : int
-    faulty_size_ : float or None
+    n_neighbors_, n_points_ : int; faulty_size_ : float or None
     step_seeds_ : dict step → int
-    simulated_reference_ : {"first_healthy", "twin"} (step 6's reference, "auto" resolved)
+    simulated_reference_, reference_blend_ : str, int (step 6: the simulated reference,
+        "first_healthy" or "twin"; how many healthy references it blends on the target)
     calibration_ : dict
         What the example calibrated: ``strategy`` ("grade" or "joint"), ``settings`` (list
         of dicts ``grade, gain, width, tf, noise, weight`` — and ``log_likelihood`` with
@@ -390,9 +390,9 @@ class OneFaultShotEstimator(_Prediction, _JointCalibration, _GradeChoosing,
             candidate_features_=names, target_healthy_mean_=target.healthy_mean,
             target_healthy_features_=target.healthy_features,
             target_residue_power_=target.residue_power, residue_weights_=target.weights,
-            selected_features_=selection.selected, feature_errors_=selection.errors,
-            selection_features_=selection.features, selected_columns_=cols,
-            faulty_size_=inputs.faulty_size, step_seeds_=seeds,
+            reference_blend_=target.blend, selected_features_=selection.selected,
+            feature_errors_=selection.errors, selection_features_=selection.features,
+            selected_columns_=cols, faulty_size_=inputs.faulty_size, step_seeds_=seeds,
             simulated_reference_=reference, comparability_reference_=comparability,
             mesh_orders_=orders, detection_limit_=detection.limit,
             detection_threshold_=detection.threshold, **grade_choice)

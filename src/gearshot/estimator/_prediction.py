@@ -68,7 +68,8 @@ class _Prediction(BaseEstimator):  # type: ignore[misc,unused-ignore]
                                 f"fitted on {self.n_points_}")
         feats = target_features(self, arr, self.target_scale_, self.references_,
                                 self.target_healthy_mean_, self.candidate_features_,
-                                getattr(self, "residue_weights_", None))
+                                getattr(self, "residue_weights_", None),
+                                getattr(self, "reference_blend_", 1))   # 1: saved before
         return feats[:, self.selected_columns_]
 
     def predict(self, sa: ArrayLike) -> FloatArray:

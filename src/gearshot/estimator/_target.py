@@ -9,8 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..signal.alignment import subtract_with_lags
-from ..signal.reference_blend import subtract_blend
 from ..signal.orders import mesh_band_orders
+from ..signal.reference_blend import subtract_blend
 from . import steps
 from ._inputs import _FitInputs, _on_grid
 from ._shared_work import keep, kept, shared, sharing
@@ -61,13 +61,17 @@ def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int
     return shared("suppress", (signals, references, int(upsample), int(blend)), compute)
 
 
-def reference_blend(est: Any) -> int:
+def reference_blend(est: Any, whitening: bool) -> int:
     """How many healthy references step 6 blends on the target
     (:attr:`~gearshot.estimator.EstimatorOptions.reference_blend` resolved: ``"auto"`` is
-    :data:`BLEND` except for the paper's estimator, which keeps its one reference)."""
+    :data:`BLEND` in a fit that ``whitening`` says whitens its residue (healthy runs of
+    ``MIN_RUNS`` recordings or more, not the paper's estimator), else 1. Blended within
+    one recording, the references follow that run's segments closer than a later run's,
+    and the fit then reads its own healthy hold-outs as a fault: PHM09 30 Hz High, one
+    healthy recording, hold-outs 0.09 → 0.26 with 3 references)."""
     value = est._options().reference_blend
     if value == "auto":
-        return 1 if getattr(est, "estimator", "paper") == "paper" else BLEND
+        return BLEND if whitening else 1
     return int(value)
 
 
@@ -86,6 +90,7 @@ class _TargetSide:
     weights: FloatArray | None = None          # residue whitening of the differences
     simulated_tf: ComplexArray | None = None   # what the simulated side goes through
     residues: FloatArray | None = None         # the matched noise's draws, when recorded
+    blend: int = 1                             # healthy references step 6 blends
 
 
 def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
@@ -111,8 +116,8 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
     if est.rms_normalization:  # the unscaled arrays' lags serve (shared_target_work)
         unscaled = steps.split_target_healthy(inputs.target_healthy)
         keep("unscaled references", (references, float(scale)), unscaled[1])
-    upsample, blend = est._options().upsample, reference_blend(est)
-    est.reference_blend_ = blend   # what predict blends (1 in a fit saved before the blend)
+    upsample = est._options().upsample
+    blend = reference_blend(est, whitens(est, recordings, matched))
 
     def step6(train: FloatArray, refs: FloatArray,
               raw: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
@@ -133,7 +138,20 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
     return _TargetSide(tf, scale, scaled, references, mean_h, feats_h,
                        steps.residue_power(sub_w),
                        residue_mean_square(sub_h, est._mesh_orders()), weights, sim_tf,
-                       sub_w if recorded else None)
+                       sub_w if recorded else None, blend)
+
+
+def whitens(est: Any, recordings: NDArray[Any] | None, matched: bool) -> bool:
+    """Whether the fit whitens its residue (:func:`fit_whitening`): the option is on
+    (``"auto"``: but for the paper's estimator), the calibration is not joint, the
+    simulated side is ``matched`` and the healthy SAs come from ``MIN_RUNS`` or more
+    ``recordings``."""
+    mode = est._options().residue_whitening
+    runs = 0 if recordings is None else np.unique(np.asarray(recordings)).size
+    return not (mode == "off" or (mode == "auto" and getattr(est, "estimator", "paper")
+                                  == "paper")
+                or resolve_calibration(est.calibration) is not None or not matched
+                or runs < MIN_RUNS)
 
 
 def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,
@@ -148,11 +166,7 @@ def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: 
     Step 5 then divides each side by its own healthy RMS *after* the weights: the target's
     weights carry the ratio of the raw to the filtered scale (its differences are formed
     on the raw scale), the simulated side filters before its scale is taken."""
-    mode = est._options().residue_whitening
-    runs = 0 if recordings is None else np.unique(np.asarray(recordings)).size
-    if mode == "off" or (mode == "auto" and getattr(est, "estimator", "paper") == "paper") \
-            or resolve_calibration(est.calibration) is not None or not matched \
-            or runs < MIN_RUNS:
+    if not whitens(est, recordings, matched):
         return None, tf
     healthy, n = inputs.target_healthy, inputs.n_points
     base = residue_weights(differences)
@@ -202,12 +216,11 @@ def target_tf(est: Any, healthy_long: FloatArray | None,
 
 def target_features(est: Any, sa: ArrayLike | None, scale: float, references: FloatArray,
                     healthy_mean: FloatArray, names: tuple[str, ...],
-                    weights: FloatArray | None = None) -> FloatArray:
-    """Steps 5–7 on target SAs with the target side's scale, references, mean and
-    residue weights (shared inside a :func:`shared_target_work` block)."""
+                    weights: FloatArray | None = None, blend: int = 1) -> FloatArray:
+    """Steps 5–7 on target SAs with the target side's scale, references, mean, residue
+    weights and reference blend (shared inside a :func:`shared_target_work` block)."""
     x = np.atleast_2d(np.asarray(sa, dtype=float))
     upsample, orders = est._options().upsample, est._mesh_orders()
-    blend = int(est.__dict__.get("reference_blend_", 1))
 
     def compute() -> FloatArray:
         y, unscaled = x, None

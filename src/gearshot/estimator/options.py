@@ -92,8 +92,10 @@ class EstimatorOptions:
         best-aligned ones (:func:`~gearshot.signal.reference_blend.subtract_blend`),
         which follows a healthy pattern that moves from segment to segment (a rough
         gear's vibration through a lightly damped path while the speed drifts). "auto":
-        3, except for the paper's estimator (1). Chosen on the rig family's development
-        range (RESULTS, "Estimator").
+        3 in a fit that whitens its residue (``residue_whitening``: healthy recordings
+        of 3 runs or more, not the paper's estimator), else 1 (blended within one run,
+        the references follow that run closer than the next). Chosen on the rig
+        family's development range and PHM09's 30 Hz cells (RESULTS, "Estimator").
 
     Examples
     --------

@@ -1,0 +1,90 @@
+"""Where a family rig's healthy residue sits and what step 6 can take off it.
+
+Records one rig of the family (``draw_family``) anew: healthy runs 0–5 and a 0.32 fault,
+4 segments of 50 gear cycles each, optionally with parts of the hidden reality set
+(``OVERRIDES``, :class:`gearshot.rig.reality.RigReality` fields). Prints, per band of
+orders outside the mesh bands (mesh harmonics ± 2, DC), the mean power per segment of:
+
+* the healthy SAs;
+* run 0's segments minus the best reference of runs 1–5 (run to run) and of its own
+  other segments (within the run);
+* run 0's segments minus the least-squares blend of their 3 best references
+  (:func:`gearshot.signal.reference_blend.subtract_blend`);
+* the faulty run's segments minus the best reference (fault + residue),
+
+and the orders that hold most of the within-run residue.
+
+    python benchmarks/residue_by_segment.py 102 '{"speed_drift": 0}'
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from gearshot.experiments import family_rigs as fr
+from gearshot.paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
+from gearshot.rig import VirtualRig
+from gearshot.signal import subtract_healthy
+from gearshot.signal.orders import mesh_band_orders
+from gearshot.signal.reference_blend import subtract_blend
+
+FRF = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "frf"
+BANDS = [(1, 38), (38, 152), (152, 304), (304, 608), (608, 1025)]
+N = SAMPLES_PER_CYCLE
+
+
+def _segments(rig, vr, size, run):
+    """The run's 4 SAs of 50 consecutive gear cycles."""
+    rec = vr.record(speed=rig.speed, load=rig.load, fault_size=size,
+                    duration=fr.campaign_duration(dict(segments=4), rig.speed),
+                    repetition=run)
+    x = rec.angle_domain(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                         samples_per_cycle=N).reshape(-1, N)
+    return x[: 4 * CYCLES_PER_SEGMENT].reshape(4, CYCLES_PER_SEGMENT, N).mean(axis=1)
+
+
+def main() -> None:
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    seed = int(sys.argv[1])
+    overrides = json.loads(sys.argv[2]) if len(sys.argv) > 2 else {}
+    paths = fr.family_paths(FRF, n_synthetic=4, seed=2023)
+    rig = fr.draw_family([seed], paths)[0]
+    vr = fr._rig(VirtualRig, seed, paths, rig.grade, rig.path_index)
+    if overrides:
+        vr = vr.with_reality(**overrides)
+    seg = [_segments(rig, vr, 0.0, r) for r in range(6)]
+    fault = _segments(rig, vr, 0.32, 0)
+    keep = np.ones(N // 2 + 1, bool)
+    keep[mesh_band_orders(N, GEAR_TEETH, 2)] = False
+    keep[0] = False
+
+    def power(x):
+        return np.abs(np.fft.rfft(x, axis=-1)) ** 2
+
+    def bands(x):
+        p = power(x)
+        return "  ".join(f"{p[..., a:b][..., keep[a:b]].sum(-1).mean():9.2e}" for a, b in BANDS)
+
+    print(f"rig {seed}: grade {rig.grade}, path {rig.path}, {rig.speed:g} rps / "
+          f"{rig.load:g} N m; overrides {overrides or 'none'}")
+    print(f"{'orders':34s}" + "  ".join(f"{f'{a}-{b - 1}':>9s}" for a, b in BANDS))
+    refs = np.vstack(seg[1:])
+    within = subtract_healthy(seg[0][:2], seg[0][2:])
+    blend, _ = subtract_blend(seg[0], refs, n_blend=3)
+    for label, x in (("healthy SAs", np.vstack(seg)),
+                     ("run to run, best reference", subtract_healthy(seg[0], refs)),
+                     ("within the run, best reference", within),
+                     ("run to run, blend of 3", blend),
+                     ("0.32 fault, best reference", subtract_healthy(fault, refs))):
+        print(f"{label:34s}{bands(x)}")
+    top = np.sort(np.argsort(power(within).mean(0) * keep)[::-1][:10])
+    print("orders holding most of the within-run residue:",
+          ", ".join(str(int(k)) for k in top))
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,93 @@
+"""Step 6's reference blend (gearshot.signal.reference_blend and the estimator's
+``reference_blend``): a healthy pattern that moves with the speed through a sharp
+resonance is followed by a blend of references where no single reference matches it, a
+fault component is left nearly whole, and the estimator records what it blends."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from gearshot import GearshotError
+from gearshot.signal import fractional_shift, subtract_healthy
+from gearshot.signal.alignment import _subtract
+from gearshot.signal.reference_blend import subtract_blend
+
+N = 512
+
+
+def _resonant_runs(speeds, *, seed=0, fault=0.0):
+    """SAs of one rough gear (every order excited, fixed amplitudes and phases) through a
+    lightly damped mode (damping ratio 0.3 %) at order 150 of the nominal speed: order k
+    sits at frequency k × speed, so a 0.5 % change of speed moves the response near the
+    mode by tens of percent and turns its phase. ``fault``: a local impulse of that
+    height added (a tooth's signature, a shape no healthy SA has)."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(N // 2 + 1)
+    excitation = rng.normal(size=k.size) * np.exp(2j * np.pi * rng.uniform(size=k.size))
+    excitation[0] = 0.0
+    theta = np.arange(N) / N
+    out = []
+    for s in speeds:
+        r = k * s / 150.0
+        h = 1.0 / (1 - r ** 2 + 2j * 0.003 * r)
+        sa = np.fft.irfft(excitation * h, n=N)
+        out.append(sa + fault * np.exp(-0.5 * ((theta - 0.3) / 0.004) ** 2))
+    return np.array(out)
+
+
+def test_one_reference_is_subtract_healthy_bit_for_bit():
+    rng = np.random.default_rng(1)
+    refs = rng.normal(size=(5, 128)).cumsum(axis=1)
+    signals = refs[[0, 2, 4]] + 0.1 * rng.normal(size=(3, 128))
+    blended, lags = subtract_blend(signals, refs, n_blend=1)
+    assert_array_equal(blended, subtract_healthy(signals, refs))
+    assert lags.shape == (3, 5)
+
+
+def test_a_speed_dependent_pattern_is_followed_by_the_blend_and_the_fault_kept():
+    rng = np.random.default_rng(2)
+    refs = _resonant_runs(1 + 0.005 * rng.uniform(-1, 1, 12))
+    new = _resonant_runs(1 + 0.005 * rng.uniform(-1, 1, 6))
+    single = subtract_healthy(new, refs)
+    blended, _ = subtract_blend(new, refs, n_blend=3)
+    # the healthy residue: far less energy left by the blend than by the best reference
+    assert (blended ** 2).sum() < 0.1 * (single ** 2).sum()
+    # a fault component passes: the faulty SAs' residual keeps most of the impulse
+    faulty = _resonant_runs(1 + 0.005 * rng.uniform(-1, 1, 6), fault=3.0)
+    impulse = _resonant_runs([1.0], fault=3.0)[0] - _resonant_runs([1.0])[0]
+    kept, _ = subtract_blend(faulty, refs, n_blend=3)
+    along = kept @ impulse / (impulse @ impulse)
+    assert np.all(np.abs(along - 1) < 0.05)
+
+
+def test_the_pruned_lag_search_keeps_every_reference_the_blend_picks():
+    rng = np.random.default_rng(3)
+    theta = np.arange(256) / 256
+    base = np.cos(2 * np.pi * 19 * theta) + 0.4 * np.cos(2 * np.pi * 38 * theta + 1)
+    refs = np.vstack([fractional_shift(base * rng.uniform(0.7, 1.3), rng.uniform(0, 5))
+                      + 0.05 * rng.normal(size=256) for _ in range(8)])
+    signals = np.vstack([fractional_shift(refs[i % 8], rng.uniform(-3, 3))
+                         + 0.05 * rng.normal(size=256) for i in range(20)])
+    full = _subtract(signals, refs, 100)[3]
+    pruned = _subtract(signals, refs, 100, prune=3)[3]
+    energy = np.array([[np.sum((s - fractional_shift(r, lag / 100)) ** 2)
+                        for r, lag in zip(refs, row)] for s, row in zip(signals, full)])
+    best3 = np.argsort(energy, axis=1)[:, :3]
+    assert (np.take_along_axis(pruned, best3, axis=1) >= 0).all()
+    assert (pruned < 0).any()            # and the bound does drop some
+    # lags found once serve again: the same residual
+    residual, lags = subtract_blend(signals, refs, n_blend=3)
+    again, _ = subtract_blend(signals, refs, n_blend=3, lags=lags)
+    assert_array_equal(residual, again)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"n_blend": 0}, "n_blend"),
+    ({"n_blend": 2.5}, "n_blend"),
+    ({"lags": np.zeros((2, 2), int)}, "lags must be integers of shape"),
+    ({"lags": np.zeros((3, 4))}, "lags must be integers of shape"),
+])
+def test_bad_arguments_are_refused_by_name(kwargs, match):
+    refs = np.random.default_rng(4).normal(size=(4, 64))
+    with pytest.raises(GearshotError, match=match):
+        subtract_blend(refs[:3], refs, **kwargs)
