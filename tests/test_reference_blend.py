@@ -8,9 +8,8 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from gearshot import GearshotError
-from gearshot.signal import fractional_shift, subtract_healthy
+from gearshot.signal import fractional_shift, subtract_blend, subtract_healthy
 from gearshot.signal.alignment import _subtract
-from gearshot.signal.reference_blend import subtract_blend
 
 N = 512
 
@@ -42,6 +41,10 @@ def test_one_reference_is_subtract_healthy_bit_for_bit():
     blended, lags = subtract_blend(signals, refs, n_blend=1)
     assert_array_equal(blended, subtract_healthy(signals, refs))
     assert lags.shape == (3, 5)
+    # leading axes are batch axes, as everywhere in gearshot.signal
+    batch, batch_lags = subtract_blend(np.stack([signals, signals[::-1]]), refs)
+    assert batch.shape == (2, 3, 128) and batch_lags.shape == (2, 3, 5)
+    assert_array_equal(batch[0], subtract_blend(signals, refs)[0])
 
 
 def test_a_speed_dependent_pattern_is_followed_by_the_blend_and_the_fault_kept():

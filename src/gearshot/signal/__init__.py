@@ -22,6 +22,7 @@ from .orders import (
     regular_signal,
     residual_signal,
 )
+from .reference_blend import subtract_blend
 from .ridge import speed_ridge
 from .spectra import acs_background, amplitude_spectrum
 from .tracking import angle_pulse_times, demodulate_angle, estimate_shaft_angle
@@ -51,6 +52,7 @@ __all__ = [
     "minimum_phase",
     "fractional_shift",
     "subtract_healthy",
+    "subtract_blend",
     "speed_ridge",
     "demodulate_angle",
     "angle_pulse_times",

@@ -43,15 +43,15 @@ def subtract_blend(signals: ArrayLike, healthy_refs: ArrayLike, *, n_blend: int 
 
     Parameters
     ----------
-    signals : array_like, shape (c, n) or (n,)
-        Synchronous averages to treat.
+    signals : array_like, shape (..., n)
+        Synchronous averages to treat (leading axes are batch axes).
     healthy_refs : array_like, shape (n_refs, n) or (n,)
         Healthy synchronous averages of the same machine and condition.
     n_blend : int >= 1, default 3
         References combined (at most ``n_refs``).
     upsample : int, default 100
         Delay resolution is ``1/upsample`` sample.
-    lags : array_like of int, shape (c, n_refs), optional
+    lags : array_like of int, shape (..., n_refs), optional
         Every reference's lag for every signal in ``1/upsample`` samples, as returned
         here (−1: a reference that cannot be among the ``n_blend`` best, not searched);
         default: search them.
@@ -59,7 +59,7 @@ def subtract_blend(signals: ArrayLike, healthy_refs: ArrayLike, *, n_blend: int 
     Returns
     -------
     residual : ndarray, shape of ``signals``
-    lags : ndarray of int, shape (c, n_refs)
+    lags : ndarray of int, shape (..., n_refs)
 
     Examples
     --------
@@ -68,7 +68,7 @@ def subtract_blend(signals: ArrayLike, healthy_refs: ArrayLike, *, n_blend: int 
 
     >>> import numpy as np
     >>> from gearshot.signal import fractional_shift, subtract_healthy
-    >>> from gearshot.signal.reference_blend import subtract_blend
+    >>> from gearshot.signal import subtract_blend
     >>> theta = np.arange(128) / 128
     >>> refs = np.vstack([np.cos(2 * np.pi * 8 * theta), np.cos(2 * np.pi * 16 * theta),
     ...                   np.cos(2 * np.pi * 24 * theta)])
@@ -79,22 +79,23 @@ def subtract_blend(signals: ArrayLike, healthy_refs: ArrayLike, *, n_blend: int 
     >>> bool(np.abs(single - fault).max() > 0.3), bool(np.abs(blend - fault).max() < 0.02)
     (True, True)
     """
-    x, refs, upsample = _checked(signals, healthy_refs, upsample, max_ndim=2)
+    x, refs, upsample = _checked(signals, healthy_refs, upsample, max_ndim=None)
     n_blend = check_int(n_blend, "n_blend", minimum=1)
-    flat = np.atleast_2d(x)
-    c, n = flat.shape
+    flat = x.reshape(-1, x.shape[-1])
+    lag_shape = (*x.shape[:-1], refs.shape[0])
     given = None
     if lags is not None:
         given = np.asarray(lags)
-        if given.shape != (c, refs.shape[0]) or given.dtype.kind not in "iu":
-            raise GearshotError(f"lags must be integers of shape {(c, refs.shape[0])} "
-                                f"(signals x references); got {describe(lags)}")
+        if given.shape != lag_shape or given.dtype.kind not in "iu":
+            raise GearshotError(f"lags must be integers of shape {lag_shape} (signals x "
+                                f"references); got {describe(lags)}")
+        given = given.reshape(flat.shape[0], refs.shape[0])
     k = min(n_blend, refs.shape[0])
     residual, _, _, found = _subtract(flat, refs, upsample, given,
                                       prune=k if given is None else 0)
     if k > 1:
         residual = _blended(flat, refs, found, upsample, k)
-    return residual.reshape(x.shape), found
+    return residual.reshape(x.shape), found.reshape(lag_shape)
 
 
 def _blended(flat: FloatArray, refs: FloatArray, lags: IntArray, upsample: int,
