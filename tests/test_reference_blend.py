@@ -84,6 +84,12 @@ def test_the_pruned_lag_search_keeps_every_reference_the_blend_picks():
     assert_array_equal(residual, again)
 
 
+def test_silent_references_leave_the_signal_whole():
+    signals = np.random.default_rng(5).normal(size=(2, 64))
+    residual, _ = subtract_blend(signals, np.zeros((4, 64)))
+    np.testing.assert_allclose(residual, signals, atol=1e-12)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"n_blend": 0}, "n_blend"),
     ({"n_blend": 2.5}, "n_blend"),

@@ -125,7 +125,8 @@ def _blended(flat: FloatArray, refs: FloatArray, lags: IntArray, upsample: int,
         weighted = basis * bins
         gram = np.einsum("cik,cjk->cij", np.conj(weighted), basis).real
         rhs = np.einsum("cik,ck->ci", np.conj(weighted), sx[part]).real
-        ridge = RIDGE * np.trace(gram, axis1=1, axis2=2)[:, None, None] / k
+        ridge = (RIDGE * np.trace(gram, axis1=1, axis2=2)[:, None, None] / k
+                 + np.finfo(float).tiny)       # all-zero references: weights 0
         weights = np.linalg.solve(gram + ridge * np.eye(k), rhs[..., None])[..., 0]
         model = np.einsum("ci,cik->ck", weights, basis)
         out[part] = scipy.fft.irfft(sx[part] - model, n=n, axis=-1)
