@@ -296,6 +296,7 @@ API_CASES = {
     "shaft_cycle_times ratio 1/10**9": lambda: gs.shaft_cycle_times(
         np.arange(5.0), revs_per_cycle=(1, 10 ** 9)),
     "subtract_healthy upsample=10**9": lambda: gs.subtract_healthy(_sa(), _sa(), upsample=10**9),
+    "subtract_blend n_blend=0": lambda: gs.subtract_blend(_sa(), _sa(), n_blend=0),
     "minimum_phase zeros": lambda: gs.minimum_phase(np.zeros(8)),
     "na4_baseline_variance ragged": lambda: na4_baseline_variance([[1, 2], [3]], 5),
     "acs_background segment_size=str": lambda: gs.acs_background(np.ones(300),
@@ -411,6 +412,10 @@ FUZZ = {
     "subtract_healthy": (gs.subtract_healthy, st.tuples(_arrays, _arrays),
                          st.fixed_dictionaries({}, optional={"upsample": _ints,
                                                              "return_details": st.booleans()})),
+    "subtract_blend": (gs.subtract_blend, st.tuples(_arrays, _arrays),
+                       st.fixed_dictionaries({}, optional={"n_blend": _ints,
+                                                           "upsample": _ints,
+                                                           "lags": _arg})),
     "extract_features": (extract_features, st.tuples(_arrays, _ints),
                          st.fixed_dictionaries({}, optional={
                              "names": st.one_of(st.lists(st.sampled_from(
