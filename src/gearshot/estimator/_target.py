@@ -117,7 +117,8 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         unscaled = steps.split_target_healthy(inputs.target_healthy)
         keep("unscaled references", (references, float(scale)), unscaled[1])
     upsample = est._options().upsample
-    blend = reference_blend(est, whitens(est, recordings, matched))
+    whitening = whitens(est, recordings, matched)
+    blend = reference_blend(est, whitening)
 
     def step6(train: FloatArray, refs: FloatArray,
               raw: tuple[FloatArray, FloatArray] | None = None) -> FloatArray:
@@ -126,7 +127,7 @@ def fit_target_side(est: Any, inputs: _FitInputs, names: tuple[str, ...],
         return cross_run(train, refs, recordings, upsample, raw, blend)
 
     sub_h = step6(train_h, references, unscaled)
-    weights, sim_tf = fit_whitening(est, inputs, sub_h, scale, tf, recordings, matched)
+    weights, sim_tf = fit_whitening(est, inputs, sub_h, scale, tf, whitening)
     sub_w = sub_h
     if weights is not None:   # step 6 again on the filtered SAs (their own lags)
         sub_w = step6(filter_orders(train_h, weights), filter_orders(references, weights))
@@ -155,18 +156,18 @@ def whitens(est: Any, recordings: NDArray[Any] | None, matched: bool) -> bool:
 
 
 def fit_whitening(est: Any, inputs: _FitInputs, differences: FloatArray, scale: float,
-                  tf: ComplexArray | None, recordings: NDArray[Any] | None, matched: bool
+                  tf: ComplexArray | None, whitening: bool
                   ) -> tuple[FloatArray | None, ComplexArray | None]:
     """The target differences' weights and the simulated side's transfer function
-    (:mod:`.whitening`), or ``(None, tf)`` when the fit does not whiten: the option is
-    off (``"auto"``: for the paper's estimator), the calibration is joint, the simulated
-    side is not ``matched`` or the healthy SAs come from fewer than ``MIN_RUNS``
-    ``recordings``.
+    (:mod:`.whitening`), or ``(None, tf)`` when the fit does not whiten (``whitening``,
+    :func:`whitens`: the option is off — ``"auto"``: for the paper's estimator —, the
+    calibration is joint, the simulated side is not matched or the healthy SAs come from
+    fewer than ``MIN_RUNS`` recordings).
 
     Step 5 then divides each side by its own healthy RMS *after* the weights: the target's
     weights carry the ratio of the raw to the filtered scale (its differences are formed
     on the raw scale), the simulated side filters before its scale is taken."""
-    if not whitens(est, recordings, matched):
+    if not whitening:
         return None, tf
     healthy, n = inputs.target_healthy, inputs.n_points
     base = residue_weights(differences)

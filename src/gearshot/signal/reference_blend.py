@@ -91,8 +91,11 @@ def subtract_blend(signals: ArrayLike, healthy_refs: ArrayLike, *, n_blend: int 
                                 f"references); got {describe(lags)}")
         given = given.reshape(flat.shape[0], refs.shape[0])
     k = min(n_blend, refs.shape[0])
-    residual, _, _, found = _subtract(flat, refs, upsample, given,
-                                      prune=k if given is None else 0)
+    if given is None or k == 1:   # the search, or the single reference's residual
+        residual, _, _, found = _subtract(flat, refs, upsample, given,
+                                          prune=k if given is None else 0)
+    else:                         # lags given: the blend needs nothing else
+        found = given
     if k > 1:
         residual = _blended(flat, refs, found, upsample, k)
     return residual.reshape(x.shape), found.reshape(lag_shape)
