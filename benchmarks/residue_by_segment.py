@@ -42,9 +42,8 @@ def _segments(rig, vr, size, run):
     rec = vr.record(speed=rig.speed, load=rig.load, fault_size=size,
                     duration=fr.campaign_duration(dict(segments=4), rig.speed),
                     repetition=run)
-    x = rec.angle_domain(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
-                         samples_per_cycle=N).reshape(-1, N)
-    return x[: 4 * CYCLES_PER_SEGMENT].reshape(4, CYCLES_PER_SEGMENT, N).mean(axis=1)
+    return rec.to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
+                              cycles_per_segment=CYCLES_PER_SEGMENT, samples_per_cycle=N)[:4]
 
 
 def main() -> None:
@@ -85,6 +84,7 @@ def main() -> None:
     top = np.sort(np.argsort(power(within).mean(0) * keep)[::-1][:10])
     print("orders holding most of the within-run residue:",
           ", ".join(str(int(k)) for k in top))
+
 
 if __name__ == "__main__":
     main()
