@@ -63,6 +63,18 @@ def test_a_speed_dependent_pattern_is_followed_by_the_blend_and_the_fault_kept()
     assert np.all(np.abs(along - 1) < 0.05)
 
 
+def test_the_step_6_function_blends_when_asked_and_is_the_papers_otherwise():
+    from gearshot.estimator.steps import suppress_harmonics_target
+
+    rng = np.random.default_rng(5)
+    refs = _resonant_runs(1 + 0.005 * rng.uniform(-1, 1, 8))
+    new = _resonant_runs(1 + 0.005 * rng.uniform(-1, 1, 3))
+    assert_array_equal(suppress_harmonics_target(new, refs), subtract_healthy(new, refs))
+    blended = suppress_harmonics_target(new, refs, blend=3)
+    assert_array_equal(blended, subtract_blend(new, refs, n_blend=3)[0])
+    assert (blended ** 2).sum() < (subtract_healthy(new, refs) ** 2).sum()
+
+
 def test_the_pruned_lag_search_keeps_every_reference_the_blend_picks():
     rng = np.random.default_rng(3)
     theta = np.arange(256) / 256

@@ -43,9 +43,8 @@ def suppressed_target(signals: FloatArray, references: FloatArray, upsample: int
     """
     def compute() -> FloatArray:
         if not sharing():
-            if blend > 1:
-                return subtract_blend(signals, references, n_blend=blend, upsample=upsample)[0]
-            return steps.suppress_harmonics_target(signals, references, upsample=upsample)
+            return steps.suppress_harmonics_target(signals, references, upsample=upsample,
+                                                   blend=blend)
         on = (*(unscaled or (signals, references)), int(upsample), int(blend))
         lags = kept("lags", on)
         if blend > 1:

@@ -7,7 +7,8 @@
 5. :func:`normalize_rms`          divide by the mean RMS of the domain's healthy SAs
    (:func:`rms_scale`: that mean, the one computation of step 5's scale)
 6. :func:`suppress_harmonics_simulated` / :func:`suppress_harmonics_target`
-   (with :func:`split_target_healthy`, which sets the target's references apart)
+   (with :func:`split_target_healthy`, which sets the target's references apart; the
+   target side blends 3 references where the fit whitens its residue)
 7. :func:`centred_features`       features minus the healthy mean of their domain
 8. :func:`fit_knn`                K-nearest-neighbour regression, K chosen on a 70/30 split
    (defined with :class:`KnnModel` in :mod:`gearshot.estimator.knn`)
@@ -29,29 +30,17 @@ from sklearn.utils import check_random_state
 
 from .._errors import GearshotError
 from ..features import extract_features
-from ..signal import mean_rms, subtract_healthy
+from ..signal import mean_rms, subtract_blend, subtract_healthy
 from ..transfer import estimate_transfer_function, propagate
 from ._inputs import REFERENCE_FRACTION, reference_count
 from ._simulated import difference_features, residue_noise_spectrum, twin_difference_features
 from .knn import KnnModel, fit_knn
 
 __all__ = [
-    "select_features",
-    "feature_invariance_errors",
-    "tune_grade",
-    "estimate_tf",
-    "propagate_simulated",
-    "rms_scale",
-    "normalize_rms",
-    "suppress_harmonics_simulated",
-    "residue_power",
-    "residue_noise",
-    "split_target_healthy",
-    "suppress_harmonics_target",
-    "centred_features",
-    "simulated_features",
-    "fit_knn",
-    "KnnModel",
+    "select_features", "feature_invariance_errors", "tune_grade", "estimate_tf",
+    "propagate_simulated", "rms_scale", "normalize_rms", "suppress_harmonics_simulated",
+    "residue_power", "residue_noise", "split_target_healthy", "suppress_harmonics_target",
+    "centred_features", "simulated_features", "fit_knn", "KnnModel",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -299,8 +288,14 @@ def split_target_healthy(target_healthy: FloatArray, *, ref_fraction: float = RE
 
 
 def suppress_harmonics_target(signals: ArrayLike, references: ArrayLike, *,
-                              upsample: int = 100) -> FloatArray:
-    """Step 6, target side: subtract the best delay-aligned healthy reference."""
+                              upsample: int = 100, blend: int = 1) -> FloatArray:
+    """Step 6, target side: subtract the best delay-aligned healthy reference (the paper),
+    or with ``blend`` > 1 the least-squares blend of that many best-aligned references,
+    each at its own delay (:func:`gearshot.signal.subtract_blend`; 3 in fits that whiten
+    their residue, ``EstimatorOptions.reference_blend``)."""
+    if blend > 1:
+        residual = subtract_blend(signals, references, n_blend=blend, upsample=upsample)[0]
+        return np.asarray(residual, dtype=np.float64)
     return np.asarray(subtract_healthy(signals, references, upsample=upsample), dtype=np.float64)
 
 
