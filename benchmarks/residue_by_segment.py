@@ -27,7 +27,6 @@ import numpy as np
 
 from gearshot.experiments import family_rigs as fr
 from gearshot.paper import CYCLES_PER_SEGMENT, GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
-from gearshot.rig import VirtualRig
 from gearshot.signal import subtract_healthy
 from gearshot.signal.orders import mesh_band_orders
 from gearshot.signal.reference_blend import subtract_blend
@@ -46,16 +45,17 @@ def _segments(rig, vr, size, run):
                               cycles_per_segment=CYCLES_PER_SEGMENT, samples_per_cycle=N)[:4]
 
 
-def main() -> None:
+def rig_from_argv(usage: str):
+    """``SEED [OVERRIDES]`` of the command line: (seed, overrides, FamilyRig, VirtualRig)."""
     if len(sys.argv) < 2:
-        sys.exit(__doc__)
+        sys.exit(usage)
     seed = int(sys.argv[1])
     overrides = json.loads(sys.argv[2]) if len(sys.argv) > 2 else {}
-    paths = fr.family_paths(FRF, n_synthetic=4, seed=2023)
-    rig = fr.draw_family([seed], paths)[0]
-    vr = fr._rig(VirtualRig, seed, paths, rig.grade, rig.path_index)
-    if overrides:
-        vr = vr.with_reality(**overrides)
+    return (seed, overrides, *fr.family_rig(seed, FRF, **overrides))
+
+
+def main() -> None:
+    seed, overrides, rig, vr = rig_from_argv(__doc__)
     seg = [_segments(rig, vr, 0.0, r) for r in range(6)]
     fault = _segments(rig, vr, 0.32, 0)
     keep = np.ones(N // 2 + 1, bool)

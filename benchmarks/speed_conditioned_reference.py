@@ -21,20 +21,15 @@ response of each order at the cycle's speed, it would leave far less than the bl
 
 from __future__ import annotations
 
-import json
-import sys
-from pathlib import Path
-
 import numpy as np
+from residue_by_segment import rig_from_argv
 
 from gearshot.experiments import family_rigs as fr
 from gearshot.paper import GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
-from gearshot.rig import VirtualRig
 from gearshot.signal import subtract_healthy
 from gearshot.signal.orders import mesh_band_orders
 from gearshot.signal.reference_blend import subtract_blend
 
-FRF = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "frf"
 BANDS = [(1, 38), (38, 152), (152, 304), (304, 608), (608, 1025)]
 N = SAMPLES_PER_CYCLE
 CYCLES = 200  # 4 segments of 50
@@ -97,15 +92,7 @@ def _models(train):
 
 
 def main() -> None:
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    seed = int(sys.argv[1])
-    overrides = json.loads(sys.argv[2]) if len(sys.argv) > 2 else {}
-    paths = fr.family_paths(FRF, n_synthetic=4, seed=2023)
-    rig = fr.draw_family([seed], paths)[0]
-    vr = fr._rig(VirtualRig, seed, paths, rig.grade, rig.path_index)
-    if overrides:
-        vr = vr.with_reality(**overrides)
+    seed, overrides, rig, vr = rig_from_argv(__doc__)
     runs = _aligned([_cycles(rig, vr, r) for r in range(6)])
     keep = np.ones(N // 2 + 1, bool)
     keep[mesh_band_orders(N, GEAR_TEETH, 2)] = False

@@ -122,13 +122,10 @@ def test_a_rough_gear_through_a_measured_beam_path_leaves_less_residue_blended(s
     quarter of it off (40-60 % per band of orders: benchmarks/residue_by_segment.py)."""
     from gearshot.experiments import family_rigs as fr
     from gearshot.paper import GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
-    from gearshot.rig import VirtualRig
     from gearshot.signal import mesh_band_orders
 
-    paths = fr.family_paths(shared_dir / "data" / "frf", n_synthetic=4, seed=2023)
-    rig = fr.draw_family([102], paths)[0]
+    rig, vr = fr.family_rig(102, shared_dir / "data" / "frf")
     assert (rig.grade, rig.path) == (11, "beam_h3")
-    vr = fr._rig(VirtualRig, 102, paths, rig.grade, rig.path_index)
     duration = fr.campaign_duration({"segments": 4}, rig.speed)
     runs = [vr.record(speed=rig.speed, load=rig.load, duration=duration, repetition=r)
             .to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH)

@@ -30,7 +30,7 @@ from ..paper import (
 __all__ = ["PAPER_CONDITIONS", "DEV_SEEDS", "HELDOUT_SEEDS", "SPENT_HELDOUT_SEEDS", "RANGES",
            "SA_PIPELINE_VERSION", "FamilyRig", "path_kind", "family_paths", "draw_family",
            "true_path_on_grid", "rig_segments", "campaign_duration", "tf_digest", "config_hash",
-           "cached_family_fits"]
+           "cached_family_fits", "family_rig"]
 
 #: The paper's four rig conditions (speed rev/s, load N m), :data:`gearshot.paper.RIG_CONDITIONS`
 PAPER_CONDITIONS = RIG_CONDITIONS
@@ -155,6 +155,18 @@ def draw_family(seeds, paths, *, conditions=PAPER_CONDITIONS, grades=(1, 12)):
 def _rig(cls, seed, paths, grade, path_index):
     return cls(seed=seed, tf_bank=paths, grade=grade,
                reality_overrides={"tf_index": int(path_index)})
+
+
+def family_rig(seed: int, frf_folder=None, **overrides):
+    """One rig of the family to record anew: ``(FamilyRig, VirtualRig)``, the rig's hidden
+    reality with ``overrides`` set (:class:`gearshot.rig.reality.RigReality` fields, e.g.
+    ``speed_drift=0``). For the benchmarks and tests that record a rig themselves."""
+    from ..rig import VirtualRig
+
+    paths = family_paths(frf_folder, n_synthetic=4, seed=2023)
+    rig = draw_family([int(seed)], paths)[0]
+    virtual = _rig(VirtualRig, int(seed), paths, rig.grade, rig.path_index)
+    return rig, (virtual.with_reality(**overrides) if overrides else virtual)
 
 
 def true_path_on_grid(rig: FamilyRig, paths, n_points=SAMPLES_PER_CYCLE,
