@@ -21,6 +21,8 @@ response of each order at the cycle's speed, it would leave far less than the bl
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 from residue_by_segment import rig_from_argv
 
@@ -29,6 +31,7 @@ from gearshot.paper import GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 from gearshot.signal import subtract_healthy
 from gearshot.signal.orders import mesh_band_orders
 from gearshot.signal.reference_blend import subtract_blend
+from gearshot.signal.trains import shaft_cycle_times
 
 BANDS = [(1, 38), (38, 152), (152, 304), (304, 608), (608, 1025)]
 N = SAMPLES_PER_CYCLE
@@ -40,7 +43,8 @@ def _cycles(rig, vr, run):
     """The run's first 200 gear cycles: order spectra (200, N/2+1) and speeds (rev/s)."""
     rec = vr.record(speed=rig.speed, load=rig.load, fault_size=0.0,
                     duration=fr.campaign_duration(dict(segments=4), rig.speed), repetition=run)
-    times = rec._cycle_times(GEAR_TEETH, PINION_TEETH)
+    times = shaft_cycle_times(rec.pulse_times(), revs_per_cycle=Fraction(GEAR_TEETH, PINION_TEETH),
+                              pulses_per_rev=rec.resolved_pulses_per_rev())
     x = rec.angle_domain(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH, samples_per_cycle=N)
     spectra = np.fft.rfft(x[: CYCLES * N].reshape(CYCLES, N), axis=-1)
     return spectra, 1.0 / np.diff(times)[:CYCLES]
