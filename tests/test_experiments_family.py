@@ -53,6 +53,21 @@ def test_duration_gives_the_wanted_segments():
     assert family._duration(dict(duration=12.0, segments=4), 15.0) == 12.0
 
 
+def test_family_rig_is_the_drawn_rig_with_its_reality_overridden(shared_dir):
+    from gearshot.experiments import family_rigs
+
+    frf = shared_dir / "data" / "frf"
+    rig, vr = family_rigs.family_rig(102, frf)
+    assert rig == family.draw_family([102], family.family_paths(frf, n_synthetic=4,
+                                                                seed=2023))[0]
+    assert (vr.seed, vr.reveal_path()[0]) == (102, rig.path)
+    assert vr.reveal().speed_drift > 0
+    _, still = family_rigs.family_rig(102, frf, speed_drift=0, speed_ripple=0)
+    hidden = still.reveal()
+    assert (hidden.speed_drift, hidden.speed_ripple) == (0, 0)
+    assert hidden.load_ripple == vr.reveal().load_ripple
+
+
 def test_true_path_on_grid_is_hermitian(paths):
     rig = family.draw_family([55], paths)[0]
     tf = family.true_path_on_grid(rig, paths, n_points=64)
