@@ -36,7 +36,25 @@ BANDS = [(1, 38), (38, 152), (152, 304), (304, 608), (608, 1025)]
 N = SAMPLES_PER_CYCLE
 
 
-def _segments(rig, vr, size, run):
+#: Orders outside the mesh bands (mesh harmonics ± 2) and DC, one-sided.
+OFF_MESH = np.ones(N // 2 + 1, bool)
+OFF_MESH[mesh_band_orders(N, GEAR_TEETH, 2)] = False
+OFF_MESH[0] = False
+
+
+def band_header() -> str:
+    """The column heads of :func:`band_line`."""
+    return "  ".join(f"{f'{a}-{b - 1}':>9s}" for a, b in BANDS)
+
+
+def band_line(power) -> str:
+    """Mean power per segment in each band of ``BANDS``, off the mesh bands (``power``:
+    one-sided power spectra, segments on the leading axes)."""
+    return "  ".join(f"{power[..., a:b][..., OFF_MESH[a:b]].sum(-1).mean():9.2e}"
+                     for a, b in BANDS)
+
+
+def run_segments(rig, vr, size, run):
     """The run's 4 SAs of 50 consecutive gear cycles."""
     rec = vr.record(speed=rig.speed, load=rig.load, fault_size=size,
                     duration=fr.campaign_duration(dict(segments=4), rig.speed),
@@ -56,22 +74,15 @@ def rig_from_argv(usage: str):
 
 def main() -> None:
     seed, overrides, rig, vr = rig_from_argv(__doc__)
-    seg = [_segments(rig, vr, 0.0, r) for r in range(6)]
-    fault = _segments(rig, vr, 0.32, 0)
-    keep = np.ones(N // 2 + 1, bool)
-    keep[mesh_band_orders(N, GEAR_TEETH, 2)] = False
-    keep[0] = False
+    seg = [run_segments(rig, vr, 0.0, r) for r in range(6)]
+    fault = run_segments(rig, vr, 0.32, 0)
 
     def power(x):
         return np.abs(np.fft.rfft(x, axis=-1)) ** 2
 
-    def bands(x):
-        p = power(x)
-        return "  ".join(f"{p[..., a:b][..., keep[a:b]].sum(-1).mean():9.2e}" for a, b in BANDS)
-
     print(f"rig {seed}: grade {rig.grade}, path {rig.path}, {rig.speed:g} rps / "
           f"{rig.load:g} N m; overrides {overrides or 'none'}")
-    print(f"{'orders':34s}" + "  ".join(f"{f'{a}-{b - 1}':>9s}" for a, b in BANDS))
+    print(f"{'orders':34s}" + band_header())
     refs = np.vstack(seg[1:])
     within = subtract_healthy(seg[0][:2], seg[0][2:])
     blend, _ = subtract_blend(seg[0], refs, n_blend=3)
@@ -80,8 +91,8 @@ def main() -> None:
                      ("within the run, best reference", within),
                      ("run to run, blend of 3", blend),
                      ("0.32 fault, best reference", subtract_healthy(fault, refs))):
-        print(f"{label:34s}{bands(x)}")
-    top = np.sort(np.argsort(power(within).mean(0) * keep)[::-1][:10])
+        print(f"{label:34s}{band_line(power(x))}")
+    top = np.sort(np.argsort(power(within).mean(0) * OFF_MESH)[::-1][:10])
     print("orders holding most of the within-run residue:",
           ", ".join(str(int(k)) for k in top))
 

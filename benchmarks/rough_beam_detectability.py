@@ -22,16 +22,12 @@ does not move by one or two standard deviations gives no feature to read the siz
 from __future__ import annotations
 
 import numpy as np
-from residue_by_segment import rig_from_argv
+from residue_by_segment import OFF_MESH, rig_from_argv, run_segments
 from scipy.ndimage import uniform_filter1d
 
 from gearshot.estimator.whitening import SMOOTH_ORDERS
-from gearshot.experiments import family_rigs as fr
-from gearshot.paper import GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
-from gearshot.signal.orders import mesh_band_orders
 from gearshot.signal.reference_blend import subtract_blend
 
-N = SAMPLES_PER_CYCLE
 SIZES = (0.32, 0.56, 0.66)
 
 
@@ -41,19 +37,8 @@ def _power(x):
 
 def main() -> None:
     seed, overrides, rig, vr = rig_from_argv(__doc__)
-    duration = fr.campaign_duration(dict(segments=4), rig.speed)
-
-    def segments(size, run):
-        rec = vr.record(speed=rig.speed, load=rig.load, fault_size=size, duration=duration,
-                        repetition=run)
-        return rec.to_sa_segments(gear_teeth=GEAR_TEETH, pinion_teeth=PINION_TEETH,
-                                  cycles_per_segment=50, samples_per_cycle=N)[:4]
-
-    keep = np.ones(N // 2 + 1, bool)
-    keep[mesh_band_orders(N, GEAR_TEETH, 2)] = False
-    keep[0] = False
-    healthy = [segments(0.0, r) for r in range(6)]
-    faulty = {s: [segments(s, r) for r in (0, 1)] for s in SIZES}
+    healthy = [run_segments(rig, vr, 0.0, r) for r in range(6)]
+    faulty = {s: [run_segments(rig, vr, s, r) for r in (0, 1)] for s in SIZES}
     stats: dict[float, dict[str, list[float]]] = {
         s: {"raw": [], "white": [], "white9": []} for s in (0.0, *SIZES)}
     for out in range(6):
@@ -61,14 +46,14 @@ def main() -> None:
         refs = np.vstack([healthy[q] for q in train])
         residue = np.vstack([subtract_blend(healthy[q], np.vstack(
             [healthy[p] for p in train if p != q]), n_blend=3)[0] for q in train])
-        r = _power(residue).mean(0)[keep]
+        r = _power(residue).mean(0)[OFF_MESH]
         smooth = np.exp(uniform_filter1d(np.log(_power(residue).mean(0) + 1e-300),
-                                         SMOOTH_ORDERS, mode="nearest"))[keep]
+                                         SMOOTH_ORDERS, mode="nearest"))[OFF_MESH]
         targets = [(0.0, healthy[out])]
         if out < 2:     # each faulty recording read against 5 healthy runs once
             targets += [(s, faulty[s][out]) for s in SIZES]
         for size, x in targets:
-            p = _power(subtract_blend(x, refs, n_blend=3)[0])[:, keep]
+            p = _power(subtract_blend(x, refs, n_blend=3)[0])[:, OFF_MESH]
             stats[size]["raw"] += p.sum(1).tolist()
             stats[size]["white"] += (p / r).sum(1).tolist()
             stats[size]["white9"] += (p / smooth).sum(1).tolist()

@@ -24,16 +24,14 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
-from residue_by_segment import rig_from_argv
+from residue_by_segment import band_header, band_line, rig_from_argv
 
 from gearshot.experiments import family_rigs as fr
 from gearshot.paper import GEAR_TEETH, PINION_TEETH, SAMPLES_PER_CYCLE
 from gearshot.signal import subtract_healthy
-from gearshot.signal.orders import mesh_band_orders
 from gearshot.signal.reference_blend import subtract_blend
 from gearshot.signal.trains import shaft_cycle_times
 
-BANDS = [(1, 38), (38, 152), (152, 304), (304, 608), (608, 1025)]
 N = SAMPLES_PER_CYCLE
 CYCLES = 200  # 4 segments of 50
 ORDERS = np.arange(N // 2 + 1)
@@ -98,14 +96,6 @@ def _models(train):
 def main() -> None:
     seed, overrides, rig, vr = rig_from_argv(__doc__)
     runs = _aligned([_cycles(rig, vr, r) for r in range(6)])
-    keep = np.ones(N // 2 + 1, bool)
-    keep[mesh_band_orders(N, GEAR_TEETH, 2)] = False
-    keep[0] = False
-
-    def bands(spectra):
-        p = np.abs(spectra) ** 2
-        return "  ".join(f"{p[..., a:b][..., keep[a:b]].sum(-1).mean():9.2e}" for a, b in BANDS)
-
     target, speed = runs[0]
     sa = _segments(target)
     refs = np.fft.irfft(np.concatenate([_segments(s) for s, _ in runs[1:]]), n=N)
@@ -113,7 +103,7 @@ def main() -> None:
     print(f"rig {seed}: grade {rig.grade}, path {rig.path}, {rig.speed:g} rps / "
           f"{rig.load:g} N m; overrides {overrides or 'none'}; cycle speeds "
           f"{speed.min():.3f}-{speed.max():.3f} rev/s (run 0)")
-    print(f"{'run 0 minus':42s}" + "  ".join(f"{f'{a}-{b - 1}':>9s}" for a, b in BANDS))
+    print(f"{'run 0 minus':42s}" + band_header())
     rows = {"nothing (the healthy SAs)": sa,
             "the best reference (step 6, one)": np.fft.rfft(
                 subtract_healthy(np.fft.irfft(sa, n=N), refs), axis=-1),
@@ -121,7 +111,7 @@ def main() -> None:
     for name, model in _models(runs[1:]).items():
         rows[name] = sa - _segments(model(speed))
     for name, spectra in rows.items():
-        print(f"{name:42s}{bands(spectra)}")
+        print(f"{name:42s}{band_line(np.abs(spectra) ** 2)}")
 
 
 if __name__ == "__main__":
