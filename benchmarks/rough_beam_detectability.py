@@ -25,6 +25,7 @@ import numpy as np
 from residue_by_segment import OFF_MESH, rig_from_argv, run_segments
 from scipy.ndimage import uniform_filter1d
 
+from gearshot.estimator.steps import residue_power
 from gearshot.estimator.whitening import SMOOTH_ORDERS
 from gearshot.signal.reference_blend import subtract_blend
 
@@ -46,9 +47,10 @@ def main() -> None:
         refs = np.vstack([healthy[q] for q in train])
         residue = np.vstack([subtract_blend(healthy[q], np.vstack(
             [healthy[p] for p in train if p != q]), n_blend=3)[0] for q in train])
-        r = _power(residue).mean(0)[OFF_MESH]
-        smooth = np.exp(uniform_filter1d(np.log(_power(residue).mean(0) + 1e-300),
-                                         SMOOTH_ORDERS, mode="nearest"))[OFF_MESH]
+        power = residue_power(residue)
+        r = power[OFF_MESH]
+        smooth = np.exp(uniform_filter1d(np.log(power + 1e-300), SMOOTH_ORDERS,
+                                         mode="nearest"))[OFF_MESH]
         targets = [(0.0, healthy[out])]
         if out < 2:     # each faulty recording read against 5 healthy runs once
             targets += [(s, faulty[s][out]) for s in SIZES]
